@@ -1,0 +1,345 @@
+"""The linear system that travels between stages, and its contact spectral data.
+
+A :class:`LinearSystem` is the one small object every stage exchanges: the
+mass and stiffness matrices of the free flight ``M x'' + K x = 0`` and the
+unilateral constraint ``wᵀx <= gap``.  Whether it came from a spring–mass
+chain, a reduced finite-element model or a user's own matrices, the
+nonsmooth-mode solver only ever sees this object.
+
+Its :attr:`LinearSystem.spectrum` (frequencies, M-normalised modes and contact
+participations ``b_j = wᵀφ_j``) is computed once, on first use, and cached.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Sequence, Union
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+ArrayLike = Union[np.ndarray, sp.spmatrix, sp.sparray]
+
+#: Relative tolerance of the symmetry check ``max|A - Aᵀ| <= SYMMETRY_RTOL * max|A|``.
+SYMMETRY_RTOL = 1e-10
+
+#: Largest model whose spectrum is computed densely.  Larger models go
+#: through the reduction layer (Lanczos, modal, Craig–Bampton) first.
+DENSE_LIMIT = 6000
+
+#: A mode with ``|b_j| <= INACTIVE_RTOL * max|b|`` does not see the contact
+#: (symmetry zeros computed as round-off); it is left out of the impact
+#: dynamics and of the resonance test.
+INACTIVE_RTOL = 1e-11
+
+
+def _is_sparse(a) -> bool:
+    return sp.issparse(a)
+
+
+def _as_matrix(name: str, a, n: int | None = None):
+    """Return ``a`` as a float dense ndarray or CSR matrix, checking shape and values."""
+    if _is_sparse(a):
+        a = sp.csr_array(a, dtype=float)
+        data = a.data
+    else:
+        try:
+            a = np.array(a, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"{name} must be a real matrix: {exc}") from None
+        data = a
+    if a.ndim != 2 or a.shape[0] != a.shape[1]:
+        raise ValueError(f"{name} must be a square matrix, got shape {a.shape}")
+    if a.shape[0] == 0:
+        raise ValueError(f"{name} is empty: a system needs at least one degree of freedom")
+    if n is not None and a.shape[0] != n:
+        raise ValueError(f"{name} has shape {a.shape}, expected ({n}, {n}) to match M")
+    bad = ~np.isfinite(data)
+    if bad.any():
+        raise ValueError(f"{name} contains {int(bad.sum())} non-finite value(s) (NaN or inf)")
+    return a
+
+
+def _check_symmetric(name: str, a) -> None:
+    if _is_sparse(a):
+        scale = abs(a).max()
+        asym = abs(a - a.T).max() if a.nnz else 0.0
+    else:
+        scale = np.abs(a).max()
+        asym = np.abs(a - a.T).max()
+    if asym > SYMMETRY_RTOL * scale:
+        raise ValueError(
+            f"{name} is not symmetric: max|{name} - {name}ᵀ| = {asym:.3g} exceeds "
+            f"{SYMMETRY_RTOL:g} * max|{name}| = {SYMMETRY_RTOL * scale:.3g}"
+        )
+
+
+def _check_positive_definite(name: str, a) -> None:
+    """Raise ``ValueError`` unless the symmetric matrix ``a`` is positive definite.
+
+    Dense: Cholesky.  Sparse: LDLᵀ through SuperLU with diagonal pivoting in
+    symmetric mode; the matrix is positive definite iff every pivot is > 0.
+    """
+    if _is_sparse(a):
+        diag = a.diagonal()
+        if np.any(diag <= 0):
+            i = int(np.argmin(diag))
+            raise ValueError(
+                f"{name} is not positive definite: diagonal entry {name}[{i},{i}] = {diag[i]:.6g} <= 0"
+            )
+        try:
+            lu = spla.splu(
+                sp.csc_array(a),
+                permc_spec="MMD_AT_PLUS_A",
+                diag_pivot_thresh=0.0,
+                options={"SymmetricMode": True},
+            )
+        except RuntimeError as exc:
+            raise ValueError(f"{name} is singular, hence not positive definite ({exc})") from None
+        pivots = lu.U.diagonal()
+        if np.any(pivots <= 0) or not np.array_equal(lu.perm_r, lu.perm_c):
+            raise ValueError(
+                f"{name} is not positive definite: its LDLᵀ factorisation has a pivot "
+                f"{pivots.min():.6g} <= 0"
+            )
+        return
+    try:
+        np.linalg.cholesky(a)
+    except np.linalg.LinAlgError:
+        lam_min = sla.eigvalsh(a, subset_by_index=[0, 0])[0]
+        raise ValueError(
+            f"{name} is not positive definite: smallest eigenvalue {lam_min:.6g} (must be > 0)"
+        ) from None
+
+
+@dataclass(frozen=True)
+class Spectrum:
+    """Contact spectral data of a :class:`LinearSystem`.
+
+    Attributes
+    ----------
+    omega : (m,) ndarray
+        Angular eigenfrequencies ``ω_j`` (rad per time unit), ascending.
+    phi : (n, m) ndarray
+        M-normalised mode shapes (``φᵀMφ = I``, ``φᵀKφ = diag(ω²)``).
+    b : (m,) ndarray
+        Contact participations ``b_j = wᵀφ_j``.
+    active : (m,) bool ndarray
+        Modes that see the contact: ``|b_j| > INACTIVE_RTOL * max|b|``.
+    """
+
+    omega: np.ndarray
+    phi: np.ndarray
+    b: np.ndarray
+    active: np.ndarray
+
+    @cached_property
+    def contact_modes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(ω, b, φ)`` restricted to the active modes (cached; no copy when all are active)."""
+        if self.active.all():
+            return self.omega, self.b, self.phi
+        return self.omega[self.active], self.b[self.active], self.phi[:, self.active]
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        """Eigenfrequencies ``ω_j / 2π`` (cycles per time unit)."""
+        return self.omega / (2 * np.pi)
+
+    @property
+    def periods(self) -> np.ndarray:
+        """Linear periods ``2π / ω_j``."""
+        return 2 * np.pi / self.omega
+
+
+def _dense(a) -> np.ndarray:
+    return a.toarray() if _is_sparse(a) else a
+
+
+def _diagonal(a) -> np.ndarray | None:
+    """The diagonal of ``a`` if ``a`` is a diagonal matrix, else ``None``."""
+    d = a.diagonal()
+    off = (a - sp.diags_array(d)) if _is_sparse(a) else (a - np.diag(d))
+    nonzero = off.count_nonzero() if _is_sparse(off) else np.count_nonzero(off)
+    return d if nonzero == 0 else None
+
+
+def _tridiagonal_bands(a):
+    """``(diag, offdiag)`` if the symmetric ``a`` (dense or sparse) is tridiagonal, else ``None``."""
+    if _is_sparse(a):
+        coo = sp.coo_array(a)
+        width = np.abs(coo.row - coo.col).max() if coo.nnz else 0
+    else:
+        rows, cols = np.nonzero(a)
+        width = np.abs(rows - cols).max() if rows.size else 0
+    if width > 1:
+        return None
+    return np.asarray(a.diagonal(0), dtype=float), np.asarray(a.diagonal(1), dtype=float)
+
+
+def compute_spectrum(M, K, w: np.ndarray) -> Spectrum:
+    """Generalised eigen-decomposition ``K φ = ω² M φ`` with M-normalised ``φ``.
+
+    Dense eigen-solution (all modes).  For a diagonal ``M`` the problem is
+    symmetrised with ``M^{-1/2}``; when ``M^{-1/2} K M^{-1/2}`` is tridiagonal
+    (spring–mass chains, Lanczos chains) LAPACK's tridiagonal MRRR solver is
+    used without forming a dense matrix; otherwise a symmetric dense solver.
+    Models larger than :data:`DENSE_LIMIT` must be reduced first.
+    """
+    n = M.shape[0]
+    mdiag = _diagonal(M)
+    if mdiag is not None:
+        s = 1.0 / np.sqrt(mdiag)
+        if _is_sparse(K):
+            S = sp.diags_array(s)
+            A = sp.csr_array(S @ K @ S)
+        else:
+            A = K * s[:, None] * s[None, :]
+        bands = _tridiagonal_bands(A)
+        if bands is not None and n > 2:
+            lam, psi = sla.eigh_tridiagonal(bands[0], bands[1])
+        else:
+            _check_dense_size(n)
+            lam, psi = sla.eigh(_dense(A))
+        phi = psi * s[:, None]
+    else:
+        _check_dense_size(n)
+        lam, phi = sla.eigh(_dense(K), _dense(M))
+    if lam[0] <= 0:
+        raise ValueError(f"K is not positive definite: eigenvalue {lam[0]:.6g} <= 0")
+    omega = np.sqrt(lam)
+    # Sign convention: the largest component of each mode is positive.
+    idx = np.argmax(np.abs(phi), axis=0)
+    phi = phi * np.sign(phi[idx, np.arange(phi.shape[1])])[None, :]
+    b = w @ phi
+    active = np.abs(b) > INACTIVE_RTOL * np.abs(b).max()
+    return Spectrum(omega=omega, phi=phi, b=b, active=active)
+
+
+def _check_dense_size(n: int) -> None:
+    if n > DENSE_LIMIT:
+        raise ValueError(
+            f"model has {n} dofs, above the dense eigen-solution limit {DENSE_LIMIT}: "
+            "reduce it first (bladecase.reduce with method 'lanczos', 'modal' or 'craig-bampton')"
+        )
+
+
+class LinearSystem:
+    """A linear structure with one unilateral contact.
+
+    Free flight ``M x'' + K x = 0``; constraint ``wᵀx <= gap``; Moreau impact
+    law ``M(v⁺ - v⁻) = -w Λ``, ``wᵀv⁺ = -e wᵀv⁻`` (theory §1).
+
+    Parameters
+    ----------
+    M, K : (n, n) array_like or scipy sparse
+        Symmetric positive definite mass and stiffness matrices.
+    w : (n,) array_like or int
+        Constraint vector; an ``int`` ``c`` means the unit vector on dof ``c``
+        (negative values count from the end, like numpy indices).
+    gap : float
+        Clearance ``d > 0`` between the structure at rest and the obstacle.
+
+    Raises
+    ------
+    ValueError
+        Wrong shapes, non-finite values, asymmetric or non positive-definite
+        matrices, ``w == 0`` or ``gap <= 0``; the message names the problem.
+    """
+
+    def __init__(self, M: ArrayLike, K: ArrayLike, w: np.ndarray | int | Sequence[float], gap: float):
+        M = _as_matrix("M", M)
+        n = M.shape[0]
+        K = _as_matrix("K", K, n)
+        _check_symmetric("M", M)
+        _check_symmetric("K", K)
+        if isinstance(w, (int, np.integer)) and not isinstance(w, bool):
+            c = int(w)
+            if not -n <= c < n:
+                raise ValueError(f"contact dof w = {c} is out of range for a system of {n} dofs (valid: 0..{n - 1})")
+            wv = np.zeros(n)
+            wv[c] = 1.0
+        else:
+            try:
+                wv = np.array(w, dtype=float).reshape(-1)
+            except (TypeError, ValueError) as exc:
+                raise ValueError(f"w must be an int or a real vector: {exc}") from None
+            if wv.shape != (n,):
+                raise ValueError(f"w has {wv.size} entries, expected {n} (one per dof)")
+            if not np.all(np.isfinite(wv)):
+                raise ValueError("w contains non-finite values (NaN or inf)")
+            if not np.any(wv):
+                raise ValueError("w is the zero vector: the constraint wᵀx <= gap needs a non-zero w")
+        try:
+            gap = float(gap)
+        except (TypeError, ValueError):
+            raise ValueError(f"gap must be a positive number, got {gap!r}") from None
+        if not np.isfinite(gap) or gap <= 0:
+            raise ValueError(f"gap must be a finite clearance > 0, got {gap!r}")
+        _check_positive_definite("M", M)
+        _check_positive_definite("K", K)
+        self._M, self._K, self._w, self._gap = M, K, wv, gap
+        self._w.setflags(write=False)
+
+    M = property(lambda self: self._M, doc="Mass matrix (dense ndarray or CSR).")
+    K = property(lambda self: self._K, doc="Stiffness matrix (dense ndarray or CSR).")
+    w = property(lambda self: self._w, doc="Constraint vector (read-only ndarray).")
+    gap = property(lambda self: self._gap, doc="Clearance ``d > 0``.")
+
+    @property
+    def n(self) -> int:
+        """Number of degrees of freedom."""
+        return self._M.shape[0]
+
+    @cached_property
+    def spectrum(self) -> Spectrum:
+        """Frequencies, M-normalised modes and contact participations (cached)."""
+        return compute_spectrum(self._M, self._K, self._w)
+
+    def energy(self, x: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """Mechanical energy ``½vᵀMv + ½xᵀKx`` of states (columns of ``x``, ``v`` if 2-D)."""
+        return 0.5 * np.sum(v * (self._M @ v), axis=0) + 0.5 * np.sum(x * (self._K @ x), axis=0)
+
+    def __repr__(self) -> str:
+        kind = "sparse" if _is_sparse(self._M) else "dense"
+        return f"LinearSystem(n={self.n}, {kind}, gap={self._gap:g})"
+
+
+def chain(n: int, k: float | Sequence[float] = 1.0, m: float | Sequence[float] = 1.0, gap: float = 1.0) -> LinearSystem:
+    """The seed paper's spring–mass chain (its Fig. 1).
+
+    wall — k₁ — m₁ — k₂ — m₂ — … — k_n — m_n | obstacle at ``gap``.
+    ``M = diag(m)``, ``K_ii = k_i + k_{i+1}`` (``k_{n+1} = 0``),
+    ``K_{i,i+1} = -k_{i+1}``; contact on the last mass (``w = e_n``).
+
+    Parameters
+    ----------
+    n : int
+        Number of masses (>= 1).
+    k, m : float or length-n sequence
+        Spring stiffnesses and masses, all > 0.
+    gap : float
+        Clearance ``d > 0`` of the last mass.
+    """
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise ValueError(f"chain length n must be an integer >= 1, got {n!r}")
+    ks = _per_mass("k", k, n)
+    ms = _per_mass("m", m, n)
+    kn = np.append(ks, 0.0)
+    K = sp.diags_array([kn[:-1] + kn[1:], -ks[1:], -ks[1:]], offsets=[0, 1, -1], shape=(n, n), format="csr")
+    M = sp.diags_array(ms, format="csr")
+    return LinearSystem(M, K, n - 1, gap)
+
+
+def _per_mass(name: str, value, n: int) -> np.ndarray:
+    arr = np.atleast_1d(np.asarray(value, dtype=float))
+    if arr.size == 1:
+        arr = np.full(n, arr.item())
+    if arr.shape != (n,):
+        raise ValueError(f"{name} must be a scalar or have {n} entries, got {arr.size}")
+    if not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+        bad = arr[~(np.isfinite(arr) & (arr > 0))][0]
+        raise ValueError(f"every {name} must be finite and > 0, got {bad!r}")
+    return arr

@@ -1,0 +1,270 @@
+"""Periodic orbits with impacts: the core of the nonsmooth-mode solver.
+
+Formulation (theory §3–4).  For a non-resonant period ``T``, the ``T``-periodic
+response to the unit impulse train ``-w Σ_k δ(t - kT)`` is ``x = -G(t)`` with
+
+    G(t)  = Σ_j φ_j b_j cos(ω_j (t - T/2)) / (2 ω_j sin(ω_j T/2)),   t ∈ [0, T)
+
+and an orbit with impacts at ``0 < t₁ < … < t_k = T`` and impulses ``Λ_i`` is
+``x(t) = -Σ_i Λ_i G((t - t_i) mod T)``.  One impact per period (k = 1) gives
+``Λ = -d / g(0)``, ``g = wᵀG``.  Everything is evaluated in the modal
+coordinates of the modes that see the contact (``b_j ≠ 0``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+from .model import LinearSystem
+from .trigsum import TrigSum, certified_max
+
+#: ``T`` is resonant when ``|ω_j T - 2πm| <= RESONANCE_RTOL · ω_j T`` for an
+#: integer ``m >= 1`` and a mode with ``b_j ≠ 0``: within the accuracy of the
+#: computed ``ω_j`` (the response amplitude there exceeds ``~1e11 d``).
+RESONANCE_RTOL = 1e-12
+
+#: An orbit is admissible when its impulses are >= 0 and
+#: ``wᵀx(t) - d <= ADMISSIBILITY_RTOL · d`` is PROVED for every ``t`` of the
+#: period (see :mod:`bladecase.trigsum`); the tolerance is raised to
+#: ``10⁴ ε Σ|coefficients|`` when round-off in evaluating ``wᵀx`` is larger.
+ADMISSIBILITY_RTOL = 1e-9
+
+
+def check_period(system: LinearSystem, T: float) -> float:
+    """Return ``T`` as a float; raise ``ValueError`` if it is invalid or resonant."""
+    try:
+        T = float(T)
+    except (TypeError, ValueError):
+        raise ValueError(f"period T must be a number, got {T!r}") from None
+    if not np.isfinite(T) or T <= 0:
+        raise ValueError(f"period T must be finite and > 0, got {T!r}")
+    sp = system.spectrum
+    omega = sp.omega[sp.active]
+    r = omega * T / (2 * np.pi)
+    m = np.rint(r)
+    bad = np.flatnonzero((m >= 1) & (np.abs(r - m) <= RESONANCE_RTOL * r))
+    if bad.size:
+        j = int(np.flatnonzero(sp.active)[bad[0]])
+        mm = int(m[bad[0]])
+        raise ValueError(
+            f"period T = {T!r} is resonant: ω_{j + 1} T = 2π·{mm} (mode {j + 1}, ω = {sp.omega[j]:.10g}, "
+            f"linear period {2 * np.pi / sp.omega[j]:.10g}); nonsmooth orbits need ω_j T ∉ 2πℤ "
+            f"(relative tolerance {RESONANCE_RTOL:g})"
+        )
+    return T
+
+
+@dataclass(frozen=True)
+class _Modal:
+    """Active-mode data of a system at period ``T``."""
+
+    omega: np.ndarray
+    b: np.ndarray
+    phi: np.ndarray
+    sin_half: np.ndarray  # sin(ω T / 2)
+
+    @classmethod
+    def of(cls, system: LinearSystem, T: float) -> "_Modal":
+        omega, b, phi = system.spectrum.contact_modes
+        return cls(omega=omega, b=b, phi=phi, sin_half=np.sin(omega * T / 2))
+
+
+@dataclass(frozen=True, eq=False)
+class PeriodicOrbit:
+    """A periodic orbit with ``k`` impacts per period.
+
+    Attributes
+    ----------
+    system : LinearSystem
+    T : float
+        Period.
+    impact_times : (k,) ndarray
+        ``0 < t₁ < … < t_k = T``; the orbit is at the obstacle at ``t = 0``.
+    impulses : (k,) ndarray
+        Impulses ``Λ_i`` (``M Δv = -w Λ``); admissible orbits have ``Λ_i >= 0``.
+    energy : float
+        ``½vᵀMv + ½xᵀKx`` (constant along the orbit).
+    admissible : bool
+        ``Λ_i >= 0`` and ``wᵀx(t) <= d(1 + ADMISSIBILITY_RTOL)`` proved on the
+        whole period (:func:`bladecase.trigsum.certified_max`).
+    max_violation : float
+        Largest ``wᵀx - d`` over the period (``0`` at the impacts, so it is
+        ``>= 0``; ``<= ADMISSIBILITY_RTOL·d`` when admissible).
+    max_violation_time : float
+        Where it occurs.
+    """
+
+    system: LinearSystem = field(repr=False)
+    T: float
+    impact_times: np.ndarray
+    impulses: np.ndarray
+    energy: float
+    admissible: bool
+    max_violation: float
+    max_violation_time: float = field(repr=False)
+
+    @property
+    def k(self) -> int:
+        """Impacts per period."""
+        return int(self.impact_times.size)
+
+    @property
+    def frequency(self) -> float:
+        """``1 / T``."""
+        return 1.0 / self.T
+
+    @cached_property
+    def _modal(self) -> _Modal:
+        return _Modal.of(self.system, self.T)
+
+    def modal_state(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """Active-mode coordinates ``(q, q̇)``, each of shape ``(m_active, len(t))``."""
+        md = self._modal
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        T = self.T
+        q = np.zeros((md.omega.size, t.size))
+        qd = np.zeros_like(q)
+        for ti, lam in zip(self.impact_times, self.impulses):
+            tau = np.mod(t - ti, T) - T / 2
+            ph = np.multiply.outer(md.omega, tau)
+            q -= lam * np.cos(ph)
+            qd += lam * np.sin(ph)
+        scale = md.b / (2 * md.sin_half)
+        q *= (scale / md.omega)[:, None]
+        qd *= scale[:, None]
+        return q, qd
+
+    def state(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """Positions and velocities ``(x, v)``, each of shape ``(n, len(t))``.
+
+        Vectorised over ``t`` (any real times; the orbit is periodic).  At an
+        impact instant the post-impact velocity is returned, so ``state(0.0)``
+        is the post-impact state at the obstacle.
+        """
+        q, qd = self.modal_state(t)
+        phi = self._modal.phi
+        return phi @ q, phi @ qd
+
+    def contact(self, t) -> np.ndarray:
+        """``wᵀx(t)`` at the times ``t`` (cheap: no mode shapes involved)."""
+        q, _ = self.modal_state(t)
+        return self._modal.b @ q
+
+    def segment(self, i: int) -> TrigSum:
+        """``wᵀx(t_{i-1} + τ) - d`` on flight ``i`` (``t₀ = 0``) as a trigonometric sum in ``τ``."""
+        return _segment_sum(self._modal, self.T, self.impact_times, self.impulses, i, self.system.gap)
+
+    def to_dict(self) -> dict:
+        """Plain-data summary (JSON-ready)."""
+        return {
+            "T": self.T,
+            "frequency": self.frequency,
+            "ipp": self.k,
+            "impact_times": self.impact_times.tolist(),
+            "impulses": self.impulses.tolist(),
+            "energy": self.energy,
+            "admissible": bool(self.admissible),
+            "max_violation": self.max_violation,
+        }
+
+
+def _segment_sum(md: _Modal, T: float, times: np.ndarray, impulses: np.ndarray, i: int, d: float) -> TrigSum:
+    start = 0.0 if i == 0 else times[i - 1]
+    theta = np.mod(start - times, T) - T / 2  # phase of each impulse at the segment start
+    ph = np.multiply.outer(md.omega, theta)
+    c = -md.b**2 / (2 * md.omega * md.sin_half)
+    alpha = c * (np.cos(ph) @ impulses)
+    beta = -c * (np.sin(ph) @ impulses)
+    return TrigSum(alpha=alpha, beta=beta, omega=md.omega, const=-d)
+
+
+def make_orbit(
+    system: LinearSystem,
+    T: float,
+    impact_times,
+    impulses,
+    _md: _Modal | None = None,
+    polish: bool = True,
+    probe: float | None = None,
+    certify: bool = True,
+) -> PeriodicOrbit:
+    """Build a :class:`PeriodicOrbit` from its impact data, computing energy and admissibility.
+
+    ``polish=False`` skips refining the location of a violation once one is
+    found (``max_violation`` is then only a sampled lower bound): for
+    predicates such as bisection on admissibility.  ``probe`` is a time where
+    a violation is suspected (e.g. where a neighbouring orbit violated the
+    constraint): it is checked first, so a violated orbit is rejected cheaply.
+    ``certify=False`` skips the admissibility check altogether (the orbit is
+    then marked non-admissible with a NaN ``max_violation``).
+    """
+    times = np.asarray(impact_times, dtype=float)
+    lam = np.asarray(impulses, dtype=float)
+    md = _md if _md is not None else _Modal.of(system, T)
+    d = system.gap
+    # Energy from the post-impact modal state at t = 0.
+    theta = np.mod(-times, T) - T / 2
+    ph = np.multiply.outer(md.omega, theta)
+    scale = md.b / (2 * md.sin_half)
+    q = -(scale / md.omega) * (np.cos(ph) @ lam)
+    qd = scale * (np.sin(ph) @ lam)
+    energy = 0.5 * float(qd @ qd + (md.omega * q) @ (md.omega * q))
+    # Admissibility, flight by flight.
+    starts = np.concatenate([[0.0], times[:-1]])
+    segments = [_segment_sum(md, T, times, lam, i, d) for i in range(times.size)]
+    tols = [max(ADMISSIBILITY_RTOL * d, 1e4 * np.finfo(float).eps * f.magnitude) for f in segments]
+    worst, worst_t, certified = 0.0, 0.0, True
+    quick = not polish
+    if not certify:
+        worst, certified, segments = np.nan, False, []
+    elif quick and np.any(lam < 0):
+        certified, segments = False, []
+    elif quick and probe is not None:
+        i = min(int(np.searchsorted(times, np.mod(probe, T), side="right")), times.size - 1)
+        f = segments[i]
+        tau = np.clip(np.mod(probe, T) - starts[i] + f.step * np.linspace(-2, 2, 9), 0, times[i] - starts[i])
+        vals = f(tau)[0]
+        if vals.max() > tols[i]:
+            worst, worst_t = float(vals.max()), float(starts[i] + tau[np.argmax(vals)])
+            certified, segments = False, []
+    for i, f in enumerate(segments):
+        res = certified_max(f, times[i] - starts[i], tols[i], ends_at_zero=True, polish=polish)
+        certified &= res.certified
+        if res.value > worst:
+            worst, worst_t = res.value, starts[i] + res.where
+        if quick and not certified:
+            break
+    admissible = bool(certified and np.all(lam >= 0))
+    return PeriodicOrbit(
+        system=system, T=T, impact_times=times, impulses=lam, energy=energy,
+        admissible=admissible, max_violation=float(worst), max_violation_time=float(worst_t),
+    )
+
+
+def orbit_1ipp(system: LinearSystem, T: float, **options) -> PeriodicOrbit:
+    """The periodic orbit of period ``T`` with one impact per period.
+
+    ``x(t) = -Λ G(t)`` with ``Λ = -d / g(0)``,
+    ``g(0) = Σ_j b_j² cot(ω_j T/2) / (2 ω_j)`` (theory §4, k = 1).  The orbit
+    always exists for a non-resonant ``T`` with ``g(0) ≠ 0``; whether it is a
+    motion of the impacting system is :attr:`PeriodicOrbit.admissible`
+    (``Λ >= 0`` and ``wᵀx <= d`` certified on the whole period).
+
+    Raises
+    ------
+    ValueError
+        ``T`` not a positive finite number, resonant (some ``ω_j T ∈ 2πℤ`` with
+        ``b_j ≠ 0``), or ``g(0) = 0`` (no impulse brings the orbit to the obstacle).
+
+    ``options`` are passed to :func:`make_orbit` (``polish``, ``probe``, ``certify``).
+    """
+    T = check_period(system, T)
+    md = _Modal.of(system, T)
+    g0 = float(np.sum(md.b**2 * np.cos(md.omega * T / 2) / (2 * md.omega * md.sin_half)))
+    if g0 == 0.0 or not np.isfinite(g0):
+        raise ValueError(f"no 1-ipp orbit at T = {T!r}: the impulse response does not reach the obstacle (g(0) = {g0})")
+    lam = -system.gap / g0
+    return make_orbit(system, T, [T], [lam], md, **options)

@@ -1,0 +1,51 @@
+"""Matplotlib figures: frequency–energy plots of nonsmooth-mode backbones."""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+
+def frequency_energy(backbones: Sequence, ax=None, linear: bool = True, title: str | None = None):
+    """Energy ``E`` against frequency ``1/T`` for one or several backbones.
+
+    Admissible orbits are drawn as solid curves, non-admissible ones as faint
+    dots; the ends of the admissible intervals are marked, and the linear
+    frequencies ``ω_j/2π`` in range are drawn as dashed vertical lines.
+
+    Returns the matplotlib ``Figure``.
+    """
+    if ax is None:
+        import matplotlib.pyplot as plt
+
+        fig, ax = plt.subplots(figsize=(7.5, 4.8), layout="constrained")
+    else:
+        fig = ax.figure
+    colors = ["C0", "C1", "C2", "C3", "C4", "C5"]
+    fmin, fmax = np.inf, -np.inf
+    for n, bb in enumerate(backbones):
+        c = colors[n % len(colors)]
+        f, E, adm = bb.frequencies, bb.energy, bb.admissible
+        fmin, fmax = min(fmin, f.min()), max(fmax, f.max())
+        ok = np.isfinite(E) & (E > 0)
+        ax.plot(f[ok & ~adm], E[ok & ~adm], ".", ms=2, color=c, alpha=0.25)
+        Ea = np.where(adm, E, np.nan)  # NaN breaks the curve between admissible arcs
+        ax.plot(f, Ea, "-", lw=1.8, color=c, label=f"{bb.ipp} ipp (admissible)")
+        for iv in bb.intervals:
+            for T, refined in ((iv.T_lo, iv.refined_lo), (iv.T_hi, iv.refined_hi)):
+                if refined:
+                    ax.axvline(1 / T, color=c, lw=0.5, ls=":", alpha=0.6)
+    if linear and backbones:
+        lf = backbones[0].linear_frequencies
+        first = True
+        for fj in lf[(lf >= fmin) & (lf <= fmax)]:
+            ax.axvline(fj, color="k", ls="--", lw=0.8, label="linear frequencies" if first else None)
+            first = False
+    ax.set_yscale("log")
+    ax.set_xlabel("frequency 1/T")
+    ax.set_ylabel("energy E")
+    ax.set_title(title or "Nonsmooth modes: frequency–energy")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(loc="best", fontsize="small")
+    return fig
