@@ -65,11 +65,18 @@ class _Modal:
     b: np.ndarray
     phi: np.ndarray
     sin_half: np.ndarray  # sin(ω T / 2)
+    T: float
 
     @classmethod
     def of(cls, system: LinearSystem, T: float) -> "_Modal":
         omega, b, phi = system.spectrum.contact_modes
-        return cls(omega=omega, b=b, phi=phi, sin_half=np.sin(omega * T / 2))
+        return cls(omega=omega, b=b, phi=phi, sin_half=np.sin(omega * T / 2), T=T)
+
+    def g_s(self, u) -> tuple[np.ndarray, np.ndarray]:
+        """``g(u) = wᵀG(u)`` and ``s(u) = wᵀG'(u)`` for ``u`` in ``[0, T]`` (any shape)."""
+        ph = np.multiply.outer(np.asarray(u, dtype=float) - self.T / 2, self.omega)
+        c = self.b**2 / (2 * self.sin_half)
+        return np.cos(ph) @ (c / self.omega), -(np.sin(ph) @ c)
 
 
 @dataclass(frozen=True, eq=False)
@@ -95,6 +102,10 @@ class PeriodicOrbit:
         ``>= 0``; ``<= ADMISSIBILITY_RTOL·d`` when admissible).
     max_violation_time : float
         Where it occurs.
+    repeats : int
+        ``j > 1`` when the orbit is an orbit of period ``T/j`` counted ``j``
+        times (its impacts and impulses are invariant under a shift by
+        ``T/j``): not a new nonsmooth mode.  ``1`` otherwise.
     """
 
     system: LinearSystem = field(repr=False)
@@ -105,6 +116,7 @@ class PeriodicOrbit:
     admissible: bool
     max_violation: float
     max_violation_time: float = field(repr=False)
+    repeats: int = 1
 
     @property
     def k(self) -> int:
@@ -168,6 +180,7 @@ class PeriodicOrbit:
             "energy": self.energy,
             "admissible": bool(self.admissible),
             "max_violation": self.max_violation,
+            "repeats": self.repeats,
         }
 
 
@@ -241,7 +254,29 @@ def make_orbit(
     return PeriodicOrbit(
         system=system, T=T, impact_times=times, impulses=lam, energy=energy,
         admissible=admissible, max_violation=float(worst), max_violation_time=float(worst_t),
+        repeats=repetitions(times, lam, T),
     )
+
+
+#: Relative tolerance (of ``T`` for times, of ``max|Λ|`` for impulses) of the
+#: repeated-orbit test.
+REPEAT_RTOL = 1e-7
+
+
+def repetitions(times: np.ndarray, impulses: np.ndarray, T: float) -> int:
+    """Largest ``j`` dividing ``k`` such that the impact pattern repeats every ``T/j``."""
+    k = times.size
+    scale = max(np.abs(impulses).max(), np.finfo(float).tiny)
+    for j in range(k, 1, -1):
+        if k % j:
+            continue
+        shift = k // j
+        dt = np.mod(np.roll(times, -shift) - times, T)
+        if np.all(np.abs(dt - T / j) <= REPEAT_RTOL * T) and np.all(
+            np.abs(np.roll(impulses, -shift) - impulses) <= REPEAT_RTOL * scale
+        ):
+            return j
+    return 1
 
 
 def orbit_1ipp(system: LinearSystem, T: float, **options) -> PeriodicOrbit:
@@ -268,3 +303,194 @@ def orbit_1ipp(system: LinearSystem, T: float, **options) -> PeriodicOrbit:
         raise ValueError(f"no 1-ipp orbit at T = {T!r}: the impulse response does not reach the obstacle (g(0) = {g0})")
     lam = -system.gap / g0
     return make_orbit(system, T, [T], [lam], md, **options)
+
+
+# ---------------------------------------------------------------------------
+# k impacts per period
+# ---------------------------------------------------------------------------
+
+
+def _check_times(impact_times) -> np.ndarray:
+    times = np.asarray(impact_times, dtype=float).reshape(-1)
+    if times.size == 0 or not np.all(np.isfinite(times)):
+        raise ValueError("impact_times must be a non-empty sequence of finite times")
+    if times[0] <= 0 or np.any(np.diff(times) <= 0):
+        raise ValueError(f"impact_times must satisfy 0 < t1 < ... < tk = T, got {times.tolist()}")
+    return times
+
+
+def _matrices(md: _Modal, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    D = np.mod(times[:, None] - times[None, :], md.T)
+    g, s = md.g_s(D)
+    np.fill_diagonal(s, 0.0)
+    return s, -g
+
+
+def impact_matrices(system: LinearSystem, impact_times) -> tuple[np.ndarray, np.ndarray]:
+    """The paper's matrices ``(Π, Σ)`` for impacts at ``0 < t₁ < … < t_k = T``.
+
+    ``Π_ij = s((t_i - t_j) mod T)`` (``Π_ii = 0``; skew-symmetric) and
+    ``Σ_ij = -g((t_i - t_j) mod T)`` (symmetric), with ``g = wᵀG`` and
+    ``s = wᵀG'`` (theory §3–4).  A ``k``-ipp orbit has impulses ``Λ`` with
+    ``ΠΛ = 0`` (elastic impact law at every impact) and ``ΣΛ = d·1`` (at the
+    obstacle at every impact).
+    """
+    times = _check_times(impact_times)
+    T = check_period(system, times[-1])
+    return _matrices(_Modal.of(system, T), times)
+
+
+def kipp_residual(md: _Modal, times: np.ndarray, impulses: np.ndarray, d: float) -> np.ndarray:
+    """``[ΠΛ ; ΣΛ - d·1]`` (length ``2k``; ``ΛᵀΠΛ ≡ 0`` makes one component redundant)."""
+    Pi, Sigma = _matrices(md, times)
+    return np.concatenate([Pi @ impulses, Sigma @ impulses - d])
+
+
+def _impulses(md: _Modal, times: np.ndarray, d: float) -> np.ndarray | None:
+    """``Λ`` from ``ΣΛ = d·1`` (least squares), or ``None`` if ``Σ`` is singular."""
+    _, Sigma = _matrices(md, times)
+    lam, *_ = np.linalg.lstsq(Sigma, np.full(times.size, d), rcond=1e-12)
+    return lam if np.all(np.isfinite(lam)) else None
+
+
+def _solve_times(md: _Modal, times0: np.ndarray, d: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """Newton (Gauss–Newton, least squares) on ``(t₁…t_{k-1}, Λ)`` at fixed ``T``."""
+    from scipy.optimize import least_squares
+
+    T, k = md.T, times0.size
+    lam0 = _impulses(md, times0, d)
+    if lam0 is None:
+        return None
+    lscale = max(np.abs(lam0).max(), d)
+
+    def fun(u):
+        times = np.append(u[: k - 1], T)
+        return kipp_residual(md, times, u[k - 1:] * lscale, d) / d
+
+    res = least_squares(fun, np.concatenate([times0[:-1], lam0 / lscale]), method="lm", xtol=1e-15, ftol=1e-15,
+                        gtol=1e-15, max_nfev=200 * k)
+    times = np.append(res.x[: k - 1], T)
+    lam = res.x[k - 1:] * lscale
+    if not np.all(np.isfinite(res.x)) or np.abs(res.fun).max() > 1e-9:
+        return None
+    if times[0] <= 0 or np.any(np.diff(times) <= 1e-9 * T):
+        return None
+    return times, lam
+
+
+def orbits_kipp(system: LinearSystem, T: float, k: int, resolution: int | None = None) -> list[PeriodicOrbit]:
+    """Every periodic orbit of period ``T`` with ``k`` impacts per period.
+
+    Solves ``Π(t)Λ = 0``, ``Σ(t)Λ = d·1`` for ``0 < t₁ < … < t_k = T``
+    (theory §4).  k = 1: :func:`orbit_1ipp`.  k = 2: the condition is the
+    scalar ``s(t₁) = 0`` (the paper's Eq. 15, ``Pf(Π) = Π₁₂``); all its sign
+    changes on ``(0, T)`` are found with certified root exclusion
+    (:func:`bladecase.trigsum.all_roots`), then ``Λ = Σ⁻¹ d·1``.  k >= 3
+    (``Pf(Π) = 0`` and a two-dimensional null space for even k, the null
+    vector of ``Π`` for odd k): Gauss–Newton on ``(t₁…t_{k-1}, Λ)`` started
+    from every cell of a grid on the ordered times whose residual is a local
+    minimum, ``resolution`` points per time (default: 4 per period of the
+    highest contact mode, between 16 and 48); solutions closer than
+    ``1e-7 T`` are merged.  For k >= 3 completeness is up to that resolution.
+    Solutions that differ only by which impact is placed at ``t = 0`` (a time
+    shift) are the same orbit and are returned once
+    (:func:`canonical_rotation`).
+
+    Each solution is a :class:`PeriodicOrbit` with certified admissibility;
+    orbits with a negative impulse are never admissible.  Solutions that are
+    an orbit of period ``T/j`` counted ``j`` times (e.g. k = 2 with
+    ``t₁ = T/2``, a 1-ipp orbit of period ``T/2``) have ``repeats = j``.
+
+    Returns
+    -------
+    list of PeriodicOrbit, sorted by ``t₁``.
+    """
+    if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
+        raise ValueError(f"k (impacts per period) must be an integer >= 1, got {k!r}")
+    if k == 1:
+        return [orbit_1ipp(system, T)]
+    T = check_period(system, T)
+    md = _Modal.of(system, T)
+    d = system.gap
+    solutions: list[tuple[np.ndarray, np.ndarray]] = []
+    if k == 2:
+        from .trigsum import all_roots
+
+        c = md.b**2 / 2
+        s_sum = TrigSum(alpha=c, beta=-c * np.cos(md.omega * T / 2) / md.sin_half, omega=md.omega)
+        for t1 in all_roots(s_sum, 0.0, T):
+            if not 0 < t1 < T:
+                continue
+            times = np.array([t1, T])
+            lam = _impulses(md, times, d)
+            if lam is not None:
+                solutions.append((times, lam))
+    else:
+        solutions = _multistart(md, k, d, resolution)
+    unique: list[tuple[np.ndarray, np.ndarray]] = []
+    for times, lam in solutions:
+        times, lam = canonical_rotation(times, lam, T)
+        if not any(np.abs(times - t).max() <= REPEAT_RTOL * T for t, _ in unique):
+            unique.append((times, lam))
+    orbits = [make_orbit(system, T, times, lam, md) for times, lam in unique]
+    return sorted(orbits, key=lambda o: tuple(o.impact_times))
+
+
+def canonical_rotation(times: np.ndarray, impulses: np.ndarray, T: float) -> tuple[np.ndarray, np.ndarray]:
+    """The same orbit re-anchored at the impact that makes ``(t₁, …, t_k)`` smallest
+    lexicographically.  Re-anchoring at impact ``r`` (a time shift by ``t_r``)
+    gives the same physical orbit; this picks one representative."""
+    best = None
+    for r in range(times.size):
+        shifted = np.mod(times - times[r], T)
+        shifted[shifted <= REPEAT_RTOL * T] = T
+        order = np.argsort(shifted)
+        cand = (shifted[order], impulses[order])
+        if best is None or tuple(cand[0]) < tuple(best[0]):
+            best = cand
+    best[0][-1] = T
+    return best
+
+
+def _multistart(md: _Modal, k: int, d: float, resolution: int | None) -> list[tuple[np.ndarray, np.ndarray]]:
+    from itertools import combinations
+
+    T = md.T
+    if resolution is None:
+        resolution = int(np.clip(np.ceil(4 * T * md.omega.max() / (2 * np.pi)), 16, 48))
+    grid = T * (np.arange(1, resolution) / resolution)
+    idx = np.array(list(combinations(range(grid.size), k - 1)))
+    starts = np.column_stack([grid[idx], np.full(len(idx), T)])
+    # Screening residual: ||Π n|| / ||n|| with n = Σ⁻¹1 (scale-free).
+    S = float(md.b @ md.b) / 2
+    score = np.full(len(starts), np.inf)
+    for i, times in enumerate(starts):
+        Pi, Sigma = _matrices(md, times)
+        try:
+            n = np.linalg.solve(Sigma, np.ones(k))
+        except np.linalg.LinAlgError:
+            continue
+        score[i] = np.linalg.norm(Pi @ n) / (np.linalg.norm(n) * S)
+    # Local minima of the score among grid neighbours (index distance 1 in every time).
+    pos = {tuple(row): i for i, row in enumerate(idx)}
+    candidates = []
+    for i, row in enumerate(idx):
+        if not np.isfinite(score[i]):
+            continue
+        best = True
+        for delta in np.ndindex(*(3,) * (k - 1)):
+            j = pos.get(tuple(row + np.array(delta) - 1))
+            if j is not None and j != i and score[j] < score[i]:
+                best = False
+                break
+        if best:
+            candidates.append(i)
+    found: list[tuple[np.ndarray, np.ndarray]] = []
+    for i in candidates:
+        sol = _solve_times(md, starts[i], d)
+        if sol is None:
+            continue
+        if any(np.abs(sol[0] - t).max() <= REPEAT_RTOL * T for t, _ in found):
+            continue
+        found.append(sol)
+    return found

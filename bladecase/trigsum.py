@@ -243,12 +243,20 @@ def first_upcrossing(f: TrigSum, start: float, stop: float, chunk: int = 512) ->
     return None
 
 
+def _brent(f: TrigSum, a: float, b: float) -> float:
+    """Root of ``f`` in ``[a, b]`` to machine precision.  Grid values (angle
+    addition) and direct values may differ in the last bits: when the direct
+    values at the ends do not bracket a root, the end nearer to zero is it."""
+    fa, fb = float(f(a)[0]), float(f(b)[0])
+    if fa == 0 or fb == 0 or np.sign(fa) == np.sign(fb):
+        return a if abs(fa) <= abs(fb) else b
+    return brentq(lambda x: f(x)[0], a, b, xtol=1e-15 * max(1.0, abs(b)), rtol=4 * np.finfo(float).eps)
+
+
 def _search(f, B2, hmin, a, b, fa, fb, da, db):
     if fb >= 0:
         if da - B2 * (b - a) > 0 or b - a < hmin:
-            if fb == 0:
-                return b
-            return brentq(lambda x: f(x)[0], a, b, xtol=1e-15 * max(1.0, b), rtol=4 * np.finfo(float).eps)
+            return _brent(f, a, b)
     elif interval_bound(fa, fb, da, db, b - a, B2) < 0 or b - a < hmin:
         return None
     m = 0.5 * (a + b)
@@ -259,3 +267,47 @@ def _search(f, B2, hmin, a, b, fa, fb, da, db):
     if root is not None:
         return root
     return _search(f, B2, hmin, m, b, fm, fb, dm, db)
+
+
+def all_roots(f: TrigSum, a: float, b: float, max_points: int = 2_000_000) -> np.ndarray:
+    """Every root of ``f`` in ``(a, b)`` where ``f`` changes sign, sorted.
+
+    Intervals are proved root-free with :func:`interval_bound` (applied to
+    ``f`` and ``-f``) or bisected; an interval with a sign change on which
+    ``f'`` provably keeps its sign holds exactly one root, refined by Brent's
+    method.  Roots of even multiplicity (tangencies) are not reported.
+    """
+    B2 = f.curvature_bound
+    count = max(2, int(np.ceil((b - a) / f.step)) + 1)
+    h = (b - a) / (count - 1)
+    tau, F, D = f.grid(a, h, count)
+    tau[-1] = b
+    scale = max(f.magnitude, abs(f.const), np.finfo(float).tiny)
+    hmin = np.sqrt(8e-14 * scale / B2) if B2 > 0 else 0.0
+    lo, hi, fl, fr, dl, dr = tau[:-1], tau[1:], F[:-1], F[1:], D[:-1], D[1:]
+    roots = []
+    used = count
+    while lo.size and used <= max_points:
+        w = hi - lo
+        change = np.sign(fl) * np.sign(fr) < 0
+        mono = change & (np.sign(dl) == np.sign(dr)) & (np.minimum(np.abs(dl), np.abs(dr)) > B2 * w)
+        for x0, x1 in zip(lo[mono | (change & (w < hmin))], hi[mono | (change & (w < hmin))]):
+            roots.append(_brent(f, x0, x1))
+        pos = ~change & (fl > 0)
+        neg = ~change & (fl < 0)
+        cleared = (pos & (-interval_bound(-fl, -fr, -dl, -dr, w, B2) > 0)) | (
+            neg & (interval_bound(fl, fr, dl, dr, w, B2) < 0)
+        )
+        split = ~(mono | cleared) & (w >= hmin)
+        if not split.any():
+            break
+        x0, x1 = lo[split], hi[split]
+        mid = 0.5 * (x0 + x1)
+        fm, dm = f(mid)
+        used += mid.size
+        lo, hi = np.concatenate([x0, mid]), np.concatenate([mid, x1])
+        fl, fr = np.concatenate([fl[split], fm]), np.concatenate([fm, fr[split]])
+        dl, dr = np.concatenate([dl[split], dm]), np.concatenate([dm, dr[split]])
+        exact = (fm == 0) & (mid > a) & (mid < b)
+        roots.extend(mid[exact].tolist())
+    return np.unique(np.array(roots, dtype=float))
