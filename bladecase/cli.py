@@ -156,9 +156,13 @@ def _cmd_backbone(args) -> int:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``bladecase`` command."""
+    """Entry point of the ``bladecase`` command; returns the exit code (0 on
+    success, 2 on bad arguments or input, with a one-line reason on stderr)."""
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # --help, --version, or a bad argument (message already printed)
+        return int(exc.code or 0) if not isinstance(exc.code, str) else 2
     if args.command is None:
         parser.print_help()
         return 2

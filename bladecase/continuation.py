@@ -389,10 +389,9 @@ def nonsmooth_mode(
         zs = bwd[::-1] + [z0] + fwd
         orbits = []
         for z in zs:
-            Tz, times, lam = curve.split(z)
             try:
-                orbits.append(make_orbit(system, Tz, times, lam))
-            except ValueError:
+                orbits.append(_polished_orbit(curve, z))
+            except (ValueError, np.linalg.LinAlgError):
                 continue
         for m in range(n + 1, len(starts)):
             if not covered[m] and _passes(curve, zs, starts[m]):
@@ -400,6 +399,16 @@ def nonsmooth_mode(
         arcs = _arcs(curve, zs, orbits, refine)
         families.append(Family(system=system, k=k, orbits=orbits, arcs=arcs))
     return families
+
+
+def _polished_orbit(curve: _Curve, z) -> PeriodicOrbit:
+    """The orbit at curve point ``z``, its impact times re-solved at fixed ``T``
+    to machine precision (Levenberg–Marquardt on ``(t, Λ)``)."""
+    T, times, lam = curve.split(z)
+    sol = _solve_times(_Modal.of(curve.system, T), times, curve.d)
+    if sol is not None and np.abs(sol[0] - times).max() < 1e-6 * T:
+        times, lam = sol
+    return make_orbit(curve.system, T, times, lam)
 
 
 def _passes(curve: _Curve, zs, start) -> bool:

@@ -167,6 +167,19 @@ def _bisect(solve, system, T_in: float, T_out: float, probe: float | None) -> fl
     return T_in
 
 
+def _first_resonance(omega: np.ndarray, T_a: float, T_b: float, last: bool = False) -> float | None:
+    """Smallest (``last``: largest) resonant period ``2πm/ω_j`` in ``(T_a, T_b)``, or ``None``."""
+    if last:
+        m = np.ceil(omega * T_b / (2 * np.pi)) - 1
+        r = 2 * np.pi * m / omega
+        r = r[(m >= 1) & (r > T_a) & (r < T_b)]
+        return float(r.max()) if r.size else None
+    m = np.floor(omega * T_a / (2 * np.pi)) + 1
+    r = 2 * np.pi * m / omega
+    r = r[(r > T_a) & (r < T_b)]
+    return float(r.min()) if r.size else None
+
+
 def _phase(orbit: PeriodicOrbit | None) -> float | None:
     return None if orbit is None else orbit.max_violation_time / orbit.T
 
@@ -194,9 +207,14 @@ def backbone(
     -------
     Backbone
         Orbits, frequency–energy data and the maximal admissible intervals of
-        ``T``, whose ends are refined by bisection to ``BISECTION_RTOL``
-        (an end next to a resonance converges to the resonant period, which
-        is excluded).
+        ``T``, whose ends are refined by bisection to ``BISECTION_RTOL``.
+        An interval never contains a resonant period ``2πm/ω_j`` of a mode
+        that sees the contact (the impulse changes sign there): two
+        admissible scan points with a resonance between them give two
+        intervals, whose ends are refined towards the resonance (an end next
+        to a resonance converges to the excluded resonant period).
+        Admissible stretches between two resonances that fall between the
+        same two scan points are not found: scan finer.
     """
     solve = _solver(ipp)
     P = np.asarray(periods, dtype=float).reshape(-1)
@@ -212,6 +230,11 @@ def backbone(
         it = tqdm(P, desc=f"{ipp}-ipp orbits", unit="T", leave=False)
     orbits = [_try(solve, system, T) for T in it]
     adm = np.array([o is not None and o.admissible for o in orbits])
+    omega = system.spectrum.contact_modes[0]
+    # Nearest resonances 2πm/ω_j strictly inside each gap between scan points:
+    # an admissible interval never contains one (Λ = -d/g(0) changes sign there).
+    first_res = [_first_resonance(omega, P[g], P[g + 1]) for g in range(P.size - 1)]
+    last_res = [_first_resonance(omega, P[g], P[g + 1], last=True) for g in range(P.size - 1)]
     intervals = []
     i = 0
     while i < P.size:
@@ -219,11 +242,19 @@ def backbone(
             i += 1
             continue
         j = i
-        while j + 1 < P.size and adm[j + 1]:
+        while j + 1 < P.size and adm[j + 1] and first_res[j] is None:
             j += 1
-        lo = _bisect(solve, system, P[i], P[i - 1], _phase(orbits[i - 1])) if i > 0 else P[i]
-        hi = _bisect(solve, system, P[j], P[j + 1], _phase(orbits[j + 1])) if j + 1 < P.size else P[j]
-        intervals.append(Interval(float(lo), float(hi), i > 0, j + 1 < P.size))
+        lo = hi = None
+        if i > 0:
+            out = last_res[i - 1]
+            lo = _bisect(solve, system, P[i], P[i - 1] if out is None else out,
+                         _phase(orbits[i - 1]) if out is None else None)
+        if j + 1 < P.size:
+            out = first_res[j]
+            hi = _bisect(solve, system, P[j], P[j + 1] if out is None else out,
+                         _phase(orbits[j + 1]) if out is None else None)
+        intervals.append(Interval(float(P[i] if lo is None else lo), float(P[j] if hi is None else hi),
+                                  lo is not None, hi is not None))
         i = j + 1
     sp = system.spectrum
     return Backbone(

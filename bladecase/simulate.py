@@ -20,7 +20,8 @@ import numpy as np
 from .model import LinearSystem
 from .trigsum import TrigSum, first_upcrossing
 
-#: Relative tolerance (of ``gap``) within which a state counts as "at the obstacle".
+#: Relative tolerance (of ``gap``) within which a state counts as "at the obstacle"
+#: (raised to the round-off of ``wᵀx`` for large amplitudes).
 CONTACT_RTOL = 1e-12
 
 
@@ -86,6 +87,12 @@ class Trajectory:
         return 0.5 * np.sum(self._p**2 + (om * self._q) ** 2, axis=0)
 
 
+def _contact_tol(b: np.ndarray, q: np.ndarray, d: float) -> float:
+    """Distance to the obstacle below which a state counts as at the obstacle:
+    ``CONTACT_RTOL·d``, or the round-off of ``wᵀx = bᵀq`` when larger."""
+    return max(CONTACT_RTOL * d, 64 * np.finfo(float).eps * float(np.abs(b) @ np.abs(q)))
+
+
 def _modal(system: LinearSystem, x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     phi = system.spectrum.phi
     return phi.T @ (system.M @ x), phi.T @ (system.M @ v)
@@ -140,8 +147,11 @@ def simulate(
         raise ValueError(f"restitution must be in (0, 1], got {restitution!r}")
     d = system.gap
     w = system.w
-    if w @ x0 - d > CONTACT_RTOL * d:
-        raise ValueError(f"initial state violates the constraint: wᵀx0 - d = {w @ x0 - d:.6g} > 0")
+    sp = system.spectrum
+    tol0 = _contact_tol(sp.b, _modal(system, x0, v0)[0], d)
+    if w @ x0 - d > tol0:
+        raise ValueError(f"initial state violates the constraint: wᵀx0 - d = {w @ x0 - d:.6g} > 0 "
+                         f"(tolerance {tol0:.3g})")
 
     sp = system.spectrum
     omega, b = sp.omega, sp.b
@@ -156,7 +166,7 @@ def simulate(
         f0 = float(b @ q) - d
         vn = float(b @ p)
         start = 0.0
-        if f0 >= -CONTACT_RTOL * d:
+        if f0 >= -_contact_tol(b, q, d):
             if vn > 0:
                 tau = 0.0  # at the obstacle and moving into it: impact now
             else:
