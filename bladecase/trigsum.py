@@ -72,7 +72,7 @@ class TrigSum:
         """``(τ, f, f')`` at ``τ = start + h·arange(count)``.
 
         Points are split as ``u_p + v_q`` (``P·Q >= count``); with
-        ``c = α - iβ``, ``f = Re Σ c e^{iωu} e^{iωv}`` is one complex matrix
+        ``c = α - iβ``, ``f = Re Σ c e^{iωu} e^{iωv}`` is one matrix
         product.  The exponentials are built by recurrence (``cumprod``), so
         only ``2m`` of them are evaluated; the recurrence error is about
         ``max(P, Q) ε Σ|c|``.
@@ -91,7 +91,9 @@ class TrigSum:
         L = np.empty((2 * p, w.size), complex)
         np.multiply(Eu, self.alpha - 1j * self.beta, out=L[:p])
         np.multiply(L[:p], 1j * w, out=L[p:])
-        R = (L @ Ev.T).real
+        # Only the real part is needed: Re(L Evᵀ) = [Re L, -Im L] [Re Ev, Im Ev]ᵀ,
+        # one real product (half the work of the complex one).
+        R = np.concatenate([L.real, -L.imag], axis=1) @ np.concatenate([Ev.real, Ev.imag], axis=1).T
         tau = start + h * np.arange(count)
         return tau, R[:p].ravel()[:count] + self.const, R[p:].ravel()[:count]
 
