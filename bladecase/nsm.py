@@ -78,6 +78,11 @@ class _Modal:
         c = self.b**2 / (2 * self.sin_half)
         return np.cos(ph) @ (c / self.omega), -(np.sin(ph) @ c)
 
+    def ds(self, u) -> np.ndarray:
+        """``s'(u) = wᵀG''(u)`` for ``u`` in ``(0, T)``."""
+        ph = np.multiply.outer(np.asarray(u, dtype=float) - self.T / 2, self.omega)
+        return -(np.cos(ph) @ (self.b**2 * self.omega / (2 * self.sin_half)))
+
 
 @dataclass(frozen=True, eq=False)
 class PeriodicOrbit:
@@ -353,14 +358,52 @@ def _impulses(md: _Modal, times: np.ndarray, d: float) -> np.ndarray | None:
     return lam if np.all(np.isfinite(lam)) else None
 
 
+def newton_times(md: _Modal, times: np.ndarray, lam: np.ndarray, d: float, maxiter: int = 12):
+    """Gauss–Newton on ``[ΠΛ ; ΣΛ - d] = 0`` in ``(t₁…t_{k-1}, Λ)`` at fixed ``T``,
+    with the analytic Jacobian; ``None`` unless it converges to round-off."""
+    k, T = times.size, md.T
+    times, lam = times.astype(float).copy(), lam.astype(float).copy()
+    prev = np.inf
+    for _ in range(maxiter):
+        D = np.mod(times[:, None] - times[None, :], T)
+        g, s = md.g_s(D)
+        np.fill_diagonal(s, 0.0)
+        r = np.concatenate([s @ lam, -g @ lam - d])
+        dsD = md.ds(D)
+        np.fill_diagonal(dsD, 0.0)
+        # d/dt_l of Σ_j X(D_ij) Λ_j, with dD_ij/dt_l = δ_il - δ_jl:
+        #   row i: δ_il Σ_j X'(D_ij)Λ_j - X'(D_il)Λ_l
+        A_pi = np.diag(dsD @ lam) - dsD * lam[None, :]
+        A_sg = -(np.diag(s @ lam) - s * lam[None, :])
+        J = np.block([[A_pi[:, : k - 1], s], [A_sg[:, : k - 1], -g]])
+        step, *_ = np.linalg.lstsq(J, -r, rcond=None)
+        times[: k - 1] += step[: k - 1]
+        lam += step[k - 1:]
+        size = np.abs(step[: k - 1]).max(initial=0.0) / T + np.abs(step[k - 1:]).max() / max(np.abs(lam).max(), d)
+        if not np.all(np.isfinite(step)) or size > 10 * prev:
+            return None
+        if size < 1e-14:
+            break
+        prev = size
+    if times[0] <= 0 or np.any(np.diff(times) <= 0):
+        return None
+    if np.abs(kipp_residual(md, times, lam, d)).max() > 1e-9 * max(d, np.abs(lam).max()):
+        return None
+    return times, lam
+
+
 def _solve_times(md: _Modal, times0: np.ndarray, d: float) -> tuple[np.ndarray, np.ndarray] | None:
-    """Newton (Gauss–Newton, least squares) on ``(t₁…t_{k-1}, Λ)`` at fixed ``T``."""
+    """Solve for ``(t₁…t_{k-1}, Λ)`` at fixed ``T`` from impact times ``times0``:
+    Newton with the analytic Jacobian, else Levenberg–Marquardt (wider basin)."""
     from scipy.optimize import least_squares
 
     T, k = md.T, times0.size
     lam0 = _impulses(md, times0, d)
     if lam0 is None:
         return None
+    sol = newton_times(md, times0, lam0, d)
+    if sol is not None:
+        return sol
     lscale = max(np.abs(lam0).max(), d)
 
     def fun(u):
