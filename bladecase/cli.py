@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 from typing import Sequence
@@ -90,7 +91,10 @@ def build_parser() -> argparse.ArgumentParser:
                     help="clearance d > 0 (required with --chain; overrides the file's gap with --matrices)")
     bb.add_argument("--periods", type=_periods, required=True, metavar="START:STOP:COUNT",
                     help="scan COUNT periods evenly from START to STOP (inclusive)")
-    bb.add_argument("--ipp", type=_positive_int, default=1, metavar="K", help="impacts per period (default 1)")
+    bb.add_argument("--ipp", type=_positive_int, default=1, metavar="K",
+                    help="impacts per period (default 1).  K >= 2: the K-ipp families (nonsmooth modes) "
+                         "are searched at the COUNT scan periods and followed by continuation over "
+                         "[START, STOP]; a table per family is printed")
     bb.add_argument("--json", type=Path, metavar="FILE", help="write the scan and intervals as JSON")
     bb.add_argument("--plot", type=Path, metavar="FILE.png", help="write the frequency–energy plot")
     bb.add_argument("--table", type=Path, metavar="FILE", help="also write the printed table to FILE")
@@ -130,29 +134,64 @@ def _cmd_backbone(args) -> int:
 
     system = _load_system(args)
     progress = not args.no_progress and sys.stderr.isatty()
-    result = backbone(system, args.periods, ipp=args.ipp, progress=progress)
-    table = result.table()
-    if args.quiet:
-        print(table.split("\n\n", 1)[-1])
+    if args.ipp == 1:
+        result = backbone(system, args.periods, ipp=1, progress=progress)
+        curves = [result]
+        table = result.table()
+        summary = table.split("\n\n", 1)[-1]
+        data = result.to_dict()
     else:
-        print(table)
+        from .continuation import nonsmooth_mode
+
+        P = args.periods
+        if P.size < 2 or P[0] == P[-1]:
+            raise ValueError("--ipp K >= 2 needs a period range: START < STOP and COUNT >= 2")
+        curves = nonsmooth_mode(system, args.ipp, (P[0], P[-1]), scan=P.size, progress=progress)
+        if curves:
+            summary = "\n".join(f.table() for f in curves)
+        else:
+            summary = f"no {args.ipp}-ipp family found in T in [{P[0]:g}, {P[-1]:g}]"
+        table = summary if args.quiet else "\n\n".join(_family_table(f) for f in curves) + "\n\n" + summary
+        data = {
+            "ipp": args.ipp,
+            "system": {"n": system.n, "gap": system.gap},
+            "T_range": [float(P[0]), float(P[-1])],
+            "families": [f.to_dict() for f in curves],
+        }
+    print(summary if args.quiet else table)
     if args.table:
         write_text(args.table, table + "\n")
     if args.json:
-        write_json(args.json, result.to_dict())
+        write_json(args.json, data)
     if args.plot:
         import matplotlib
 
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
 
-        fig = result.plot()
+        from .plot import frequency_energy
+
+        if not curves:
+            raise ValueError("nothing to plot: no family found")
+        fig = frequency_energy(curves)
         save_figure(fig, args.plot, dpi=150)
         plt.close(fig)
     for label, path in (("table", args.table), ("json", args.json), ("plot", args.plot)):
         if path:
             print(f"wrote {label}: {path}", file=sys.stderr)
     return 0
+
+
+def _family_table(family) -> str:
+    """Per-orbit table of one k-ipp family (in continuation order)."""
+    lines = [family.table().split("\n", 1)[0],
+             f"{'T':>14} {'1/T':>12} {'energy':>12} {'impact times':>36} {'impulses':>30} admissible"]
+    for o in family.orbits:
+        times = " ".join(f"{t:.6g}" for t in o.impact_times)
+        imp = " ".join(f"{x:.5g}" for x in o.impulses)
+        lines.append(f"{o.T:14.8g} {1 / o.T:12.6g} {o.energy:12.6g} {times:>36} {imp:>30} "
+                     f"{'yes' if o.admissible else 'no'}")
+    return "\n".join(lines)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -171,6 +210,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except ValueError as exc:
         print(f"bladecase {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:  # output piped into e.g. `head`
+        sys.stdout = open(os.devnull, "w")
+        return 0
 
 
 if __name__ == "__main__":  # pragma: no cover

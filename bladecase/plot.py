@@ -10,9 +10,12 @@ import numpy as np
 def frequency_energy(backbones: Sequence, ax=None, linear: bool = True, title: str | None = None):
     """Energy ``E`` against frequency ``1/T`` for one or several backbones.
 
-    Admissible orbits are drawn as solid curves, non-admissible ones as faint
-    dots; the ends of the admissible intervals are marked, and the linear
-    frequencies ``ω_j/2π`` in range are drawn as dashed vertical lines.
+    ``backbones`` are :class:`bladecase.Backbone` (1 ipp) or
+    :class:`bladecase.Family` (k ipp) objects, one colour per number of
+    impacts per period.  Admissible orbits are drawn as solid curves,
+    non-admissible ones as faint dots; the ends of the admissible intervals
+    are marked, and the linear frequencies ``ω_j/2π`` in range are drawn as
+    dashed vertical lines.
 
     Returns the matplotlib ``Figure``.
     """
@@ -24,14 +27,18 @@ def frequency_energy(backbones: Sequence, ax=None, linear: bool = True, title: s
         fig = ax.figure
     colors = ["C0", "C1", "C2", "C3", "C4", "C5"]
     fmin, fmax = np.inf, -np.inf
-    for n, bb in enumerate(backbones):
-        c = colors[n % len(colors)]
+    labelled = set()
+    for bb in backbones:
+        c = colors[(bb.ipp - 1) % len(colors)]
         f, E, adm = bb.frequencies, bb.energy, bb.admissible
         fmin, fmax = min(fmin, f.min()), max(fmax, f.max())
         ok = np.isfinite(E) & (E > 0)
-        ax.plot(f[ok & ~adm], E[ok & ~adm], ".", ms=2, color=c, alpha=0.25)
+        ax.plot(f[ok & ~adm], E[ok & ~adm], ".", ms=2, color=c, alpha=0.2)
         Ea = np.where(adm, E, np.nan)  # NaN breaks the curve between admissible arcs
-        ax.plot(f, Ea, "-", lw=1.8, color=c, label=f"{bb.ipp} ipp (admissible)")
+        label = None if bb.ipp in labelled or not adm.any() else f"{bb.ipp} ipp (admissible)"
+        if label:
+            labelled.add(bb.ipp)
+        ax.plot(f, Ea, "-", lw=1.8, color=c, label=label)
         for iv in bb.intervals:
             for T, refined in ((iv.T_lo, iv.refined_lo), (iv.T_hi, iv.refined_hi)):
                 if refined:

@@ -127,7 +127,11 @@ class Backbone:
 def _solver(ipp: int) -> Callable[[LinearSystem, float], PeriodicOrbit]:
     if ipp == 1:
         return orbit_1ipp
-    raise ValueError(f"ipp = {ipp!r}: only 1 impact per period is available in this version")
+    raise ValueError(
+        f"backbone scans 1-ipp orbits (ipp = 1), got ipp = {ipp!r}: for k >= 2 impacts per period the "
+        "orbits exist only on curves of impact times, use bladecase.nonsmooth_mode(system, k, T_range) "
+        "(or orbits_kipp(system, T, k) at one period)"
+    )
 
 
 def _try(solve, system, T) -> PeriodicOrbit | None:
