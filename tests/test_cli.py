@@ -93,7 +93,7 @@ def test_matrices_file(tmp_path, capsys):
         (["backbone", "--gap", "1", "--periods", "1:5:3"], "exactly one of --chain N or --matrices"),
         (["backbone", "--chain", "2", "--k", "1,2,3", "--gap", "1", "--periods", "1:5:3"], "k must be a scalar or have 2"),
         (["backbone", "--chain", "2", "--k", "x", "--gap", "1", "--periods", "1:5:3"], "expected a number"),
-        (["backbone", "--chain", "2", "--gap", "1", "--periods", "1:5:3", "--ipp", "2"], "ipp = 2"),
+        (["backbone", "--chain", "2", "--gap", "1", "--periods", "2:2:1", "--ipp", "2"], "period range"),
         (["backbone", "--matrices", "/nonexistent/sys.npz", "--periods", "1:5:3"], "cannot read"),
     ],
 )
