@@ -403,12 +403,14 @@ def nonsmooth_mode(
 
 def _polished_orbit(curve: _Curve, z) -> PeriodicOrbit:
     """The orbit at curve point ``z``, its impact times re-solved at fixed ``T``
-    to machine precision (Levenberg–Marquardt on ``(t, Λ)``)."""
+    to machine precision (Newton on ``(t, Λ)``).  Admissibility is certified;
+    for a non-admissible orbit ``max_violation`` is the largest sampled
+    violation (not polished)."""
     T, times, lam = curve.split(z)
     sol = _solve_times(_Modal.of(curve.system, T), times, curve.d)
     if sol is not None and np.abs(sol[0] - times).max() < 1e-6 * T:
         times, lam = sol
-    return make_orbit(curve.system, T, times, lam)
+    return make_orbit(curve.system, T, times, lam, polish=False)
 
 
 def _passes(curve: _Curve, zs, start) -> bool:
