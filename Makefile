@@ -16,6 +16,9 @@ demo: $(STAMP)
 	$(BIN)/bladecase backbone --chain 2 --k 1 --m 0.5 --gap 1 --periods 1:12:600 \
 		--json results/backbone_2dof.json --plot results/backbone_2dof.png \
 		--table results/backbone_2dof.txt
+	$(BIN)/bladecase backbone --chain 2 --k 1 --m 0.5 --gap 1 --periods 3:14.5:24 --ipp 2 --quiet \
+		--json results/modes_2ipp_2dof.json --plot results/modes_2ipp_2dof.png \
+		--table results/modes_2ipp_2dof.txt
 
 test: $(STAMP)
 	$(BIN)/python -m pytest
