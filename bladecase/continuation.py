@@ -40,15 +40,25 @@ MERGE_RTOL = 1e-4
 @dataclass(frozen=True)
 class Arc:
     """An admissible arc of a family: points ``start..stop`` (inclusive) and its
-    refined period range ``[T_lo, T_hi]``."""
+    period range ``[T_lo, T_hi]``.
+
+    ``refined_lo``/``refined_hi`` say whether that end is where admissibility
+    is lost (refined by bisection along the curve); otherwise the arc ends
+    where the family itself ends (period range, resonance, impacts merging,
+    branch point with a repeated orbit).  Along a curve with a turning point
+    ``T`` is not monotone: ``T_lo``/``T_hi`` are the extreme periods of the arc.
+    """
 
     start: int
     stop: int
     T_lo: float
     T_hi: float
+    refined_lo: bool = True
+    refined_hi: bool = True
 
     def to_dict(self) -> dict:
-        return {"start": self.start, "stop": self.stop, "T_lo": self.T_lo, "T_hi": self.T_hi}
+        return {"start": self.start, "stop": self.stop, "T_lo": self.T_lo, "T_hi": self.T_hi,
+                "refined_lo": self.refined_lo, "refined_hi": self.refined_hi}
 
 
 @dataclass(frozen=True, eq=False)
@@ -106,7 +116,7 @@ class Family:
         """Admissible arcs as :class:`bladecase.Interval` (for plots shared with backbones)."""
         from .scan import Interval
 
-        return [Interval(a.T_lo, a.T_hi, True, True) for a in self.arcs]
+        return [Interval(a.T_lo, a.T_hi, a.refined_lo, a.refined_hi) for a in self.arcs]
 
     @property
     def linear_frequencies(self) -> np.ndarray:
@@ -266,6 +276,21 @@ class _Curve:
         return None, maxiter
 
 
+def _repetition_offsets(times, T) -> list[np.ndarray]:
+    """For each ``j > 1`` dividing ``k``: the offsets of the impact pattern from
+    one repeating every ``T/j`` (all zero at a repeated orbit)."""
+    k = times.size
+    return [np.mod(np.roll(times, -(k // j)) - times, T) - T / j for j in range(2, k + 1) if k % j == 0]
+
+
+def _crosses_repetition(curve: "_Curve", z_a, z_b) -> bool:
+    """Does the segment ``z_a → z_b`` cross a repeated orbit (all offsets flip sign)?"""
+    for da, db in zip(_repetition_offsets(*curve.times(z_a)[::-1]), _repetition_offsets(*curve.times(z_b)[::-1])):
+        if np.all(np.sign(da) * np.sign(db) < 0):
+            return True
+    return False
+
+
 def _distance_to_repetition(times, lam, T) -> float:
     """How far (relative) the impact pattern is from repeating every ``T/j``, ``j | k``."""
     k = times.size
@@ -294,8 +319,16 @@ def _follow(curve: _Curve, z0, direction, T_range, ds, ds_min, ds_max, max_point
     for _ in range(max_points):
         step = ds
         while True:
-            zc, iters = curve.correct(z + step * tan, tan, J)
-            if zc is not None and curve.valid(zc) and np.linalg.norm(zc - z) < 2 * step:
+            zp = z + step * tan
+            zc, iters = curve.correct(zp, tan, J)
+            if zc is None:  # chord method failed: full Newton (fresh Jacobian every iteration)
+                zc, iters = curve.correct(zp, tan)
+            # The corrector moves across the curve; a large move means it jumped
+            # to another branch: take a smaller step instead.
+            # Crossing a repeated (period T/j) orbit is a branch point: the family
+            # ends there; smaller steps bring its last point close to it.
+            if (zc is not None and curve.valid(zc) and np.linalg.norm(zc - zp) < 0.3 * step
+                    and not _crosses_repetition(curve, z, zc)):
                 break
             step /= 2
             if step < ds_min:
@@ -340,7 +373,7 @@ def nonsmooth_mode(
         1``) are not followed: they are not new modes.
     step : float
         Initial arclength step in scaled unknowns (times / ``T``, impulses /
-        their scale); it adapts between ``step/1000`` and ``5·step``.
+        their scale); it adapts between ``step/1000`` and ``2·step``.
     max_points : int
         Cap on points per direction of each family.
     refine : bool
@@ -384,8 +417,8 @@ def nonsmooth_mode(
         curve = _Curve(system, k, T, lam0)
         z0 = curve.join(o.impact_times)
         t0 = curve.tangent(z0)
-        fwd = _follow(curve, z0, t0, (T_lo, T_hi), step, step / 1000, 5 * step, max_points)
-        bwd = _follow(curve, z0, -t0, (T_lo, T_hi), step, step / 1000, 5 * step, max_points)
+        fwd = _follow(curve, z0, t0, (T_lo, T_hi), step, step / 1000, 2 * step, max_points)
+        bwd = _follow(curve, z0, -t0, (T_lo, T_hi), step, step / 1000, 2 * step, max_points)
         zs = bwd[::-1] + [z0] + fwd
         orbits = []
         for z in zs:
@@ -447,9 +480,13 @@ def _arcs(curve: _Curve, zs, orbits, refine: bool) -> list[Arc]:
         j = i
         while j + 1 < adm.size and adm[j + 1]:
             j += 1
-        T_a = orbits[i].T if not (refine and i > 0) else _bisect_curve(curve, zs[i], zs[i - 1])
-        T_b = orbits[j].T if not (refine and j + 1 < adm.size) else _bisect_curve(curve, zs[j], zs[j + 1])
-        arcs.append(Arc(i, j, min(T_a, T_b), max(T_a, T_b)))
+        ref_a, ref_b = refine and i > 0, refine and j + 1 < adm.size
+        T_a = _bisect_curve(curve, zs[i], zs[i - 1]) if ref_a else orbits[i].T
+        T_b = _bisect_curve(curve, zs[j], zs[j + 1]) if ref_b else orbits[j].T
+        Ts = [o.T for o in orbits[i:j + 1]] + [T_a, T_b]
+        lo, hi = min(Ts), max(Ts)
+        arcs.append(Arc(i, j, lo, hi, refined_lo=(lo == T_a and ref_a) or (lo == T_b and ref_b),
+                        refined_hi=(hi == T_a and ref_a) or (hi == T_b and ref_b)))
         i = j + 1
     return arcs
 
@@ -491,6 +528,6 @@ def _one_ipp_families(system, T_range, scan, refine) -> list[Family]:
     for iv in bb.intervals:
         idx = [n for n, o in enumerate(orbits) if iv.T_lo <= o.T <= iv.T_hi]
         if idx:
-            arcs.append(Arc(idx[0], idx[-1], iv.T_lo, iv.T_hi))
+            arcs.append(Arc(idx[0], idx[-1], iv.T_lo, iv.T_hi, iv.refined_lo, iv.refined_hi))
     del adm
     return [Family(system=system, k=1, orbits=orbits, arcs=arcs)]

@@ -50,6 +50,11 @@ def frequency_energy(backbones: Sequence, ax=None, linear: bool = True, title: s
             ax.axvline(fj, color="k", ls="--", lw=0.8, label="linear frequencies" if first else None)
             first = False
     ax.set_yscale("log")
+    # Non-admissible energies diverge at resonances: frame the admissible curves.
+    adm_E = np.concatenate([bb.energy[bb.admissible] for bb in backbones]) if backbones else np.array([])
+    adm_E = adm_E[np.isfinite(adm_E) & (adm_E > 0)]
+    if adm_E.size:
+        ax.set_ylim(adm_E.min() / 3, adm_E.max() * 3)
     ax.set_xlabel("frequency 1/T")
     ax.set_ylabel("energy E")
     ax.set_title(title or "Nonsmooth modes: frequency–energy")
