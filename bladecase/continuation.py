@@ -429,7 +429,7 @@ def nonsmooth_mode(
         for m in range(n + 1, len(starts)):
             if not covered[m] and _passes(curve, zs, starts[m]):
                 covered[m] = True
-        arcs = _arcs(curve, zs, orbits, refine)
+        arcs = _arcs(curve, [curve.join(o.impact_times) for o in orbits], orbits, refine)
         families.append(Family(system=system, k=k, orbits=orbits, arcs=arcs))
     return families
 
@@ -481,8 +481,11 @@ def _arcs(curve: _Curve, zs, orbits, refine: bool) -> list[Arc]:
         while j + 1 < adm.size and adm[j + 1]:
             j += 1
         ref_a, ref_b = refine and i > 0, refine and j + 1 < adm.size
-        T_a = _bisect_curve(curve, zs[i], zs[i - 1]) if ref_a else orbits[i].T
-        T_b = _bisect_curve(curve, zs[j], zs[j + 1]) if ref_b else orbits[j].T
+        T_a, T_b = orbits[i].T, orbits[j].T
+        if ref_a:
+            T_a, ref_a = _bisect_curve(curve, zs[i], zs[i - 1])
+        if ref_b:
+            T_b, ref_b = _bisect_curve(curve, zs[j], zs[j + 1])
         Ts = [o.T for o in orbits[i:j + 1]] + [T_a, T_b]
         lo, hi = min(Ts), max(Ts)
         arcs.append(Arc(i, j, lo, hi, refined_lo=(lo == T_a and ref_a) or (lo == T_b and ref_b),
@@ -491,19 +494,42 @@ def _arcs(curve: _Curve, zs, orbits, refine: bool) -> list[Arc]:
     return arcs
 
 
-def _bisect_curve(curve: _Curve, z_in, z_out, maxiter: int = 60) -> float:
-    """Period where admissibility is lost between curve points ``z_in`` (admissible)
-    and ``z_out``: bisection along the curve (midpoint predictor, corrector
-    orthogonal to the chord)."""
+def _bisect_curve(curve: _Curve, z_in, z_out, maxiter: int = 80) -> tuple[float, bool]:
+    """Period where admissibility is lost between curve points ``z_in``
+    (admissible) and ``z_out``: bisection along the curve.
+
+    The midpoint is solved at fixed ``T = (T_in + T_out)/2`` by Newton from
+    the interpolated impact times (robust near resonances, where the
+    eliminated-impulse residual is stiff), else by the arclength corrector
+    orthogonal to the chord (turning points); a midpoint that leaves the
+    bracket is rejected.  Returns the admissible end and whether the bracket
+    was narrowed to ``ARC_RTOL``.
+    """
     k = curve.k
     for _ in range(maxiter):
         T_in, T_out = z_in[k - 1] * curve.T0, z_out[k - 1] * curve.T0
         if abs(T_out - T_in) <= ARC_RTOL * abs(T_in):
-            break
-        chord = z_out - z_in
-        chord = chord / np.linalg.norm(chord)
-        zm, _ = curve.correct(0.5 * (z_in + z_out), chord)
+            return float(T_in), True
+        zm = None
+        Tm = 0.5 * (T_in + T_out)
+        if T_in != T_out:
+            try:
+                md = _Modal.of(curve.system, check_period(curve.system, Tm))
+                guess = 0.5 * (curve.times(z_in)[1] / T_in + curve.times(z_out)[1] / T_out) * Tm
+                sol = _solve_times(md, guess, curve.d)
+            except ValueError:
+                sol = None
+            if sol is not None:
+                zm = curve.join(sol[0])
         if zm is None:
+            chord = (z_out - z_in) / np.linalg.norm(z_out - z_in)
+            zm, _ = curve.correct(0.5 * (z_in + z_out), chord)
+        if zm is None:
+            break
+        # stay on this stretch of the curve: between the two ends, near the chord
+        span = z_out - z_in
+        a = float((zm - z_in) @ span / (span @ span))
+        if not 0 < a < 1 or np.linalg.norm(zm - z_in - a * span) > np.linalg.norm(span):
             break
         Tm, times, lam = curve.split(zm)
         try:
@@ -514,7 +540,7 @@ def _bisect_curve(curve: _Curve, z_in, z_out, maxiter: int = 60) -> float:
             z_in = zm
         else:
             z_out = zm
-    return float(z_in[k - 1] * curve.T0)
+    return float(z_in[k - 1] * curve.T0), False
 
 
 def _one_ipp_families(system, T_range, scan, refine) -> list[Family]:

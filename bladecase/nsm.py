@@ -267,6 +267,10 @@ def make_orbit(
 #: repeated-orbit test.
 REPEAT_RTOL = 1e-7
 
+#: Two impacts closer than ``DISTINCT_RTOL·T`` are one: such a "solution" is
+#: not a k-ipp orbit and is discarded.
+DISTINCT_RTOL = 1e-7
+
 
 def repetitions(times: np.ndarray, impulses: np.ndarray, T: float) -> int:
     """Largest ``j`` dividing ``k`` such that the impact pattern repeats every ``T/j``."""
@@ -385,9 +389,11 @@ def newton_times(md: _Modal, times: np.ndarray, lam: np.ndarray, d: float, maxit
         if size < 1e-14:
             break
         prev = size
-    if times[0] <= 0 or np.any(np.diff(times) <= 0):
-        return None
-    if np.abs(kipp_residual(md, times, lam, d)).max() > 1e-9 * max(d, np.abs(lam).max()):
+    if times[0] <= DISTINCT_RTOL * T or np.any(np.diff(times) <= DISTINCT_RTOL * T):
+        return None  # impacts merged: not a k-ipp orbit
+    r = kipp_residual(md, times, lam, d)
+    scale = float(md.b @ md.b) / 2 * np.abs(lam).max()
+    if np.abs(r[:k]).max() > 1e-9 * max(scale, d) or np.abs(r[k:]).max() > 1e-9 * d:
         return None
     return times, lam
 
@@ -416,7 +422,7 @@ def _solve_times(md: _Modal, times0: np.ndarray, d: float) -> tuple[np.ndarray, 
     lam = res.x[k - 1:] * lscale
     if not np.all(np.isfinite(res.x)) or np.abs(res.fun).max() > 1e-9:
         return None
-    if times[0] <= 0 or np.any(np.diff(times) <= 1e-9 * T):
+    if times[0] <= DISTINCT_RTOL * T or np.any(np.diff(times) <= DISTINCT_RTOL * T):
         return None
     return times, lam
 
@@ -457,13 +463,7 @@ def orbits_kipp(system: LinearSystem, T: float, k: int, resolution: int | None =
     d = system.gap
     solutions: list[tuple[np.ndarray, np.ndarray]] = []
     if k == 2:
-        from .trigsum import all_roots
-
-        c = md.b**2 / 2
-        s_sum = TrigSum(alpha=c, beta=-c * np.cos(md.omega * T / 2) / md.sin_half, omega=md.omega)
-        for t1 in all_roots(s_sum, 0.0, T):
-            if not 0 < t1 < T:
-                continue
+        for t1 in _k2_roots(md):
             times = np.array([t1, T])
             lam = _impulses(md, times, d)
             if lam is not None:
@@ -481,21 +481,33 @@ def orbits_kipp(system: LinearSystem, T: float, k: int, resolution: int | None =
 
 def canonical_rotation(times: np.ndarray, impulses: np.ndarray, T: float) -> tuple[np.ndarray, np.ndarray]:
     """The same orbit re-anchored at the impact that makes ``(t₁, …, t_k)`` smallest
-    lexicographically.  Re-anchoring at impact ``r`` (a time shift by ``t_r``)
-    gives the same physical orbit; this picks one representative."""
+    lexicographically (times closer than ``REPEAT_RTOL·T`` count as equal, so
+    that round-off cannot pick different representatives of one orbit).
+    Re-anchoring at impact ``r`` (a time shift by ``t_r``) gives the same
+    physical orbit; this picks one representative."""
+    tol = REPEAT_RTOL * T
     best = None
     for r in range(times.size):
         shifted = np.mod(times - times[r], T)
-        shifted[shifted <= REPEAT_RTOL * T] = T
+        shifted[(shifted <= tol) | (shifted >= T - tol)] = T
         order = np.argsort(shifted)
         cand = (shifted[order], impulses[order])
-        if best is None or tuple(cand[0]) < tuple(best[0]):
+        if best is None:
+            best = cand
+            continue
+        diff = cand[0] - best[0]
+        first = np.flatnonzero(np.abs(diff) > tol)
+        if first.size and diff[first[0]] < 0:
             best = cand
     best[0][-1] = T
     return best
 
 
 def _multistart(md: _Modal, k: int, d: float, resolution: int | None) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Solutions for k >= 3: Newton from the equally spaced pattern, from every
+    repeated lower-order solution (period ``T/j``, ``j | k``), and from the
+    grid cells of ordered impact times whose screening residual is a local
+    minimum (non-strict) or among the lowest 5 %."""
     from itertools import combinations
 
     T = md.T
@@ -514,26 +526,50 @@ def _multistart(md: _Modal, k: int, d: float, resolution: int | None) -> list[tu
         except np.linalg.LinAlgError:
             continue
         score[i] = np.linalg.norm(Pi @ n) / (np.linalg.norm(n) * S)
-    # Local minima of the score among grid neighbours (index distance 1 in every time).
     pos = {tuple(row): i for i, row in enumerate(idx)}
+    finite = np.isfinite(score)
+    low = set(np.flatnonzero(finite & (score <= np.quantile(score[finite], 0.05)))) if finite.any() else set()
     candidates = []
     for i, row in enumerate(idx):
-        if not np.isfinite(score[i]):
+        if not finite[i]:
             continue
-        best = True
-        for delta in np.ndindex(*(3,) * (k - 1)):
-            j = pos.get(tuple(row + np.array(delta) - 1))
-            if j is not None and j != i and score[j] < score[i]:
-                best = False
-                break
+        best = i in low
+        if not best:
+            best = True
+            for delta in np.ndindex(*(3,) * (k - 1)):
+                j = pos.get(tuple(row + np.array(delta) - 1))
+                if j is not None and j != i and score[j] < score[i]:
+                    best = False
+                    break
         if best:
-            candidates.append(i)
+            candidates.append(starts[i])
+    # Patterns that always solve or nearly solve: equally spaced impacts, and
+    # repetitions of the solutions with k/j impacts at period T/j.
+    seeds = [T * np.arange(1, k + 1) / k]
+    for j in range(2, k):
+        if k % j == 0:
+            sub = _Modal(omega=md.omega, b=md.b, phi=md.phi, sin_half=np.sin(md.omega * T / (2 * j)), T=T / j)
+            base = [np.array([T / j])] if k // j == 1 else (
+                [t for t, _ in _multistart(sub, k // j, d, resolution)] if k // j >= 3 else
+                [np.array([t1, T / j]) for t1 in _k2_roots(sub)])
+            for t in base:
+                seeds.append(np.concatenate([t + m * T / j for m in range(j)]))
     found: list[tuple[np.ndarray, np.ndarray]] = []
-    for i in candidates:
-        sol = _solve_times(md, starts[i], d)
+    for times0 in seeds + candidates:
+        sol = _solve_times(md, np.asarray(times0, dtype=float), d)
         if sol is None:
             continue
         if any(np.abs(sol[0] - t).max() <= REPEAT_RTOL * T for t, _ in found):
             continue
         found.append(sol)
     return found
+
+
+def _k2_roots(md: _Modal) -> np.ndarray:
+    """Every ``t₁`` in ``(0, T)`` with ``s(t₁) = 0`` (the k = 2 condition)."""
+    from .trigsum import all_roots
+
+    T = md.T
+    c = md.b**2 / 2
+    s_sum = TrigSum(alpha=c, beta=-c * np.cos(md.omega * T / 2) / md.sin_half, omega=md.omega)
+    return np.array([t for t in all_roots(s_sum, 0.0, T) if 0 < t < T])

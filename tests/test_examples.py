@@ -141,7 +141,7 @@ def test_fig2_paper_arc(ex, sys2):
     assert np.min(np.abs(ends - FIVE_T2)) <= 0.01 * FIVE_T2
     arc = f2.paper_arc(arcs, sys2)
     assert arc["T_hi"] == pytest.approx(FIVE_T2, rel=0.01)
-    assert arc["T_hi"] < FIVE_T2  # T = 5 T2 itself is resonant
+    assert arc["T_hi"] <= FIVE_T2 * (1 + 1e-9)  # T = 5 T2 itself is resonant (excluded); the end converges to it
     # ① on the diagonal at T ≈ 13.33 (the paper's red curve starts there)
     i = int(np.argmin(arc["T"]))
     assert arc["T"][i] == pytest.approx(13.33, abs=0.01)
