@@ -436,10 +436,11 @@ def orbits_kipp(system: LinearSystem, T: float, k: int, resolution: int | None =
     changes on ``(0, T)`` are found with certified root exclusion
     (:func:`bladecase.trigsum.all_roots`), then ``Λ = Σ⁻¹ d·1``.  k >= 3
     (``Pf(Π) = 0`` and a two-dimensional null space for even k, the null
-    vector of ``Π`` for odd k): Gauss–Newton on ``(t₁…t_{k-1}, Λ)`` started
-    from every cell of a grid on the ordered times whose residual is a local
-    minimum, ``resolution`` points per time (default: 4 per period of the
-    highest contact mode, between 16 and 48); solutions closer than
+    vector of ``Π`` for odd k): Newton on ``(t₁…t_{k-1}, Λ)`` started from
+    every cell of a grid on the ordered times, ``resolution`` points per time
+    (default: 4 per period of the highest contact mode, between 16 and 48),
+    from the equally spaced and repeated lower-order patterns, and
+    Levenberg–Marquardt from the most promising cells; solutions closer than
     ``1e-7 T`` are merged.  For k >= 3 completeness is up to that resolution.
     Solutions that differ only by which impact is placed at ``t = 0`` (a time
     shift) are the same orbit and are returned once
@@ -504,10 +505,11 @@ def canonical_rotation(times: np.ndarray, impulses: np.ndarray, T: float) -> tup
 
 
 def _multistart(md: _Modal, k: int, d: float, resolution: int | None) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Solutions for k >= 3: Newton from the equally spaced pattern, from every
-    repeated lower-order solution (period ``T/j``, ``j | k``), and from the
-    grid cells of ordered impact times whose screening residual is a local
-    minimum (non-strict) or among the lowest 5 %."""
+    """Solutions for k >= 3: Levenberg–Marquardt from the equally spaced
+    pattern, from every repeated lower-order solution (period ``T/j``,
+    ``j | k``) and from the grid cells of ordered impact times whose screening
+    residual is a local minimum (non-strict) or among the lowest 5 %; Newton
+    from every grid cell."""
     from itertools import combinations
 
     T = md.T
@@ -555,13 +557,20 @@ def _multistart(md: _Modal, k: int, d: float, resolution: int | None) -> list[tu
             for t in base:
                 seeds.append(np.concatenate([t + m * T / j for m in range(j)]))
     found: list[tuple[np.ndarray, np.ndarray]] = []
+
+    def keep(sol):
+        if sol is not None and not any(np.abs(sol[0] - t).max() <= REPEAT_RTOL * T for t, _ in found):
+            found.append(sol)
+
+    # Newton (analytic Jacobian, cheap) from every cell: the screening score is
+    # a poor guide to Newton's basins; Levenberg–Marquardt (wider basin,
+    # costlier) from the seeds and the promising cells.
     for times0 in seeds + candidates:
-        sol = _solve_times(md, np.asarray(times0, dtype=float), d)
-        if sol is None:
-            continue
-        if any(np.abs(sol[0] - t).max() <= REPEAT_RTOL * T for t, _ in found):
-            continue
-        found.append(sol)
+        keep(_solve_times(md, np.asarray(times0, dtype=float), d))
+    for times0 in starts:
+        lam0 = _impulses(md, times0, d)
+        if lam0 is not None:
+            keep(newton_times(md, times0, lam0, d))
     return found
 
 
