@@ -451,14 +451,14 @@ def _passes(curve: _Curve, zs, start) -> bool:
     T_s, o = start
     k = curve.k
     Ts = np.array([z[k - 1] for z in zs]) * curve.T0
+    lo, hi = np.minimum(Ts[:-1], Ts[1:]), np.maximum(Ts[:-1], Ts[1:])
+    segments = np.flatnonzero((lo <= T_s) & (T_s <= hi) & (hi > lo))
+    if segments.size == 0:
+        return False
     md = _Modal.of(curve.system, T_s)
-    for i in range(len(zs) - 1):
-        lo, hi = sorted((Ts[i], Ts[i + 1]))
-        if not lo <= T_s <= hi or hi == lo:
-            continue
+    for i in segments:
         a = (T_s - Ts[i]) / (Ts[i + 1] - Ts[i])
-        _, ta, _ = curve.split(zs[i])
-        _, tb, _ = curve.split(zs[i + 1])
+        ta, tb = curve.times(zs[i])[1], curve.times(zs[i + 1])[1]
         guess = ((1 - a) * ta / Ts[i] + a * tb / Ts[i + 1]) * T_s
         sol = _solve_times(md, guess, curve.d)
         if sol is None:
