@@ -22,3 +22,9 @@ __all__ = [
     "simulate",
 ]
 __version__ = "0.1.0"
+
+# Geometry and meshing front end (gmsh, meshio; imported lazily inside the functions).
+from .geometry import BladeGeometry, PlateGeometry, blade_mesh  # noqa: E402
+from .mesh import Mesh, load_mesh, save_mesh  # noqa: E402
+
+__all__ += ["BladeGeometry", "Mesh", "PlateGeometry", "blade_mesh", "load_mesh", "save_mesh"]

@@ -1,14 +1,24 @@
 """The mesh that travels from geometry (or a user's file) to the FE assembly.
 
 A :class:`Mesh` is plain data: node coordinates, cells by meshio cell type,
-and named node groups.  :func:`load_mesh` reads any format meshio reads.
+and named node groups.  :func:`load_mesh` reads any format meshio reads
+(:func:`from_meshio` converts an in-memory ``meshio.Mesh``) and checks the
+elements; :func:`save_mesh` writes ``.vtu``/``.vtk``/``.inp`` files with the
+groups in a form :func:`load_mesh` reads back.
 """
 
 from __future__ import annotations
 
+import os
+import re
+from contextlib import redirect_stderr, redirect_stdout
 from dataclasses import dataclass, field
+from io import StringIO
+from typing import Sequence
 
 import numpy as np
+
+from .io import atomic_path
 
 #: meshio cell types accepted as the body of a model, by dimension and order.
 VOLUME_TYPES = {3: {1: "tetra", 2: "tetra10"}, 2: {1: "triangle", 2: "triangle6"}}
@@ -62,3 +72,382 @@ class Mesh:
             have = ", ".join(sorted(self.groups)) or "none"
             raise ValueError(f"mesh {self.source or ''} has no group {name!r} (groups: {have})")
         return self.groups[name]
+
+
+# ----------------------------------------------------------------------------- reading
+
+#: Prefix of the ``.vtu``/``.vtk`` point-data arrays that carry named node groups:
+#: ``group:root`` is a per-node mask (non-zero = in the group).
+GROUP_PREFIX = "group:"
+
+#: Element whose ``|volume|`` (area in 2-D) is at most ``DEGENERATE_RTOL`` times the
+#: mean ``|volume|`` of the mesh is degenerate.
+DEGENERATE_RTOL = 1e-12
+
+#: meshio simplex cell types by topological dimension.
+_SIMPLEX = {0: ("vertex",), 1: ("line", "line3"), 2: ("triangle", "triangle6"), 3: ("tetra", "tetra10")}
+_ALIASES = {"tetra4": "tetra"}  # meshio's name for Abaqus C3D4H
+
+#: Abaqus simplex element types missing from meshio 5.3's table (plane stress/strain).
+_ABAQUS_EXTRA = {
+    "CPS6": "triangle6", "CPS6M": "triangle6", "CPE3": "triangle", "CPE6M": "triangle6", "CPS3H": "triangle",
+}
+
+
+def _cell_dim(cell_type: str) -> int:
+    """Topological dimension of a meshio cell type (-1 if unknown)."""
+    if cell_type == "vertex":
+        return 0
+    if cell_type.startswith("line"):
+        return 1
+    if cell_type.startswith(("triangle", "quad", "polygon")):
+        return 2
+    if cell_type.startswith(("tetra", "hexahedron", "wedge", "pyramid", "polyhedron")):
+        return 3
+    return -1
+
+
+def load_mesh(path: str | os.PathLike, require: Sequence[str] = ()) -> Mesh:
+    """Read a simplex mesh and its named groups from any file meshio reads.
+
+    Parameters
+    ----------
+    path : path-like
+        ``.msh`` (gmsh 2.2/4.1), ``.vtu``/``.vtk``, ``.inp`` (Abaqus), ``.med``, …
+    require : sequence of str
+        Group names that must exist and be non-empty (e.g. ``("root", "tip")``).
+
+    Returns
+    -------
+    Mesh
+        See :func:`from_meshio` for what is kept and checked.
+
+    Raises
+    ------
+    ValueError
+        Unreadable file (the path and meshio's reason), no tetrahedra nor
+        triangles, non-simplex body cells, mixed element orders, a 2-D mesh
+        off the plane ``z = 0``, degenerate or inverted elements (count and
+        first offender), a required group missing or empty.
+    """
+    import meshio
+
+    _register_abaqus_types()
+    source = str(path)
+    # ".msh" is also an ANSYS suffix: name gmsh first, try ANSYS if gmsh fails.
+    formats = ["gmsh", "ansys"] if source.lower().endswith(".msh") else [None]
+    reasons = []
+    for fmt in formats:
+        m, reason = _read_quietly(meshio, path, fmt)
+        if m is not None:
+            break
+        reasons.append(reason)
+    else:
+        raise ValueError(f"cannot read mesh file {source!r}: {'; '.join(reasons)}")
+    return from_meshio(m, source=source, require=require)
+
+
+def _read_quietly(meshio, path, file_format):
+    """``(meshio.Mesh, None)`` or ``(None, reason)``; meshio's prints and ``sys.exit`` are captured."""
+    out = StringIO()
+    try:
+        with redirect_stdout(out), redirect_stderr(out):
+            return meshio.read(path, file_format=file_format), None
+    except (Exception, SystemExit) as exc:  # meshio raises ReadError, KeyError, …, or exits
+        said = " ".join(out.getvalue().split())
+        text = "" if isinstance(exc, SystemExit) else f"{type(exc).__name__}: {exc}".rstrip(": ")
+        return None, " ".join(filter(None, [text, said])) or type(exc).__name__
+
+
+def _register_abaqus_types() -> None:
+    """Teach meshio's Abaqus reader the simplex types it lacks (never overrides an entry)."""
+    from meshio.abaqus import _abaqus
+
+    for key, value in _ABAQUS_EXTRA.items():
+        _abaqus.abaqus_to_meshio_type.setdefault(key, value)
+
+
+def from_meshio(m, source: str = "", require: Sequence[str] = ()) -> Mesh:
+    """Convert a ``meshio.Mesh`` to a checked :class:`Mesh`.
+
+    * **Dimension**: 3 if the mesh has ``tetra``/``tetra10`` cells, else 2 if it
+      has ``triangle``/``triangle6`` cells (which must then lie in ``z = 0``).
+    * **Cells kept**: the body cells (one simplex type, all blocks merged) and
+      the lower-dimensional simplex cells (``vertex``, ``line``, ``line3``,
+      ``triangle``, ``triangle6`` in 3-D), e.g. the faces of physical groups.
+      Other cell types of lower dimension are dropped; non-simplex cells of
+      the body dimension are an error.
+    * **Nodes**: all points of the file are kept, with their indices, even the
+      ones no kept cell uses (e.g. geometry vertices); points are padded to
+      three columns.
+    * **Groups** (node sets, unions when a name appears in several sources):
+      gmsh physical groups (``cell_sets``, or ``field_data`` + ``cell_data
+      ["gmsh:physical"]`` for MSH 2.2) → the nodes of their cells; Abaqus
+      ``*NSET`` (``point_sets``) as they are and ``*ELSET`` (``cell_sets``) →
+      the nodes of their elements; MED families (``point_tags``,
+      ``cell_tags``); point-data masks ``group:<name>`` (``.vtu``/``.vtk``).
+    * **Checks**: degenerate elements (``|volume| <= DEGENERATE_RTOL · mean``),
+      inverted elements (negative signed volume of the straight element
+      through the corner nodes) and, for ``tetra10``/``triangle6``, curved
+      elements whose Jacobian is not positive at every corner node.  Planar
+      triangles that are ALL clockwise are reoriented to counter-clockwise
+      (corner and midside nodes); a mix is an error.  Errors name the count
+      and the first offending element (its index among the body cells and
+      its nodes).
+    """
+    if not source:
+        source = "<meshio mesh>"
+    points = np.array(m.points, dtype=float)  # a copy: the meshio mesh is not modified
+    if points.ndim != 2 or points.shape[1] not in (2, 3) or len(points) == 0:
+        raise ValueError(f"mesh {source} has no usable points (array shape {points.shape})")
+    if not np.all(np.isfinite(points)):
+        bad = int((~np.isfinite(points)).any(axis=1).sum())
+        raise ValueError(f"mesh {source} has {bad} point(s) with non-finite coordinates")
+    if points.shape[1] == 2:
+        points = np.column_stack([points, np.zeros(len(points))])
+
+    blocks = [(_ALIASES.get(b.type, b.type), np.asarray(b.data)) for b in m.cells]
+    present = {t for t, d in blocks if len(d)}
+    dim = 3 if present & set(_SIMPLEX[3]) else 2 if present & set(_SIMPLEX[2]) else 0
+    if dim == 0:
+        found = ", ".join(sorted(present)) or "none"
+        raise ValueError(
+            f"mesh {source} has no volume cells (tetra, tetra10) nor planar cells (triangle, triangle6); "
+            f"cell types: {found}"
+        )
+    body_types = present & set(_SIMPLEX[dim])
+    if len(body_types) > 1:
+        raise ValueError(f"mesh {source} mixes element orders ({', '.join(sorted(body_types))}); use one order")
+    other = sorted(t for t in present if _cell_dim(t) == dim and t not in _SIMPLEX[dim])
+    if other:
+        raise ValueError(
+            f"mesh {source} has non-simplex {dim}-D cells ({', '.join(other)}); only "
+            f"{' and '.join(_SIMPLEX[dim])} are supported"
+        )
+    if dim == 2:
+        extent = float(np.ptp(points[:, :2], axis=0).max()) or 1.0
+        zmax = float(np.abs(points[:, 2]).max())
+        if zmax > 1e-12 * extent:
+            raise ValueError(f"2-D mesh {source} does not lie in the plane z = 0 (max |z| = {zmax:.6g})")
+        points[:, 2] = 0.0
+
+    groups = _groups(m, blocks, len(points), source)
+    btype = body_types.pop()
+    body = np.concatenate([d for t, d in blocks if t == btype]).astype(np.int64)
+    if body.min() < 0 or body.max() >= len(points):
+        raise ValueError(f"mesh {source}: {btype} cells refer to nodes outside 0..{len(points) - 1}")
+    body = _check_orientation(points, body, btype, dim, source)
+    cells = {btype: body}
+    for d in range(dim - 1, -1, -1):  # boundary cells: faces, edges, vertices
+        for t in _SIMPLEX[d]:
+            if t in present:
+                cells[t] = np.concatenate([c for tt, c in blocks if tt == t]).astype(np.int64)
+    mesh = Mesh(points=points, cells=cells, dim=dim, groups=groups, source=source)
+    for name in require:
+        if len(mesh.group(name)) == 0:
+            raise ValueError(f"mesh {source}: group {name!r} is empty")
+    return mesh
+
+
+def _groups(m, blocks, n_points: int, source: str) -> dict[str, np.ndarray]:
+    """Named node sets from every source meshio exposes (see :func:`from_meshio`)."""
+    found: dict[str, list[np.ndarray]] = {}
+
+    def add(name, nodes):
+        found.setdefault(str(name), []).append(np.asarray(nodes, dtype=np.int64).ravel())
+
+    cell_sets = {k: v for k, v in (getattr(m, "cell_sets", None) or {}).items() if not k.startswith("gmsh:")}
+    for name, per_block in cell_sets.items():
+        add(name, [])
+        for (_, data), idx in zip(blocks, per_block):
+            if idx is not None and len(idx):
+                add(name, data[np.asarray(idx, dtype=np.int64)])
+    # gmsh MSH 2.2: physical names in field_data, tags in cell_data (no cell_sets).
+    physical = (getattr(m, "cell_data", None) or {}).get("gmsh:physical")
+    if physical is not None:
+        for name, value in (getattr(m, "field_data", None) or {}).items():
+            if name in cell_sets or np.size(value) != 2:
+                continue
+            tag, gdim = (int(v) for v in np.ravel(value))
+            add(name, [])
+            for (t, data), tags in zip(blocks, physical):
+                if _cell_dim(t) == gdim:
+                    add(name, data[np.asarray(tags) == tag])
+    for name, nodes in (getattr(m, "point_sets", None) or {}).items():
+        add(name, nodes)
+    point_data = getattr(m, "point_data", None) or {}
+    for key, mask in point_data.items():
+        if key.startswith(GROUP_PREFIX):
+            add(key[len(GROUP_PREFIX):], np.flatnonzero(np.asarray(mask).ravel()))
+    # MED families: family id -> group names, on nodes and on cells.
+    fam = point_data.get("point_tags")
+    for tag, names in (getattr(m, "point_tags", None) or {}).items():
+        if fam is not None:
+            for name in names:
+                add(name, np.flatnonzero(np.asarray(fam) == tag))
+    cell_fam = (getattr(m, "cell_data", None) or {}).get("cell_tags")
+    for tag, names in (getattr(m, "cell_tags", None) or {}).items():
+        if cell_fam is not None:
+            for name in names:
+                for (_, data), tags in zip(blocks, cell_fam):
+                    add(name, data[np.asarray(tags) == tag])
+
+    groups = {}
+    for name, parts in found.items():
+        nodes = np.unique(np.concatenate(parts)) if parts else np.zeros(0, dtype=np.int64)
+        if len(nodes) and (nodes[0] < 0 or nodes[-1] >= n_points):
+            raise ValueError(f"mesh {source}: group {name!r} refers to nodes outside 0..{n_points - 1}")
+        groups[name] = nodes
+    return groups
+
+
+def signed_measures(points: np.ndarray, cells: np.ndarray, dim: int) -> np.ndarray:
+    """Signed volumes (3-D) or signed ``xy`` areas (2-D) of the straight simplices through the corner nodes.
+
+    Positive for the gmsh/meshio orientation (counter-clockwise triangles seen
+    from ``+z``; tetrahedra with ``(p1-p0)×(p2-p0)·(p3-p0) > 0``).
+    """
+    p = points[cells[:, : dim + 1]]
+    a, b = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    if dim == 3:
+        return np.einsum("ij,ij->i", np.cross(a, b), p[:, 3] - p[:, 0]) / 6.0
+    return 0.5 * (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
+
+
+#: Edges of the midside nodes of order-2 simplices (meshio/VTK ordering).
+_P2_EDGES = {2: [(0, 1), (1, 2), (0, 2)], 3: [(0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3)]}
+
+
+def jacobian_dets(points: np.ndarray, cells: np.ndarray, dim: int, bary: np.ndarray) -> np.ndarray:
+    """Jacobian determinants of order-1 or order-2 simplices at barycentric points.
+
+    Parameters
+    ----------
+    points : (n, 3) ndarray
+    cells : (m, dim+1) or (m, (dim+1)(dim+2)/2) int ndarray
+        ``triangle``/``tetra`` or ``triangle6``/``tetra10`` connectivity.
+    dim : {2, 3}
+    bary : (q, dim+1) ndarray
+        Barycentric coordinates of the evaluation points.
+
+    Returns
+    -------
+    (m, q) ndarray
+        ``det(∂x/∂ξ)`` (reference simplex ``ξ_i >= 0, Σξ_i <= 1``); in 2-D
+        the ``xy`` determinant.
+    """
+    bary = np.atleast_2d(np.asarray(bary, dtype=float))
+    dl = np.vstack([-np.ones(dim), np.eye(dim)])  # ∇λ_a in reference coordinates
+    if cells.shape[1] == dim + 1:
+        grads = np.broadcast_to(dl, (len(bary), dim + 1, dim))
+    else:
+        grads = np.empty((len(bary), cells.shape[1], dim))
+        for a in range(dim + 1):
+            grads[:, a] = (4 * bary[:, a] - 1)[:, None] * dl[a]
+        for k, (a, b) in enumerate(_P2_EDGES[dim]):
+            grads[:, dim + 1 + k] = 4 * (bary[:, b, None] * dl[a] + bary[:, a, None] * dl[b])
+    x = points[cells][:, :, :dim]  # (m, nodes, dim)
+    J = np.einsum("mai,qaj->mqij", x, grads)
+    return np.linalg.det(J)
+
+
+#: Node permutation that reverses a triangle's orientation (meshio ordering).
+_FLIP = {"triangle": [0, 2, 1], "triangle6": [0, 2, 1, 5, 4, 3]}
+
+
+def _check_orientation(points, body, btype, dim, source) -> np.ndarray:
+    """Reject degenerate and inverted elements; return ``body`` (reoriented if all planar ones are clockwise)."""
+    vol = signed_measures(points, body, dim)
+    what = "volume" if dim == 3 else "area"
+    typical = float(np.mean(np.abs(vol)))
+    degenerate = np.abs(vol) <= DEGENERATE_RTOL * typical
+    if degenerate.any():
+        i = int(np.flatnonzero(degenerate)[0])
+        raise ValueError(
+            f"mesh {source} has {int(degenerate.sum())} degenerate {btype} element(s) "
+            f"(|{what}| <= {DEGENERATE_RTOL:g} x mean {typical:.3g}); first: element {i}, "
+            f"nodes {body[i].tolist()}, {what} {vol[i]:.3g}"
+        )
+    negative = vol < 0
+    if dim == 2 and negative.all():
+        body, negative = body[:, _FLIP[btype]], ~negative  # clockwise file: reorient every triangle
+    if negative.any():
+        i = int(np.flatnonzero(negative)[0])
+        hint = " (all of them: the file may use the opposite node ordering)" if negative.all() else ""
+        raise ValueError(
+            f"mesh {source} has {int(negative.sum())} inverted {btype} element(s) (negative {what}){hint}; "
+            f"first: element {i}, nodes {body[i].tolist()}, {what} {vol[i]:.3g}"
+        )
+    if body.shape[1] > dim + 1:  # curved elements: the Jacobian must stay positive at the corners
+        dets = jacobian_dets(points, body, dim, np.eye(dim + 1))
+        bad = (dets <= 0).any(axis=1)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            shown = ", ".join(f"{d:.3g}" for d in dets[i])
+            raise ValueError(
+                f"mesh {source} has {int(bad.sum())} inverted curved {btype} element(s) (Jacobian <= 0 at a "
+                f"corner node); first: element {i}, nodes {body[i].tolist()}, corner Jacobians [{shown}]"
+            )
+    return body
+
+
+# ----------------------------------------------------------------------------- writing
+
+#: Abaqus element keywords written by :func:`save_mesh` (plane stress in 2-D).
+_ABAQUS_TYPES = {"tetra": "C3D4", "tetra10": "C3D10", "triangle": "CPS3", "triangle6": "CPS6"}
+_ABAQUS_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,79}$")
+
+
+def save_mesh(mesh: Mesh, path: str | os.PathLike) -> None:
+    """Write ``mesh`` with its groups, atomically, in a form :func:`load_mesh` reads back.
+
+    * ``.vtu`` / ``.vtk``: all cells; each group as a ``uint8`` point-data
+      mask ``group:<name>`` (1 = in the group), viewable in ParaView.
+    * ``.inp`` (Abaqus): nodes, the body elements (``C3D4``, ``C3D10``, or
+      plane-stress ``CPS3``, ``CPS6``) and one ``*NSET`` per group (names:
+      a letter then letters, digits, ``_``).
+
+    gmsh ``.msh`` files come from :func:`bladecase.blade_mesh`.
+    """
+    path = os.fspath(path)
+    suffix = os.path.splitext(path)[1].lower()
+    if suffix in (".vtu", ".vtk"):
+        import meshio
+
+        out = meshio.Mesh(
+            mesh.points,
+            [(t, np.asarray(c)) for t, c in mesh.cells.items()],
+            point_data={GROUP_PREFIX + name: _mask(nodes, len(mesh.points)) for name, nodes in mesh.groups.items()},
+        )
+        with atomic_path(path) as tmp:
+            meshio.write(tmp, out, file_format="vtu" if suffix == ".vtu" else "vtk")
+    elif suffix == ".inp":
+        for name in mesh.groups:
+            if not _ABAQUS_NAME.match(name):
+                raise ValueError(
+                    f"group name {name!r} is not a valid Abaqus set name (a letter, then letters, digits, _)"
+                )
+        with atomic_path(path) as tmp:
+            tmp.write_text(_abaqus_text(mesh), encoding="ascii")
+    else:
+        raise ValueError(f"save_mesh cannot write {path!r}: suffix {suffix or '(none)'!r}, valid: .vtu, .vtk, .inp")
+
+
+def _mask(nodes: np.ndarray, n: int) -> np.ndarray:
+    mask = np.zeros(n, dtype=np.uint8)
+    mask[nodes] = 1
+    return mask
+
+
+def _abaqus_text(mesh: Mesh) -> str:
+    btype = mesh.body_type
+    origin = os.path.basename(mesh.source) or "memory"
+    lines = ["*HEADING", f"bladecase mesh from {origin}".encode("ascii", "replace").decode(), "*NODE"]
+    lines += [f"{i + 1}, {x!r}, {y!r}, {z!r}" for i, (x, y, z) in enumerate(mesh.points.tolist())]
+    lines.append(f"*ELEMENT, TYPE={_ABAQUS_TYPES[btype]}")
+    lines += [f"{e + 1}, " + ", ".join(str(v + 1) for v in row) for e, row in enumerate(mesh.cells[btype].tolist())]
+    for name, nodes in mesh.groups.items():
+        lines.append(f"*NSET, NSET={name}")
+        ids = [str(v + 1) for v in np.asarray(nodes).tolist()]
+        lines += [", ".join(ids[i : i + 16]) for i in range(0, len(ids), 16)]
+    return "\n".join(lines) + "\n"
