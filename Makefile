@@ -25,6 +25,8 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_core.py
+	$(BIN)/python benchmarks/bench_kipp.py --skip-b
+	$(BIN)/python benchmarks/bench_fem.py
 
 clean:
 	rm -rf $(VENV) results build *.egg-info
