@@ -20,19 +20,16 @@ also have non-negative impulses and stay behind the obstacle for all ``t``.
 Those admissible arcs, followed by continuation
 (``bladecase.nonsmooth_mode(sys, 2, (3, 14.5), scan=24)``), are drawn in
 red; the one between ① (on the diagonal, T ≈ 13.33) and ② (T → 5T₂ ≈ 13.73)
-is the paper's red curve, the nonsmooth mode of Figs. 3 and 4.  Its
-continuation stops at T ≈ 13.7227; the admissible orbits of that branch
-beyond it (up to T = 13.7290) are found with ``bladecase.orbits_kipp`` and
-drawn dashed (too short to see at this scale: ΔT = 0.006).
+is the paper's red curve, the nonsmooth mode of Figs. 3 and 4
+(``_paper.paper_mode``: its upper end is refined to 5T₂ = 13.72926331).
 
 Run: ``python examples/fig2_impact_time_map.py [--out DIR] [--low]``.
 """
 
 from __future__ import annotations
 
-import argparse
 import pathlib
-import time
+import sys
 
 import matplotlib
 
@@ -43,15 +40,14 @@ import numpy as np  # noqa: E402
 import bladecase  # noqa: E402
 from bladecase.io import save_figure  # noqa: E402
 
+_HERE = str(pathlib.Path(__file__).resolve().parent)
+if _HERE not in sys.path:  # for examples/_paper.py, also when the script is loaded by path (tests)
+    sys.path.insert(0, _HERE)
+import _paper as paper  # noqa: E402
+
 T_RANGE = (1.0, 14.5)  # periods shown in the map
-FAMILY_RANGE = (3.0, 14.5)  # periods where 2-ipp families are followed
 ZOOM_T = (13.22, 13.82)  # right panel: the paper's red arc
 ZOOM_T1 = (5.25, 7.05)
-
-
-def two_dof() -> bladecase.LinearSystem:
-    """The paper's Sec. 1.4 system: k₁ = k₂ = 1, m₁ = m₂ = 1/2, d = 1."""
-    return bladecase.chain(2, k=1.0, m=0.5, gap=1.0)
 
 
 def numerator(system: bladecase.LinearSystem, t1, T) -> np.ndarray:
@@ -85,12 +81,6 @@ def resonant_periods(system: bladecase.LinearSystem, T_range=T_RANGE) -> list[tu
     return sorted(out)
 
 
-def two_ipp_families(system: bladecase.LinearSystem | None = None) -> list[bladecase.Family]:
-    """Every 2-ipp family of the 2-dof system with periods in ``FAMILY_RANGE``."""
-    system = two_dof() if system is None else system
-    return bladecase.nonsmooth_mode(system, 2, FAMILY_RANGE, scan=24)
-
-
 def admissible_arcs(families) -> list[dict]:
     """The admissible stretches of the families, as curves in the (t₁, T) plane.
 
@@ -103,38 +93,6 @@ def admissible_arcs(families) -> list[dict]:
         for arc in fam.arcs:
             sl = slice(arc.start, arc.stop + 1)
             out.append({"family": n, "arc": arc, "T": T[sl], "t1": t1[sl], "T_lo": arc.T_lo, "T_hi": arc.T_hi})
-    return out
-
-
-def paper_arc(arcs: list[dict], system: bladecase.LinearSystem | None = None) -> dict:
-    """The arc of the paper's Figs. 2–4: the one whose upper end is closest to ``5T₂``."""
-    system = two_dof() if system is None else system
-    T2 = 2 * np.pi / system.spectrum.omega[1]
-    return min(arcs, key=lambda a: abs(a["T_hi"] - 5 * T2))
-
-
-def grazing_extension(system: bladecase.LinearSystem, last: bladecase.PeriodicOrbit, T_end: float,
-                      fractions=(0.2, 0.4, 0.6, 0.8, 0.9, 0.96)) -> list[bladecase.PeriodicOrbit]:
-    """Admissible orbits of the same branch beyond ``last``, towards ``T_end`` (excluded).
-
-    Work-around: the continuation of ``nonsmooth_mode`` stops at T ≈ 13.7227,
-    short of the end ② of the branch at the resonant period 5T₂ = 13.7293,
-    although admissible 2-ipp orbits of the branch exist up to 5T₂ (their
-    impulses vanish there).  They are found directly with
-    ``bladecase.orbits_kipp(system, T, 2)`` at periods ``last.T + f·(T_end -
-    last.T)``, keeping the admissible, non-repeated solution whose ``t₁/T`` is
-    closest to the previous orbit's.
-    """
-    out, prev = [], last
-    for f in fractions:
-        T = last.T + f * (T_end - last.T)
-        cands = [o for o in bladecase.orbits_kipp(system, T, 2) if o.admissible and o.repeats == 1]
-        phase = prev.impact_times[0] / prev.T
-        cands = [o for o in cands if abs(o.impact_times[0] / o.T - phase) < 0.01]
-        if not cands:
-            break
-        prev = min(cands, key=lambda o: abs(o.impact_times[0] / o.T - phase))
-        out.append(prev)
     return out
 
 
@@ -151,16 +109,12 @@ def main(out_dir: str = "results/examples", resolution: str = "full") -> list[pa
     low = resolution == "low"
     n_grid, n_zoom = (60, 60) if low else (400, 300)
     out = pathlib.Path(out_dir)
-    system = two_dof()
-    omega = system.spectrum.omega
-    T2 = 2 * np.pi / omega[1]
-    families = two_ipp_families(system)
-    arcs = admissible_arcs(families)
-    main_arc = paper_arc(arcs, system)
-    fam = families[main_arc["family"]]
-    last = max(fam.orbits[main_arc["arc"].start: main_arc["arc"].stop + 1], key=lambda o: o.T)
-    ext = [last] + grazing_extension(system, last, 5 * T2)
-    ext_t1, ext_T = np.array([o.impact_times[0] for o in ext]), np.array([o.T for o in ext])
+    system = paper.two_dof()
+    T5 = paper.five_T2(system)
+    arcs = admissible_arcs(paper.two_ipp_families(system))
+    mode = paper.paper_mode(system)  # the paper's arc from ① to ②, sorted by T
+    mode_t1, mode_T = mode.impact_times[:, 0], mode.T
+    _, main_arc = paper.paper_arc(system)
     for a in arcs:
         print(f"admissible 2-ipp arc (family {a['family']}): T in [{a['T_lo']:.6f}, {a['T_hi']:.6f}]")
 
@@ -170,15 +124,15 @@ def main(out_dir: str = "results/examples", resolution: str = "full") -> list[pa
     for a in (ax, az):
         lo, hi = a.get_xlim()
         for Tr, i, j in resonant_periods(system):
-            if abs(Tr - 5 * T2) > 1e-9:
+            if abs(Tr - T5) > 1e-9:
                 a.axhline(Tr, color="0.55", ls=(0, (3, 3)), lw=0.6, zorder=0)
-        a.axhline(5 * T2, color="tab:blue", ls="--", lw=1.3, zorder=1)
+        a.axhline(T5, color="tab:blue", ls="--", lw=1.3, zorder=1)
         d = np.array(T_RANGE)
         a.plot(d / 2, d, color="tab:orange", lw=1.4, ls="-.", zorder=2)
         for arc in arcs:
-            lw = 3.2 if arc is main_arc else 2.4
-            a.plot(arc["t1"], arc["T"], color="red", lw=lw, solid_capstyle="round", zorder=3)
-        a.plot(ext_t1, ext_T, color="red", lw=1.6, ls=(0, (2, 1.5)), zorder=3)
+            if arc["arc"] is not main_arc:
+                a.plot(arc["t1"], arc["T"], color="red", lw=2.4, solid_capstyle="round", zorder=3)
+        a.plot(mode_t1, mode_T, color="red", lw=3.2, solid_capstyle="round", zorder=3)
         a.set_xlabel(r"first impact time $t_1$")
         a.set_ylabel(r"period $T$ ($t_2 = T$)")
     # left panel: whole map
@@ -186,7 +140,7 @@ def main(out_dir: str = "results/examples", resolution: str = "full") -> list[pa
     ax.set_xlim(0, T_RANGE[1])
     ax.set_ylim(*T_RANGE)
     ax.text(11.6, 7.2, r"$t_1 \geq T$" "\n(excluded)", color="0.45", ha="center", fontsize=9)
-    ax.text(0.25, 5 * T2 + 0.12, r"$T = 5T_2$", color="tab:blue", fontsize=9)
+    ax.text(0.25, T5 + 0.12, r"$T = 5T_2$", color="tab:blue", fontsize=9)
     ax.annotate(r"$t_1 = T/2$: 1-ipp orbit of period $T/2$" "\ncounted twice", xy=(4.25, 8.5), xytext=(5.2, 6.4),
                 fontsize=8.5, color="tab:orange", arrowprops=dict(arrowstyle="->", color="tab:orange", lw=0.8))
     for Tr, i, j in resonant_periods(system):
@@ -202,24 +156,21 @@ def main(out_dir: str = "results/examples", resolution: str = "full") -> list[pa
         Line2D([], [], color="0.15", lw=0.9, label=r"$N = 0$ (paper's Eq. 15, $Q_T(T-2t_1)=0$)"),
         Line2D([], [], color="red", lw=2.4, label="admissible 2-ipp orbits (nonsmooth modes)"),
         Line2D([], [], color="tab:orange", ls="-.", lw=1.4, label=r"$t_1 = T/2$"),
-        Line2D([], [], color="tab:blue", ls="--", lw=1.3, label=rf"$T = 5T_2 = {5 * T2:.4f}$"),
+        Line2D([], [], color="tab:blue", ls="--", lw=1.3, label=rf"$T = 5T_2 = {T5:.4f}$"),
         Line2D([], [], color="0.55", ls=(0, (3, 3)), lw=0.6, label=r"resonant $T = 2\pi j/\omega_i$ (excluded)"),
     ]
     ax.legend(handles=handles, loc="lower right", fontsize=8.5, framealpha=0.95)
     # right panel: zoom on the paper's arc
     az.set_xlim(*ZOOM_T1)
     az.set_ylim(*ZOOM_T)
-    i1 = int(np.argmin(main_arc["T"]))
-    ends = ((main_arc["t1"][i1], main_arc["T"][i1]), (ext_t1[-1], ext_T[-1]))
+    ends = ((mode_t1[0], mode_T[0]), (mode_t1[-1], mode_T[-1]))
     for (t1p, Tp), label, dx, dy in zip(ends, ("①", "②"), (-0.17, -0.09), (0.0, -0.022)):
         az.plot(t1p, Tp, "o", ms=6, mfc="white", mec="red", mew=1.6, zorder=4)
         az.text(t1p + dx, Tp + dy, label, fontsize=15, color="red", ha="center", va="center")
-    az.text(ZOOM_T1[0] + 0.05, 5 * T2 + 0.006, r"$T = 5T_2$", color="tab:blue", fontsize=9)
+    az.text(ZOOM_T1[0] + 0.05, T5 + 0.006, r"$T = 5T_2$", color="tab:blue", fontsize=9)
     az.text(0.03, 0.04,
-            f"① T = {main_arc['T_lo']:.4f}, t₁ = T/2 (1-ipp orbit of period T/2)\n"
-            f"② T → 5T₂ = {5 * T2:.4f} (5th harmonic of linear mode 2)\n"
-            f"(continuation stops at T = {main_arc['T_hi']:.4f}; the branch's admissible\n"
-            f" orbits beyond it, found by orbits_kipp, reach T = {ext_T[-1]:.4f})",
+            f"① T = {mode_T[0]:.4f}, t₁ = T/2 (1-ipp orbit of period T/2)\n"
+            f"② T → 5T₂ = {T5:.4f}, t₁ → 2T₂ (5th harmonic of linear mode 2)",
             transform=az.transAxes, fontsize=8.5, va="bottom", bbox=dict(fc="white", ec="0.7", alpha=0.95))
     az.set_title("zoom: the paper's red arc from ① to ②")
     fig.suptitle("Seed paper Fig. 2 — roots of the 2-ipp condition $s(t_1)=0$, 2-dof chain "
@@ -231,10 +182,4 @@ def main(out_dir: str = "results/examples", resolution: str = "full") -> list[pa
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--out", default="results/examples", help="output directory (default: %(default)s)")
-    parser.add_argument("--low", action="store_true", help="low resolution (fast)")
-    args = parser.parse_args()
-    t0 = time.perf_counter()
-    paths = main(args.out, "low" if args.low else "full")
-    print("wrote", *paths, f"({time.perf_counter() - t0:.1f} s)")
+    paper.run(main, __doc__)

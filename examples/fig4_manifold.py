@@ -5,10 +5,8 @@ m=1/2, gap=1)``).  The nonsmooth mode is the 2-ipp family whose admissible
 arc runs from ① (T ≈ 13.33) to ② (T → 5T₂ ≈ 13.73) — the red curve of Fig. 2
 and the trajectories of Fig. 3.  Its orbits sweep a two-dimensional invariant
 manifold ``(T, t) ↦ (x, v)`` of the four-dimensional state space, sampled with
-``Family.manifold(n_orbits, n_times)`` and projected onto ``(x₁, x₂, ẋ₂)``.
-The continuation stops at T ≈ 13.7227, short of ②; the few admissible orbits
-of the branch beyond it (up to T = 13.7290) are added with
-``bladecase.orbits_kipp`` (see :func:`grazing_extension`).
+``Family.manifold(n_orbits, n_times)`` and projected onto ``(x₁, x₂, ẋ₂)``
+(the orbits of ``_paper.paper_mode``, from ① to the arc's end at 5T₂).
 
 The manifold is smooth along each flight and torn along the impacts: at
 ``x₂ = d`` the contact velocity jumps from ``ẋ₂⁻`` to ``ẋ₂⁺ = -ẋ₂⁻`` (elastic
@@ -23,9 +21,8 @@ Run: ``python examples/fig4_manifold.py [--out DIR] [--low]``.
 
 from __future__ import annotations
 
-import argparse
 import pathlib
-import time
+import sys
 
 import matplotlib
 
@@ -37,56 +34,10 @@ from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection  # noq
 import bladecase  # noqa: E402
 from bladecase.io import save_figure  # noqa: E402
 
-
-def two_dof() -> bladecase.LinearSystem:
-    """The paper's Sec. 1.4 system: k₁ = k₂ = 1, m₁ = m₂ = 1/2, d = 1."""
-    return bladecase.chain(2, k=1.0, m=0.5, gap=1.0)
-
-
-def paper_mode(system: bladecase.LinearSystem | None = None, extend: bool = True) -> bladecase.Family:
-    """The paper's nonsmooth mode, restricted to its admissible arc.
-
-    Among the 2-ipp families of ``nonsmooth_mode(sys, 2, (3, 14.5), scan=24)``,
-    the arc whose upper end is closest to ``5T₂``; returned as a
-    :class:`bladecase.Family` holding only that arc's orbits, sorted by ``T``
-    (so that ``manifold()`` samples that arc alone, not other arcs of the same
-    family), followed when ``extend`` by the :func:`grazing_extension` of the
-    arc towards ``5T₂``.
-    """
-    system = two_dof() if system is None else system
-    T2 = 2 * np.pi / system.spectrum.omega[1]
-    families = bladecase.nonsmooth_mode(system, 2, (3.0, 14.5), scan=24)
-    fam, arc = min(((f, a) for f in families for a in f.arcs), key=lambda fa: abs(fa[1].T_hi - 5 * T2))
-    orbits = sorted(fam.orbits[arc.start: arc.stop + 1], key=lambda o: o.T)
-    if extend:
-        orbits += grazing_extension(system, orbits[-1], 5 * T2)
-    sub_arc = bladecase.Arc(0, len(orbits) - 1, arc.T_lo, orbits[-1].T)
-    return bladecase.Family(system=system, k=fam.k, orbits=orbits, arcs=[sub_arc])
-
-
-def grazing_extension(system: bladecase.LinearSystem, last: bladecase.PeriodicOrbit, T_end: float,
-                      fractions=(0.2, 0.4, 0.6, 0.8, 0.9, 0.96)) -> list[bladecase.PeriodicOrbit]:
-    """Admissible orbits of the same branch beyond ``last``, towards ``T_end`` (excluded).
-
-    Work-around: the continuation of ``nonsmooth_mode`` stops at T ≈ 13.7227,
-    short of the end ② of the branch at the resonant period 5T₂ = 13.7293,
-    although admissible 2-ipp orbits of the branch exist up to 5T₂ (their
-    impulses vanish there).  They are found directly with
-    ``bladecase.orbits_kipp(system, T, 2)`` at periods ``last.T + f·(T_end -
-    last.T)``, keeping the admissible, non-repeated solution whose ``t₁/T`` is
-    closest to the previous orbit's.
-    """
-    out, prev = [], last
-    for f in fractions:
-        T = last.T + f * (T_end - last.T)
-        cands = [o for o in bladecase.orbits_kipp(system, T, 2) if o.admissible and o.repeats == 1]
-        phase = prev.impact_times[0] / prev.T
-        cands = [o for o in cands if abs(o.impact_times[0] / o.T - phase) < 0.01]
-        if not cands:
-            break
-        prev = min(cands, key=lambda o: abs(o.impact_times[0] / o.T - phase))
-        out.append(prev)
-    return out
+_HERE = str(pathlib.Path(__file__).resolve().parent)
+if _HERE not in sys.path:  # for examples/_paper.py, also when the script is loaded by path (tests)
+    sys.path.insert(0, _HERE)
+import _paper as paper  # noqa: E402
 
 
 def evenly_spaced(mode: bladecase.Family, n: int, n_probe: int = 64) -> bladecase.Family:
@@ -169,10 +120,9 @@ def main(out_dir: str = "results/examples", resolution: str = "full") -> list[pa
     low = resolution == "low"
     n_orbits, n_times = (12, 60) if low else (60, 360)
     out = pathlib.Path(out_dir)
-    system = two_dof()
+    system = paper.two_dof()
     d = system.gap
-    T2 = 2 * np.pi / system.spectrum.omega[1]
-    mode = evenly_spaced(paper_mode(system), n_orbits)
+    mode = evenly_spaced(paper.paper_mode(system), n_orbits)
     T, theta, x, v = mode.manifold(len(mode.orbits), n_times)
     by_T = {o.T: o for o in mode.orbits}
     orbits = [by_T[t] for t in T]  # the sampled orbits (manifold() picks computed ones)
@@ -257,7 +207,7 @@ def main(out_dir: str = "results/examples", resolution: str = "full") -> list[pa
                                             label="manifold (colour: period T)")],
               loc="upper left", fontsize=8.5, framealpha=0.9)
     fig.suptitle(f"Seed paper Fig. 4 — the 2-ipp nonsmooth mode ① → ② (T ∈ [{T.min():.4f}, {T.max():.4f}], "
-                 f"5T₂ = {5 * T2:.4f}) as an invariant manifold, 2-dof chain", fontsize=12.5)
+                 f"5T₂ = {paper.five_T2(system):.4f}) as an invariant manifold, 2-dof chain", fontsize=12.5)
     path = out / "fig4_manifold.png"
     save_figure(fig, path, dpi=100 if low else 150)
     plt.close(fig)
@@ -265,10 +215,4 @@ def main(out_dir: str = "results/examples", resolution: str = "full") -> list[pa
 
 
 if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--out", default="results/examples", help="output directory (default: %(default)s)")
-    parser.add_argument("--low", action="store_true", help="low resolution (fast)")
-    args = parser.parse_args()
-    t0 = time.perf_counter()
-    paths = main(args.out, "low" if args.low else "full")
-    print("wrote", *paths, f"({time.perf_counter() - t0:.1f} s)")
+    paper.run(main, __doc__)

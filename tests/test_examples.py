@@ -3,18 +3,21 @@
 Every example's ``main(out_dir, resolution="low")`` must write valid, non-trivial
 PNGs, and the numbers behind the figures must be right:
 
-* Fig. 2 — the pole-free numerator is ``s(t₁)·Π sin(ω_j T/2)``; one admissible
-  2-ipp arc starts on the diagonal ``t₁ = T/2`` at T ≈ 13.33 (①) and ends within
-  1 % of ``5T₂ = 13.7293`` (②), as in the paper;
-* Fig. 3 — the trajectories stay behind the obstacle and touch it at the impacts;
-  the branch, completed beyond the end of the continuation with ``orbits_kipp``,
-  reaches ② (T → 5T₂, impulses → 0, t₁ → 2T₂);
-* Fig. 4 — the manifold samples the arc, the jumps are elastic at ``x₂ = d``;
+* the paper's mode (``examples/_paper.py``, shared by the scripts) — one
+  admissible 2-ipp arc starts on the diagonal ``t₁ = T/2`` at T ≈ 13.33 (①) and
+  ends at ``5T₂ = 13.72926332`` (②, to 1e-6 relative), where the impulses
+  vanish and ``t₁ → 2T₂``, as in the paper;
+* Fig. 2 — the pole-free numerator is ``s(t₁)·Π sin(ω_j T/2)``; the arc lies on
+  its zero set;
+* Fig. 3 — the trajectories stay behind the obstacle and touch it at the impacts,
+  from ① to ②;
+* Fig. 4 — the manifold samples the arc up to ②, the jumps are elastic at ``x₂ = d``;
 * frequency–energy — ① has the energy of the 1-ipp orbit of period ``T/2``;
-  towards ② the energy tends to that of linear mode 2 grazing the obstacle.
+  at ② the energy is that of linear mode 2 grazing the obstacle.
 
-``bladecase.nonsmooth_mode`` is memoised for the module (every example follows
-the same families; the function is deterministic), which keeps the file fast.
+``_paper`` computes the 2-ipp families once per system instance and
+``_paper.two_dof()`` is one shared instance, so the examples (and these tests)
+follow the families once, which keeps the file fast.
 """
 
 from __future__ import annotations
@@ -37,7 +40,7 @@ from bladecase.nsm import _Modal
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 NAMES = ["fig2_impact_time_map", "fig3_trajectories", "fig4_manifold", "frequency_energy"]
-FIVE_T2 = 5 * 2.745852661  # 5 · 2π/ω₂ for chain(2, k=1, m=1/2)
+FIVE_T2 = 10 * np.pi / np.sqrt(3 + np.sqrt(5))  # 5 · 2π/ω₂ for chain(2, k=1, m=1/2): ω₂² = 3 + √5
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
 
@@ -48,40 +51,26 @@ def _load(name: str):
     return mod
 
 
-@pytest.fixture(scope="module", autouse=True)
-def memo_nonsmooth_mode():
-    cache = {}
-    original = bc.nonsmooth_mode
-
-    def cached(system, k, T_range, **kw):
-        key = (id(system), system.n, system.gap, k, tuple(T_range), tuple(sorted(kw.items())))
-        if key not in cache:
-            cache[key] = original(system, k, T_range, **kw)
-        return cache[key]
-
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(bc, "nonsmooth_mode", cached)
-        yield
-
-
 @pytest.fixture(scope="module")
 def ex():
     return {name: _load(name) for name in NAMES}
 
 
 @pytest.fixture(scope="module")
-def sys2():
-    # one shared instance, so that the memoised families are reused across examples
-    s = bc.chain(2, k=1.0, m=0.5, gap=1.0)
+def paper(ex):
+    # the module the scripts import (they put examples/ on sys.path): one cache for all
+    mod = ex[NAMES[0]].paper
+    assert all(m.paper is mod for m in ex.values())
+    return mod
+
+
+@pytest.fixture(scope="module")
+def sys2(paper):
+    # the scripts' own shared instance, so that the cached families are reused
+    s = paper.two_dof()
+    assert s is paper.two_dof()
+    assert (s.n, s.gap) == (2, 1.0) and np.allclose(s.spectrum.omega ** 2, [3 - np.sqrt(5), 3 + np.sqrt(5)])
     return s
-
-
-@pytest.fixture(scope="module", autouse=True)
-def shared_system(ex, sys2):
-    with pytest.MonkeyPatch.context() as mp:
-        for mod in ex.values():
-            mp.setattr(mod, "two_dof", lambda: sys2)
-        yield
 
 
 def _check_png(path: Path, min_bytes: int = 15_000):
@@ -113,6 +102,27 @@ def test_example_cli_help(name):
     assert "--out" in r.stdout and "--low" in r.stdout
 
 
+# --- the paper's mode (examples/_paper.py) ----------------------------------
+
+
+def test_paper_mode_from_1_to_2(paper, sys2):
+    assert paper.five_T2(sys2) == pytest.approx(FIVE_T2, rel=1e-14)
+    assert paper.two_ipp_families(sys2) == paper.two_ipp_families()  # cached, same families
+    family, arc = paper.paper_arc(sys2)
+    assert arc.T_hi == pytest.approx(FIVE_T2, rel=1e-6) and arc.refined_hi
+    mode = paper.paper_mode(sys2)
+    assert len(mode.arcs) == 1 and mode.arcs[0].T_lo == arc.T_lo and mode.arcs[0].T_hi == arc.T_hi
+    assert mode.k == 2 and mode.admissible.all() and np.all(np.diff(mode.T) > 0)
+    assert len(mode.orbits) == arc.stop - arc.start + 2  # the arc's points, then ② at T_hi
+    one, two = mode.orbits[0], mode.orbits[-1]
+    # ①: on the diagonal t1 = T/2, T ≈ 13.33
+    assert one.T == pytest.approx(13.3286, abs=1e-4) and one.impact_times[0] == pytest.approx(one.T / 2, rel=1e-3)
+    # ②: T -> 5 T2 (resonant, excluded), impulses -> 0, t1 -> 2 T2
+    assert two.T == arc.T_hi and two.T <= FIVE_T2
+    assert two.impulses.max() < 0.01 and np.all(two.impulses >= 0)
+    assert two.impact_times[0] == pytest.approx(2 * FIVE_T2 / 5, rel=1e-6)
+
+
 # --- Fig. 2 -----------------------------------------------------------------
 
 
@@ -133,15 +143,16 @@ def test_fig2_numerator_is_pole_free_s(ex, sys2):
     assert any(abs(r - FIVE_T2) < 1e-6 for r in res) and any(abs(r - 7.1887356) < 1e-6 for r in res)
 
 
-def test_fig2_paper_arc(ex, sys2):
+def test_fig2_paper_arc(ex, paper, sys2):
     f2 = ex["fig2_impact_time_map"]
-    arcs = f2.admissible_arcs(f2.two_ipp_families(sys2))
+    arcs = f2.admissible_arcs(paper.two_ipp_families(sys2))
     assert len(arcs) >= 1
     ends = np.array([a["T_hi"] for a in arcs])
-    assert np.min(np.abs(ends - FIVE_T2)) <= 0.01 * FIVE_T2
-    arc = f2.paper_arc(arcs, sys2)
-    assert arc["T_hi"] == pytest.approx(FIVE_T2, rel=0.01)
-    assert arc["T_hi"] <= FIVE_T2 * (1 + 1e-9)  # T = 5 T2 itself is resonant (excluded); the end converges to it
+    assert np.min(np.abs(ends - FIVE_T2)) <= 1e-6 * FIVE_T2
+    _, main = paper.paper_arc(sys2)
+    (arc,) = [a for a in arcs if a["arc"] is main]
+    assert arc["T_hi"] == pytest.approx(FIVE_T2, rel=1e-6)
+    assert arc["T_hi"] <= FIVE_T2 * (1 + 1e-12)  # T = 5 T2 itself is resonant (excluded); the end converges to it
     # ① on the diagonal at T ≈ 13.33 (the paper's red curve starts there)
     i = int(np.argmin(arc["T"]))
     assert arc["T"][i] == pytest.approx(13.33, abs=0.01)
@@ -154,19 +165,17 @@ def test_fig2_paper_arc(ex, sys2):
 # --- Fig. 3 -----------------------------------------------------------------
 
 
-def test_fig3_trajectories_admissible(ex, sys2):
+def test_fig3_trajectories_admissible(ex, paper, sys2):
     f3 = ex["fig3_trajectories"]
-    fam, arc = f3.paper_family(sys2)
-    assert arc.T_hi == pytest.approx(FIVE_T2, rel=0.01)
-    every = f3.mode_orbits(fam, arc, sys2)
-    # the arc (continuation, plus per-T solves closer to 5 T2) reaches ② (impulses -> 0)
-    ext = [max(every, key=lambda o: o.T)]
-    assert ext[-1].T == pytest.approx(FIVE_T2, rel=1e-4) and ext[-1].impulses.max() < 0.01
-    assert ext[-1].impact_times[0] == pytest.approx(2 * FIVE_T2 / 5, rel=1e-3)  # t1 -> 2 T2
-    orbits = f3.arc_orbits(every, 6)
+    mode = paper.paper_mode(sys2)
+    arc = mode.arcs[0]
+    orbits = f3.arc_orbits(mode.orbits, 6)
     assert len(orbits) == 6
     Ts = [o.T for o in orbits]
-    assert Ts == sorted(Ts) and Ts[0] == pytest.approx(arc.T_lo) and Ts[-1] == ext[-1].T
+    assert Ts == sorted(Ts) and Ts[0] == pytest.approx(arc.T_lo) and Ts[-1] == arc.T_hi
+    # the last one is ②: T -> 5 T2, impulses -> 0, t1 -> 2 T2
+    assert Ts[-1] == pytest.approx(FIVE_T2, rel=1e-6) and orbits[-1].impulses.max() < 0.01
+    assert orbits[-1].impact_times[0] == pytest.approx(2 * FIVE_T2 / 5, rel=1e-6)
     d = sys2.gap
     for o in orbits:
         assert o.admissible and o.k == 2 and np.all(o.impulses >= 0)
@@ -182,16 +191,16 @@ def test_fig3_trajectories_admissible(ex, sys2):
 # --- Fig. 4 -----------------------------------------------------------------
 
 
-def test_fig4_manifold_and_jumps(ex, sys2):
+def test_fig4_manifold_and_jumps(ex, paper, sys2):
     f4 = ex["fig4_manifold"]
-    mode = f4.paper_mode(sys2)
+    mode = paper.paper_mode(sys2)
     assert len(mode.arcs) == 1 and mode.admissible.all()
     sub = f4.evenly_spaced(mode, 15)
     assert 6 <= len(sub.orbits) <= 15
     T, theta, x, v = sub.manifold(len(sub.orbits), 40)
     assert x.shape == v.shape == (2, len(sub.orbits), 40)
     assert T.min() == pytest.approx(mode.arcs[0].T_lo) and T.max() == pytest.approx(mode.arcs[0].T_hi)
-    assert np.all(np.diff(T) > 0) and T.max() == pytest.approx(FIVE_T2, rel=1e-4)
+    assert np.all(np.diff(T) > 0) and T.max() == pytest.approx(FIVE_T2, rel=1e-6)
     assert x[1].max() <= sys2.gap + 1e-9
     for o in sub.orbits:
         jumps = f4.impact_jumps(o)  # (k, 2, 3): pre/post (x1, x2, x2dot)
@@ -209,21 +218,20 @@ def test_fig4_manifold_and_jumps(ex, sys2):
 # --- frequency–energy --------------------------------------------------------
 
 
-def test_frequency_energy_numbers(ex, sys2):
+def test_frequency_energy_numbers(ex, paper, sys2):
     fe = ex["frequency_energy"]
     bb, families = fe.compute(sys2, 200)
+    assert families == paper.two_ipp_families(sys2)
     ends = [iv.T_hi for iv in bb.intervals]
     assert any(abs(e - FIVE_T2) < 1e-6 for e in ends)  # 1-ipp interval ending at 5 T2 (resonance)
-    fam, arc = min(((f, a) for f in families for a in f.arcs), key=lambda fa: abs(fa[1].T_hi - FIVE_T2))
-    o1 = fam.orbits[arc.start]
+    mode = paper.paper_mode(sys2)
+    o1, o2 = mode.orbits[0], mode.orbits[-1]
     # ①: the 2-ipp orbit is the 1-ipp orbit of period T/2 counted twice — same energy
     assert o1.energy == pytest.approx(bc.orbit_1ipp(sys2, o1.T / 2).energy, rel=1e-6)
     assert o1.energy == pytest.approx(0.2886, abs=1e-3)
-    assert np.all(np.diff(fam.energy[arc.start: arc.stop + 1]) > -1e-9)  # energy grows from ① to ②
-    # ②: towards the energy of linear mode 2 grazing the obstacle, ½(ω₂ d/|b₂|)²
-    last = fam.orbits[arc.stop]
-    ext = fe.grazing_extension(sys2, last, FIVE_T2)
+    assert np.all(np.diff(mode.energy) > -1e-9)  # energy grows from ① to ②
+    # ②: the energy of linear mode 2 grazing the obstacle, ½(ω₂ d/|b₂|)²
     omega, b, _ = sys2.spectrum.contact_modes
     E_graze = 0.5 * (omega[1] * sys2.gap / abs(b[1])) ** 2
     assert E_graze == pytest.approx(4.736, abs=1e-3)
-    assert last.energy < ext[-1].energy < E_graze and ext[-1].energy == pytest.approx(E_graze, rel=0.02)
+    assert mode.orbits[-2].energy < o2.energy <= E_graze and o2.energy == pytest.approx(E_graze, rel=1e-5)
