@@ -28,3 +28,17 @@ __all__ = [
     "natural_frequencies", "nonsmooth_mode", "orbit_1ipp", "orbits_kipp", "save_mesh", "simulate",
 ]
 __version__ = "0.1.0"
+
+# Reduction layer: the contact of an FE model and the Lanczos chain (theory §2).
+from .contact import Contact, radial_normal
+from .lanczos import LanczosChain, MassFactor, PerDofDefect, SymmetryBasis, lanczos_chain, mass_factor, per_dof_defect
+
+__all__ += [
+    "Contact", "LanczosChain", "MassFactor", "PerDofDefect", "SymmetryBasis",
+    "lanczos_chain", "mass_factor", "per_dof_defect", "radial_normal",
+]
+
+# Reduction layer: the front door, FE model + contact -> the reduced system the solver consumes.
+from .reduction import FULL_LIMIT, ReducedModel, reduce
+
+__all__ += ["FULL_LIMIT", "ReducedModel", "reduce"]

@@ -1,0 +1,255 @@
+"""The blade–casing contact of a finite-element model: one node, a normal, a gap.
+
+A :class:`Contact` says which mesh node touches the casing, along which unit
+normal ``ν`` and after which clearance ``d``.  On an :class:`~bladecase.fem.FEModel`
+it becomes the constraint vector ``w`` of theory §1 (``wᵀx = ν·u_node``, the
+normal components on that node's free dofs, zero elsewhere) and the
+:class:`~bladecase.model.LinearSystem` the solver and the reduction layer consume.
+
+Picking the node:
+
+* by id: ``Contact(node, normal, gap)`` or :meth:`Contact.at` (checked against a model);
+* the free node nearest a point: :meth:`Contact.nearest`;
+* the node of a group (``"tip"`` by default) farthest along a direction, e.g.
+  the leading-edge tip corner: :meth:`Contact.farthest`.
+
+Default normal (``normal=None``): the casing's radial direction.  The blades of
+:mod:`bladecase.geometry` are radial along the LAST axis — 3-D blades along
+``+z``, 2-D plates along ``+y`` — so the default normal is ``(0, 0, 1)`` in 3-D
+and ``(0, 1)`` in 2-D (:func:`radial_normal`).  Give the normal explicitly for a
+mesh oriented otherwise.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+
+from .fem import FEModel
+from .model import LinearSystem
+
+
+def radial_normal(dim: int) -> np.ndarray:
+    """The default contact normal: the unit vector of the last axis (``+z`` in 3-D, ``+y`` in 2-D)."""
+    if isinstance(dim, bool) or dim not in (2, 3):
+        raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+    e = np.zeros(dim)
+    e[-1] = 1.0
+    return e
+
+
+def _unit(name: str, value, sizes: Sequence[int] = (2, 3)) -> tuple[float, ...]:
+    """``value`` normalised to unit length, as a tuple; ``ValueError`` if not a finite non-zero 2- or 3-vector."""
+    try:
+        v = np.array(value, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a vector of {' or '.join(map(str, sizes))} numbers, got {value!r}") from None
+    if v.size not in sizes:
+        raise ValueError(f"{name} must have {' or '.join(map(str, sizes))} components, got {v.size} ({value!r})")
+    if not np.all(np.isfinite(v)):
+        raise ValueError(f"{name} must be finite, got {value!r}")
+    norm = float(np.linalg.norm(v))
+    if norm == 0.0:
+        raise ValueError(f"{name} must be a non-zero vector, got {value!r}")
+    return tuple(float(c) for c in v / norm)
+
+
+def _gap(gap) -> float:
+    if gap is None:
+        raise ValueError("gap is required: the clearance d > 0 between the contact node at rest and the casing")
+    try:
+        d = float(gap)
+    except (TypeError, ValueError):
+        raise ValueError(f"gap must be a number > 0 (the clearance), got {gap!r}") from None
+    if isinstance(gap, bool) or not math.isfinite(d) or d <= 0:
+        raise ValueError(f"gap must be a finite clearance > 0, got {gap!r}")
+    return d
+
+
+def _in_dim(name: str, vec: Sequence[float], dim: int) -> np.ndarray:
+    """A 2- or 3-vector as a ``dim``-vector (a 3-vector with zero ``z`` is accepted in 2-D)."""
+    v = np.asarray(vec, dtype=float)
+    if v.size == dim:
+        return v
+    if dim == 2 and v.size == 3 and v[2] == 0.0:
+        return v[:2]
+    what = "(x, y) or (x, y, 0)" if dim == 2 else "(x, y, z)"
+    raise ValueError(f"{name} {tuple(vec)!r} does not fit a {dim}-D model: give {what}")
+
+
+def _check_model(model) -> FEModel:
+    if not isinstance(model, FEModel):
+        raise ValueError(f"model must be an FEModel (from bladecase.assemble), got {type(model).__name__}")
+    return model
+
+
+def free_nodes(model: FEModel) -> np.ndarray:
+    """Sorted mesh nodes that carry free dofs (vertices of the body cells that are not clamped)."""
+    nodes = _check_model(model).dofs.node
+    return np.unique(nodes[nodes >= 0])
+
+
+@dataclass(frozen=True)
+class Contact:
+    """A unilateral contact ``ν·u_node <= gap`` on one mesh node.
+
+    Parameters
+    ----------
+    node : int
+        Mesh node index (into ``mesh.points``); it must carry free dofs of the
+        model it is used with (a vertex of the body cells, not clamped).
+    normal : sequence of 2 or 3 floats, or None
+        Casing normal, pointing from the blade towards the casing; stored
+        normalised.  ``None``: the radial direction of the model it is used
+        with, the last axis (:func:`radial_normal`).  A 3-vector with zero
+        ``z`` is accepted for a 2-D model.
+    gap : float
+        Clearance ``d > 0`` between the node at rest and the casing.
+
+    Raises
+    ------
+    ValueError
+        ``node`` not an integer >= 0, ``normal`` zero, non-finite or of the
+        wrong size, ``gap <= 0``.  Whether the node is free is checked when a
+        model is given (:meth:`w`, :meth:`at`, :meth:`nearest`, :meth:`farthest`).
+    """
+
+    node: int
+    normal: tuple[float, ...] | None
+    gap: float
+
+    def __post_init__(self) -> None:
+        node = self.node
+        if isinstance(node, (bool, np.bool_)) or not isinstance(node, (int, np.integer)) or node < 0:
+            raise ValueError(f"node must be a mesh node index (integer >= 0), got {node!r}")
+        object.__setattr__(self, "node", int(node))
+        if self.normal is not None:
+            object.__setattr__(self, "normal", _unit("normal", self.normal))
+        object.__setattr__(self, "gap", _gap(self.gap))
+
+    # ------------------------------------------------------------------ helpers to pick the node
+
+    @classmethod
+    def at(
+        cls, model: FEModel, node: int, normal: Sequence[float] | None = None, gap: float | None = None
+    ) -> "Contact":
+        """The contact on mesh node ``node`` of ``model`` (checked), normal defaulted to the radial direction."""
+        contact = cls(node, normal, gap)
+        return contact._resolved(model)
+
+    @classmethod
+    def nearest(
+        cls, model: FEModel, point: Sequence[float], normal: Sequence[float] | None = None, gap: float | None = None
+    ) -> "Contact":
+        """The contact on the free node of ``model`` nearest ``point`` (lowest index on a tie).
+
+        ``point`` has ``model.dim`` coordinates (``(x, y, 0)`` is accepted in 2-D).
+        """
+        _check_model(model)
+        dim = model.dim
+        p = _in_dim("point", _finite_vector("point", point), dim)
+        nodes = free_nodes(model)
+        dist = np.linalg.norm(model.mesh.points[nodes, :dim] - p, axis=1)
+        return cls.at(model, int(nodes[np.argmin(dist)]), normal, gap)
+
+    @classmethod
+    def farthest(
+        cls,
+        model: FEModel,
+        direction: Sequence[float],
+        normal: Sequence[float] | None = None,
+        gap: float | None = None,
+        group: str | None = "tip",
+    ) -> "Contact":
+        """The contact on the free node of ``group`` farthest along ``direction``.
+
+        E.g. ``Contact.farthest(model, (-1, 0, 0), gap=1e-4)`` picks the tip
+        node of smallest ``x`` (the leading-edge tip corner of a blade whose
+        leading edge points to ``-x``).  ``group=None`` searches every free
+        node.  Ties go to the lowest node index.
+        """
+        _check_model(model)
+        dim = model.dim
+        u = _in_dim("direction", _unit("direction", direction), dim)
+        nodes = free_nodes(model)
+        if group is not None:
+            members = model.mesh.group(group)
+            nodes = nodes[np.isin(nodes, members)]
+            if nodes.size == 0:
+                raise ValueError(
+                    f"group {group!r} has no free node (all {len(members)} of its nodes are clamped or off the body)"
+                )
+        reach = model.mesh.points[nodes, :dim] @ u
+        return cls.at(model, int(nodes[np.argmax(reach)]), normal, gap)
+
+    # ------------------------------------------------------------------ on a model
+
+    def normal_for(self, model: FEModel) -> np.ndarray:
+        """The unit normal as a ``model.dim``-vector (the radial default if ``normal`` is ``None``)."""
+        dim = _check_model(model).dim
+        if self.normal is None:
+            return radial_normal(dim)
+        return _in_dim("normal", self.normal, dim)
+
+    def dofs(self, model: FEModel) -> np.ndarray:
+        """Free dofs of the contact node (one per direction, in direction order).
+
+        Raises
+        ------
+        ValueError
+            The node is not a mesh node, is clamped, or is not a vertex of the body cells.
+        """
+        _check_model(model)
+        n_nodes = model.mesh.points.shape[0]
+        if self.node >= n_nodes:
+            raise ValueError(f"contact node {self.node} is not a mesh node (mesh nodes 0..{n_nodes - 1})")
+        idx = np.flatnonzero(model.dofs.node == self.node)
+        if idx.size == 0:
+            if np.isin(self.node, model.clamped):
+                raise ValueError(f"contact node {self.node} is clamped: pick a free node (e.g. a tip node)")
+            raise ValueError(f"contact node {self.node} is not a vertex of the body cells: it has no dof")
+        return idx[np.argsort(model.dofs.direction[idx])]
+
+    def w(self, model: FEModel) -> np.ndarray:
+        """Constraint vector ``w`` on the free dofs of ``model``: ``wᵀx = ν·u_node``.
+
+        Returns
+        -------
+        (model.n_dofs,) ndarray
+            The normal's components on the contact node's dofs, zero elsewhere.
+        """
+        idx = self.dofs(model)
+        nu = self.normal_for(model)
+        w = np.zeros(model.n_dofs)
+        w[idx] = nu[model.dofs.direction[idx]]
+        if not np.any(w):  # a free node always has all its directions free; guard anyway
+            raise ValueError(f"the normal {tuple(nu)} has no component on the free dofs of node {self.node}")
+        return w
+
+    def system(self, model: FEModel) -> LinearSystem:
+        """The FULL model with this contact: ``LinearSystem(model.M, model.K, w, gap)``.
+
+        Sparse matrices are kept (the constructor checks positive definiteness
+        with a sparse LDLᵀ).  Its :attr:`~bladecase.model.LinearSystem.spectrum`
+        is dense and limited to :data:`bladecase.model.DENSE_LIMIT` dofs; reduce
+        larger models first (:func:`bladecase.lanczos_chain`).
+        """
+        return LinearSystem(model.M, model.K, self.w(model), self.gap)
+
+    def _resolved(self, model: FEModel) -> "Contact":
+        """This contact with its normal made explicit for ``model``, after checking the node."""
+        self.dofs(model)
+        return Contact(self.node, tuple(self.normal_for(model)), self.gap)
+
+
+def _finite_vector(name: str, value) -> np.ndarray:
+    try:
+        v = np.array(value, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a vector of 2 or 3 numbers, got {value!r}") from None
+    if v.size not in (2, 3) or not np.all(np.isfinite(v)):
+        raise ValueError(f"{name} must be 2 or 3 finite numbers, got {value!r}")
+    return v
