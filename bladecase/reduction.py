@@ -268,7 +268,9 @@ def reduce(model: FEModel, contact: Contact, method: str, size: int | None = Non
         valid = ", ".join(repr(m) for m in METHODS)
         raise ValueError(f"unknown reduction method {method!r} (valid: {valid})")
     if not isinstance(contact, Contact):
-        raise ValueError(f"contact must be a bladecase.contact.Contact (node, normal, gap), got {type(contact).__name__}")
+        raise ValueError(
+            f"contact must be a bladecase.contact.Contact (node, normal, gap), got {type(contact).__name__}"
+        )
     n = model.n_dofs
     if method == "full":
         if size is not None and size != n:
