@@ -57,8 +57,8 @@ class Arc:
     refined_hi: bool = True
 
     def to_dict(self) -> dict:
-        return {"start": self.start, "stop": self.stop, "T_lo": self.T_lo, "T_hi": self.T_hi,
-                "refined_lo": self.refined_lo, "refined_hi": self.refined_hi}
+        return {"start": int(self.start), "stop": int(self.stop), "T_lo": float(self.T_lo),
+                "T_hi": float(self.T_hi), "refined_lo": bool(self.refined_lo), "refined_hi": bool(self.refined_hi)}
 
 
 @dataclass(frozen=True, eq=False)
@@ -488,8 +488,8 @@ def _arcs(curve: _Curve, zs, orbits, refine: bool) -> list[Arc]:
             T_b, ref_b = _bisect_curve(curve, zs[j], zs[j + 1])
         Ts = [o.T for o in orbits[i:j + 1]] + [T_a, T_b]
         lo, hi = min(Ts), max(Ts)
-        arcs.append(Arc(i, j, lo, hi, refined_lo=(lo == T_a and ref_a) or (lo == T_b and ref_b),
-                        refined_hi=(hi == T_a and ref_a) or (hi == T_b and ref_b)))
+        arcs.append(Arc(i, j, float(lo), float(hi), refined_lo=bool((lo == T_a and ref_a) or (lo == T_b and ref_b)),
+                        refined_hi=bool((hi == T_a and ref_a) or (hi == T_b and ref_b))))
         i = j + 1
     return arcs
 

@@ -123,3 +123,21 @@ def test_no_command_prints_help(capsys):
 
 def test_main_returns_exit_code_on_parse_errors(capsys):
     assert main(["backbone", "--chain", "2", "--gap", "1", "--periods", "1:12"]) == 2
+
+
+def test_backbone_ipp2_writes_json_plot_table(tmp_path, capsys):
+    """--ipp 2: a table per family, JSON with the families and their arcs, a plot."""
+    import json
+
+    out = tmp_path / "m.json"
+    png = tmp_path / "m.png"
+    txt = tmp_path / "m.txt"
+    rc = main(["backbone", "--chain", "2", "--k", "1", "--m", "0.5", "--gap", "1", "--periods", "12:14.5:6",
+               "--ipp", "2", "--json", str(out), "--plot", str(png), "--table", str(txt), "--no-progress"])
+    assert rc == 0
+    data = json.loads(out.read_text())
+    assert data["ipp"] == 2 and data["families"]
+    arcs = [a for f in data["families"] for a in f["arcs"]]
+    assert any(abs(a["T_hi"] - 5 * 2 * np.pi / 2.2882456112707374) < 1e-6 for a in arcs)  # the paper's point 2
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "2-ipp family" in txt.read_text() and "admissible arc" in capsys.readouterr().out
