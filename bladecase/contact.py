@@ -22,13 +22,12 @@ mesh oriented otherwise.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Sequence
 
 import numpy as np
 
-from .fem import FEModel
+from .fem import FEModel, _positive
 from .model import LinearSystem
 
 
@@ -60,13 +59,7 @@ def _unit(name: str, value, sizes: Sequence[int] = (2, 3)) -> tuple[float, ...]:
 def _gap(gap) -> float:
     if gap is None:
         raise ValueError("gap is required: the clearance d > 0 between the contact node at rest and the casing")
-    try:
-        d = float(gap)
-    except (TypeError, ValueError):
-        raise ValueError(f"gap must be a number > 0 (the clearance), got {gap!r}") from None
-    if isinstance(gap, bool) or not math.isfinite(d) or d <= 0:
-        raise ValueError(f"gap must be a finite clearance > 0, got {gap!r}")
-    return d
+    return _positive("gap", gap, noun="clearance")
 
 
 def _in_dim(name: str, vec: Sequence[float], dim: int) -> np.ndarray:

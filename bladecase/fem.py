@@ -64,14 +64,15 @@ _ELEMENTS = {
 _DIRECTIONS = {"x": 0, "y": 1, "z": 2}
 
 
-def _positive(name: str, value, what: str = "> 0") -> float:
-    """``float(value)`` if it is a finite number > 0, else ``ValueError``."""
+def _positive(name: str, value, what: str = "> 0", noun: str = "number") -> float:
+    """``float(value)`` if it is a finite number > 0, else ``ValueError``
+    ("``name`` must be a [finite] ``noun`` ``what``, got …")."""
     try:
         x = float(value)
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be a number {what}, got {value!r}") from None
     if isinstance(value, bool) or not math.isfinite(x) or x <= 0:
-        raise ValueError(f"{name} must be a finite number {what}, got {value!r}")
+        raise ValueError(f"{name} must be a finite {noun} {what}, got {value!r}")
     return x
 
 
