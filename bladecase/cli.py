@@ -101,7 +101,239 @@ def build_parser() -> argparse.ArgumentParser:
     bb.add_argument("--quiet", action="store_true", help="print only the admissible intervals")
     bb.add_argument("--no-progress", action="store_true", help="no progress bar")
     bb.set_defaults(func=_cmd_backbone)
+    _study_commands(sub)
     return parser
+
+
+# ----------------------------------------------------------------------------- study commands
+
+def _progress_options(p) -> None:
+    p.add_argument("--quiet", action="store_true", help="log only warnings and errors")
+    p.add_argument("--no-progress", action="store_true", help="no progress bars")
+
+
+def _study_commands(sub) -> None:
+    run = sub.add_parser(
+        "run", help="run a study file end to end: mesh, FE model, reduction, nonsmooth modes, animations, VTK",
+        description="Run the whole chain of a TOML study file (see docs/study.md) and write summary.json, "
+                    "report.md, modes.json, the frequency–energy plot, GIF/MP4 animations and VTK time series "
+                    "into the output directory.  Results are staged and moved into place only on success.")
+    run.add_argument("study", type=Path, metavar="STUDY.toml")
+    run.add_argument("--out", type=Path, metavar="DIR", help="output directory (overrides [output] directory)")
+    _progress_options(run)
+    run.set_defaults(func=_cmd_run)
+
+    demo = sub.add_parser(
+        "demo", help="run the embedded demo study (a twisted, leaned 3-D Ti-6Al-4V blade, about a minute)",
+        description="Run the embedded demo study: a twisted, leaned NACA 2412 blade of a few thousand dofs, "
+                    "Ti-6Al-4V, lumped mass, tip contact with a 0.1 mm clearance; 1- and 2-ipp nonsmooth modes "
+                    "below the first linear period, animated.  --print-study shows its TOML as a template.")
+    demo.add_argument("--out", type=Path, metavar="DIR", help="output directory (default results/demo)")
+    demo.add_argument("--print-study", action="store_true", help="print the demo study file and exit")
+    _progress_options(demo)
+    demo.set_defaults(func=_cmd_demo)
+
+    mesh = sub.add_parser("mesh", help="stage 1: mesh the study's blade (gmsh) or convert its mesh file",
+                          description="Write the study's mesh: gmsh on [geometry], or the [mesh] file converted. "
+                                      "The format follows OUT's suffix (.msh for gmsh meshes, .vtu, .vtk, .inp).")
+    mesh.add_argument("study", type=Path, metavar="STUDY.toml")
+    mesh.add_argument("-o", "--output", type=Path, required=True, metavar="OUT")
+    _progress_options(mesh)
+    mesh.set_defaults(func=_cmd_mesh)
+
+    asm = sub.add_parser("assemble", help="stage 2: FE matrices (scikit-fem) of the study's or a given mesh",
+                         description="Assemble K and M ([material], [fem]) on the study's mesh or on --mesh FILE "
+                                     "(any meshio format with the clamp group), print the first frequencies and "
+                                     "write an .npz FE model file.")
+    asm.add_argument("study", type=Path, metavar="STUDY.toml")
+    asm.add_argument("--mesh", type=Path, metavar="FILE", help="use this mesh instead of the study's")
+    asm.add_argument("-o", "--output", type=Path, required=True, metavar="MODEL.npz")
+    _progress_options(asm)
+    asm.set_defaults(func=_cmd_assemble)
+
+    red = sub.add_parser("reduce", help="stage 3: contact + reduced model of an FE model file",
+                         description="Apply [contact] and [reduction] to an FE model file (from 'bladecase "
+                                     "assemble') and write the reduced model (.npz).")
+    red.add_argument("study", type=Path, metavar="STUDY.toml")
+    red.add_argument("--model", type=Path, required=True, metavar="MODEL.npz")
+    red.add_argument("--method", help="override [reduction] method")
+    red.add_argument("--size", type=_positive_int, help="override [reduction] size")
+    red.add_argument("-o", "--output", type=Path, required=True, metavar="REDUCED.npz")
+    _progress_options(red)
+    red.set_defaults(func=_cmd_reduce)
+
+    modes = sub.add_parser("modes", help="stage 4: nonsmooth modes ([search]) of a reduced model or matrices",
+                           description="Find and follow the families of [search] ipp over its period range, on a "
+                                       "reduced model file or on user matrices (.npz with M, K, w, gap); write "
+                                       "the families as JSON and optionally the frequency–energy plot.")
+    modes.add_argument("study", type=Path, metavar="STUDY.toml")
+    src = modes.add_mutually_exclusive_group(required=True)
+    src.add_argument("--reduced", type=Path, metavar="REDUCED.npz")
+    src.add_argument("--matrices", type=Path, metavar="FILE.npz",
+                     help="user system: arrays M, K (n×n), w (n,) or an integer contact dof, gap")
+    modes.add_argument("-o", "--output", type=Path, required=True, metavar="MODES.json")
+    modes.add_argument("--plot", type=Path, metavar="FILE.png", help="also write the frequency–energy plot")
+    _progress_options(modes)
+    modes.set_defaults(func=_cmd_modes)
+
+    ani = sub.add_parser("animate", help="stage 5: animations and VTK time series of chosen orbits",
+                         description="Animate the orbits chosen by [output] (orbits, or the widest admissible "
+                                     "arcs) of a modes file on the reduced model's mesh: GIF/MP4 (pyvista, "
+                                     "off-screen) and VTK time series (.pvd + .vtu).")
+    ani.add_argument("study", type=Path, metavar="STUDY.toml")
+    ani.add_argument("--reduced", type=Path, required=True, metavar="REDUCED.npz")
+    ani.add_argument("--modes", type=Path, required=True, metavar="MODES.json")
+    ani.add_argument("--out", type=Path, metavar="DIR", help="output directory (overrides [output] directory)")
+    _progress_options(ani)
+    ani.set_defaults(func=_cmd_animate)
+
+
+def _setup(args) -> bool:
+    """Configure logging of the 'bladecase' logger; return whether to show progress bars."""
+    import logging
+
+    logger = logging.getLogger("bladecase")
+    if not any(getattr(h, "_bladecase", False) for h in logger.handlers):
+        handler = logging.StreamHandler(sys.stderr)
+        handler.setFormatter(logging.Formatter("bladecase: %(message)s"))
+        handler._bladecase = True
+        logger.addHandler(handler)
+        logger.propagate = False
+    logger.setLevel(logging.WARNING if args.quiet else logging.INFO)
+    return not args.no_progress and not args.quiet and sys.stderr.isatty()
+
+
+def _study(path: Path):
+    from .study import load_study
+
+    return load_study(path)
+
+
+def _cmd_run(args) -> int:
+    from .pipeline import run
+
+    progress = _setup(args)
+    result = run(_study(args.study), out=args.out, progress=progress)
+    print(result.directory / "report.md")
+    return 0
+
+
+def _cmd_demo(args) -> int:
+    from .pipeline import run
+    from .study import demo_study, demo_text
+
+    if args.print_study:
+        print(demo_text(), end="")
+        return 0
+    progress = _setup(args)
+    result = run(demo_study(), out=args.out, progress=progress)
+    print(result.directory / "report.md")
+    return 0
+
+
+def _cmd_mesh(args) -> int:
+    from .mesh import save_mesh
+    from .pipeline import build_mesh
+
+    _setup(args)
+    study = _study(args.study)
+    if study.parametric and args.output.suffix == ".msh":
+        mesh = build_mesh(study, path=args.output)
+    else:
+        mesh = build_mesh(study)
+        save_mesh(mesh, args.output)
+    groups = ", ".join(f"{k} ({len(v)})" for k, v in sorted(mesh.groups.items()))
+    print(f"{args.output}: {len(mesh.points)} nodes, {len(mesh.cells[mesh.body_type])} {mesh.body_type}; "
+          f"groups {groups}")
+    return 0
+
+
+def _cmd_assemble(args) -> int:
+    from .fem import natural_frequencies, save_model
+    from .mesh import load_mesh
+    from .pipeline import build_mesh, build_model
+
+    _setup(args)
+    study = _study(args.study)
+    if args.mesh is not None:
+        mesh = load_mesh(args.mesh, require=[study["fem"]["clamp"]])
+    else:
+        mesh = build_mesh(study)
+    model = build_model(study, mesh)
+    f = natural_frequencies(model, min(study["fem"]["frequencies"], model.n_dofs - 1))
+    save_model(model, args.output)
+    print(f"{args.output}: {model}")
+    print("linear frequencies (Hz): " + ", ".join(f"{x:.3f}" for x in f))
+    return 0
+
+
+def _cmd_reduce(args) -> int:
+    from .fem import load_model
+    from .pipeline import build_contact, build_reduced
+    from .reduction import save_reduced
+
+    _setup(args)
+    study = _study(args.study)
+    model = load_model(args.model)
+    contact = build_contact(study, model)
+    reduced = build_reduced(study, model, contact, args.method, args.size)
+    save_reduced(reduced, args.output)
+    sp = reduced.system.spectrum
+    print(f"{args.output}: {reduced}; contact node {contact.node}")
+    print("reduced frequencies (Hz): " + ", ".join(f"{x:.3f}" for x in sp.frequencies[sp.active][:12]))
+    return 0
+
+
+def _cmd_modes(args) -> int:
+    from .io import save_figure, write_json
+    from .pipeline import families_document, search
+
+    progress = _setup(args)
+    study = _study(args.study)
+    if args.reduced is not None:
+        from .reduction import load_reduced
+
+        system = load_reduced(args.reduced).system
+    else:
+        args.chain, args.gap = None, None
+        system = _load_system(args)
+    families = search(study, system, progress=progress)
+    write_json(args.output, families_document(families, system))
+    for i, fam in enumerate(families):
+        if fam.arcs:
+            print(f"family {i}: " + fam.table())
+    print(f"{args.output}: {len(families)} families, {sum(len(f.arcs) for f in families)} admissible arcs")
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        from .plot import frequency_energy
+
+        if not families:
+            raise ValueError("nothing to plot: no family found")
+        fig = frequency_energy(families)
+        save_figure(fig, args.plot, dpi=150)
+        plt.close(fig)
+    return 0
+
+
+def _cmd_animate(args) -> int:
+    from .pipeline import animate_families, load_families
+    from .reduction import load_reduced
+
+    progress = _setup(args)
+    study = _study(args.study)
+    reduced = load_reduced(args.reduced)
+    families = load_families(args.modes, reduced.system)
+    written = animate_families(study, reduced, families, out=args.out, progress=progress)
+    for entry in written:
+        print(", ".join(str(entry[k]) for k in ("gif", "mp4", "pvd", "manifold") if k in entry))
+    if not written:
+        print("no admissible orbit to animate", file=sys.stderr)
+        return 1
+    return 0
 
 
 def _load_system(args):
@@ -207,9 +439,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     try:
         return args.func(args)
-    except ValueError as exc:
+    except ValueError as exc:  # includes StudyError: the message names the key
         print(f"bladecase {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except RuntimeError as exc:  # e.g. no off-screen rendering
+        print(f"bladecase {args.command}: error: {exc}", file=sys.stderr)
+        return 1
     except BrokenPipeError:  # output piped into e.g. `head`
         sys.stdout = open(os.devnull, "w")
         return 0

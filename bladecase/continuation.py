@@ -446,6 +446,21 @@ def _polished_orbit(curve: _Curve, z) -> PeriodicOrbit:
     return make_orbit(curve.system, T, times, lam, polish=False)
 
 
+#: A start orbit is only re-solved from a crossing segment of a followed curve
+#: when the interpolated impact times lie within ``PASS_GATE·T`` of its own
+#: (under every re-anchoring); farther crossings are other orbits of that period.
+PASS_GATE = 0.05
+
+
+def _phase_distance(times: np.ndarray, reference: np.ndarray, T: float) -> float:
+    """``min`` over re-anchorings of ``times`` (shift by each ``t_r``) of the largest
+    distance to ``reference`` (both sets of ``k`` impact times in ``(0, T]``)."""
+    shifted = np.mod(times[None, :] - times[:, None], T)  # row r: re-anchored at impact r
+    shifted[shifted == 0] = T
+    shifted.sort(axis=1)
+    return float(np.abs(shifted - np.sort(reference)[None, :]).max(axis=1).min())
+
+
 def _passes(curve: _Curve, zs, start) -> bool:
     """Does the polyline ``zs`` cross the start orbit (same period, same impacts)?"""
     T_s, o = start
@@ -460,6 +475,8 @@ def _passes(curve: _Curve, zs, start) -> bool:
         a = (T_s - Ts[i]) / (Ts[i + 1] - Ts[i])
         ta, tb = curve.times(zs[i])[1], curve.times(zs[i + 1])[1]
         guess = ((1 - a) * ta / Ts[i] + a * tb / Ts[i + 1]) * T_s
+        if _phase_distance(guess, o.impact_times, T_s) > PASS_GATE * T_s:
+            continue  # the interpolated impacts are far from the start's: no need to solve
         sol = _solve_times(md, guess, curve.d)
         if sol is None:
             continue

@@ -451,3 +451,22 @@ def _abaqus_text(mesh: Mesh) -> str:
         ids = [str(v + 1) for v in np.asarray(nodes).tolist()]
         lines += [", ".join(ids[i : i + 16]) for i in range(0, len(ids), 16)]
     return "\n".join(lines) + "\n"
+
+
+# ----------------------------------------------------------------------------- arrays (for .npz stage files)
+
+def mesh_to_arrays(mesh: Mesh, prefix: str = "mesh/") -> dict[str, np.ndarray]:
+    """The mesh as flat named arrays (for ``np.savez``): points, cells by type, groups."""
+    out = {f"{prefix}points": mesh.points, f"{prefix}dim": np.array(mesh.dim),
+           f"{prefix}source": np.array(mesh.source)}
+    out.update({f"{prefix}cells/{t}": np.asarray(c) for t, c in mesh.cells.items()})
+    out.update({f"{prefix}groups/{g}": np.asarray(n) for g, n in mesh.groups.items()})
+    return out
+
+
+def mesh_from_arrays(data, prefix: str = "mesh/") -> Mesh:
+    """Inverse of :func:`mesh_to_arrays` (``data``: a mapping such as an ``NpzFile``)."""
+    cells = {k[len(prefix) + 6:]: np.asarray(data[k]) for k in data if k.startswith(f"{prefix}cells/")}
+    groups = {k[len(prefix) + 7:]: np.asarray(data[k]) for k in data if k.startswith(f"{prefix}groups/")}
+    return Mesh(points=np.asarray(data[f"{prefix}points"], dtype=float), cells=cells,
+                dim=int(data[f"{prefix}dim"]), groups=groups, source=str(data[f"{prefix}source"]))

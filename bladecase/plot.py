@@ -59,5 +59,6 @@ def frequency_energy(backbones: Sequence, ax=None, linear: bool = True, title: s
     ax.set_ylabel("energy E")
     ax.set_title(title or "Nonsmooth modes: frequency–energy")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(loc="best", fontsize="small")
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(loc="best", fontsize="small")
     return fig

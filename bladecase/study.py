@@ -1,0 +1,429 @@
+"""Study files: a TOML description of a whole analysis, validated before any work starts.
+
+A study names the blade (a parametric geometry meshed by gmsh, or a mesh file),
+the material and the finite elements, the contact (node, casing normal,
+clearance), the reduced model(s), the nonsmooth-mode search and the outputs.
+:func:`load_study` reads and validates it into a :class:`Study` (plain nested
+dicts with every default filled in); :mod:`bladecase.pipeline` runs it.
+
+Every key, its type, default and meaning is in :data:`SCHEMA` (and
+``docs/study.md``, which a test keeps in step with it).  Unknown keys, wrong
+types and out-of-range values raise :class:`StudyError` naming the key, e.g.
+``[contact] clearance: must be > 0 (metres), got -0.0001``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+import re
+import tomllib
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from .geometry import BladeGeometry, PlateGeometry
+from .reduction import METHODS
+
+REQUIRED = object()  #: marks a key without a default
+
+
+class StudyError(ValueError):
+    """A study file that cannot be run: the message names the key and the reason."""
+
+
+@dataclass(frozen=True)
+class Key:
+    """One study-file key: accepted types, default, and a one-line meaning."""
+
+    types: tuple
+    default: Any
+    doc: str
+    check: Any = None  # callable(value) -> str | None (an error message)
+
+
+def _num(x) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+def _positive(v) -> str | None:
+    return None if math.isfinite(v) and v > 0 else "must be a finite number > 0"
+
+
+def _int_at_least(n):
+    return lambda v: None if v >= n else f"must be >= {n}"
+
+
+def _one_of(*choices):
+    return lambda v: None if v in choices else f"must be one of {', '.join(repr(c) for c in choices)}"
+
+
+def _vector(v) -> str | None:
+    if len(v) not in (2, 3) or not all(_num(x) and math.isfinite(x) for x in v):
+        return "must be a list of 2 or 3 finite numbers"
+    return None
+
+
+def _period_unit(v) -> str | None:
+    return None if v == "s" or re.fullmatch(r"T[1-9][0-9]*", v) else (
+        "must be 's' (seconds) or 'T<j>' (the period of the j-th linear mode seen by the contact, e.g. 'T1')")
+
+
+def _periods(v) -> str | None:
+    if len(v) != 2 or not all(_num(x) and math.isfinite(x) for x in v) or not 0 < v[0] < v[1]:
+        return "must be [lower, upper] with 0 < lower < upper"
+    return None
+
+
+def _ipp(v) -> str | None:
+    if not v or not all(isinstance(k, int) and not isinstance(k, bool) and 1 <= k <= 8 for k in v):
+        return "must be a non-empty list of integers between 1 and 8 (impacts per period)"
+    if len(set(v)) != len(v):
+        return "must not repeat a value"
+    return None
+
+
+def _formats(v) -> str | None:
+    bad = [f for f in v if f not in FORMATS]
+    return f"unknown format(s) {bad} (valid: {', '.join(FORMATS)})" if bad else None
+
+
+def _window(v) -> str | None:
+    if len(v) != 2 or not all(isinstance(x, int) and not isinstance(x, bool) and 64 <= x <= 4096 for x in v):
+        return "must be [width, height] in pixels, integers between 64 and 4096"
+    return None
+
+
+def _scale(v) -> str | None:
+    if v == "auto":
+        return None
+    if _num(v):
+        return _positive(v)
+    return "must be 'auto' or a number > 0"
+
+
+def _reduction_list(v) -> str | None:
+    for i, item in enumerate(v):
+        if not isinstance(item, dict):
+            return f"item {i} must be a table {{method = ..., size = ...}}"
+        extra = set(item) - {"method", "size"}
+        if extra:
+            return f"item {i}: unknown key(s) {sorted(extra)} (valid: method, size)"
+        if item.get("method") not in METHODS:
+            return f"item {i}: method must be one of {', '.join(METHODS)}, got {item.get('method')!r}"
+        size = item.get("size")
+        if item["method"] != "full" and (not isinstance(size, int) or isinstance(size, bool) or size < 1):
+            return f"item {i}: size must be an integer >= 1, got {size!r}"
+    return None
+
+
+def _orbit_list(v) -> str | None:
+    for i, item in enumerate(v):
+        if not isinstance(item, dict) or set(item) - {"ipp", "T"} or not {"ipp", "T"} <= set(item):
+            return f"item {i} must be a table {{ipp = K, T = period}} (T in search.period_unit)"
+        if not isinstance(item["ipp"], int) or isinstance(item["ipp"], bool) or item["ipp"] < 1:
+            return f"item {i}: ipp must be an integer >= 1, got {item['ipp']!r}"
+        if not _num(item["T"]) or not math.isfinite(item["T"]) or item["T"] <= 0:
+            return f"item {i}: T must be a number > 0, got {item['T']!r}"
+    return None
+
+
+#: Output formats: GIF/MP4 animations, VTK time series (+ manifold samples), PNG plots.
+FORMATS = ("gif", "mp4", "vtu", "png")
+
+_STR, _INT, _NUM, _BOOL, _LIST = (str,), (int,), (int, float), (bool,), (list,)
+
+#: The study-file schema: section → key → :class:`Key`.  ``[geometry]`` also
+#: takes the fields of :class:`~bladecase.BladeGeometry` (``kind = "blade"``)
+#: or :class:`~bladecase.PlateGeometry` (``kind = "plate"``), see :data:`GEOMETRY_FIELDS`.
+SCHEMA: dict[str, dict[str, Key]] = {
+    "study": {
+        "name": Key(_STR, "study", "Name used in titles and file names.",
+                    lambda v: None if re.fullmatch(r"[A-Za-z0-9_.-]{1,64}", v) else
+                    "must be 1-64 characters among letters, digits, '_', '.', '-'"),
+    },
+    "geometry": {
+        "kind": Key(_STR, "blade", "'blade' (3-D lofted solid, tetrahedra) or 'plate' (2-D plane stress).",
+                    _one_of("blade", "plate")),
+        "size": Key(_NUM, None, "Target element size (m); default: the geometry's own default.", _positive),
+        "tip_size": Key(_NUM, None, "Element size at the tip (m, <= size); default: uniform.", _positive),
+        "mesh_order": Key(_INT, 1, "Geometric order of the gmsh mesh (1 or 2).", _one_of(1, 2)),
+    },
+    "mesh": {
+        "path": Key(_STR, REQUIRED, "Mesh file (any meshio format with named groups), relative to the study file."),
+    },
+    "material": {
+        "preset": Key(_STR, "Ti-6Al-4V", "Material preset (Ti-6Al-4V, steel, Inconel 718, Al 6061-T6); "
+                      "ignored when E, nu and rho are given."),
+        "E": Key(_NUM, None, "Young's modulus (Pa).", _positive),
+        "nu": Key(_NUM, None, "Poisson's ratio.", lambda v: None if -1 < v < 0.5 else "must be in (-1, 0.5)"),
+        "rho": Key(_NUM, None, "Density (kg/m³).", _positive),
+    },
+    "fem": {
+        "order": Key(_INT, 2, "Polynomial order of the elements (1 or 2).", _one_of(1, 2)),
+        "mass": Key(_STR, "consistent", "'consistent' or 'lumped' mass matrix.", _one_of("consistent", "lumped")),
+        "clamp": Key(_STR, "root", "Mesh group whose nodes are clamped."),
+        "thickness": Key(_NUM, None, "Out-of-plane thickness of a 2-D model (m); required in 2-D.", _positive),
+        "plane": Key(_STR, "stress", "'stress' or 'strain' (2-D models).", _one_of("stress", "strain")),
+        "frequencies": Key(_INT, 6, "Linear frequencies of the full FE model to compute and report.",
+                           _int_at_least(1)),
+    },
+    "contact": {
+        "clearance": Key(_NUM, REQUIRED, "Clearance d between the contact node at rest and the casing (m).",
+                         lambda v: None if math.isfinite(v) and v > 0 else "must be > 0 (metres)"),
+        "group": Key(_STR, "contact", "Mesh group holding the contact node (a one-node group), or the group "
+                     "searched by 'farthest'/'nearest'."),
+        "node": Key(_INT, None, "Mesh node index of the contact (overrides group).", _int_at_least(0)),
+        "farthest": Key(_LIST, None, "Pick the node of 'group' (default 'tip' here) farthest along this "
+                        "direction, e.g. [-1, 0, 0].", _vector),
+        "nearest": Key(_LIST, None, "Pick the free node nearest this point (within 'group' if given).", _vector),
+        "normal": Key(_LIST, None, "Casing normal, from the blade towards the casing; default: radial "
+                      "(+z in 3-D, +y in 2-D).", _vector),
+    },
+    "reduction": {
+        "method": Key(_STR, "lanczos-si", f"Reduced model: {', '.join(METHODS)}.", _one_of(*METHODS)),
+        "size": Key(_INT, 20, "Modes / Lanczos steps / fixed-interface modes kept (ignored by 'full').",
+                    _int_at_least(1)),
+        "compare": Key(_LIST, [], "Other reduced models run through the same search for comparison: "
+                       "[{method = 'modal', size = 20}, …].", _reduction_list),
+    },
+    "search": {
+        "ipp": Key(_LIST, [1, 2], "Impacts per period of the families to look for.", _ipp),
+        "periods": Key(_LIST, [0.9, 0.9999], "Period range [lower, upper] in 'period_unit'.", _periods),
+        "period_unit": Key(_STR, "T1", "'s', or 'T<j>': the period 2π/ω_j of the j-th linear mode of the "
+                           "reduced model that sees the contact.", _period_unit),
+        "scan": Key(_INT, 24, "Starting periods scanned for k >= 2 (1 ipp scans max(scan, 200)).",
+                    _int_at_least(2)),
+        "step": Key(_NUM, 0.01, "Initial continuation step (scaled arclength).", _positive),
+        "max_points": Key(_INT, 400, "Cap on continuation points per direction of each family.",
+                          _int_at_least(2)),
+    },
+    "output": {
+        "directory": Key(_STR, None, "Output directory, relative to the current directory; default "
+                         "'results/<name>'; the command line's --out overrides it."),
+        "animate": Key(_INT, 2, "How many orbits to animate when 'orbits' is empty: the middles of the "
+                       "widest admissible arcs, one per family.", _int_at_least(0)),
+        "orbits": Key(_LIST, [], "Orbits to animate: [{ipp = 1, T = 0.95}, …], T in search.period_unit "
+                      "(the nearest admissible orbit of a family of that ipp).", _orbit_list),
+        "frames": Key(_INT, 40, "Frames per period of the animations and VTK time series.", _int_at_least(2)),
+        "scale": Key((str, int, float), "auto", "Amplitude scale of the animations, or 'auto' (largest "
+                     "displacement drawn at 'auto_fraction' of the blade's bounding-box diagonal).", _scale),
+        "auto_fraction": Key(_NUM, 0.1, "Drawn size of the largest displacement with scale = 'auto'.",
+                             lambda v: None if 0 < v <= 1 else "must be in (0, 1]"),
+        "formats": Key(_LIST, ["gif", "mp4", "vtu", "png"], f"Outputs among {', '.join(FORMATS)} (mp4 needs "
+                       "imageio-ffmpeg: skipped with a note without it).", _formats),
+        "manifold": Key(_BOOL, True, "Export the invariant-manifold samples of each animated family (VTK)."),
+        "manifold_size": Key(_LIST, [40, 100], "[orbits, phases] sampled on the manifold.",
+                             lambda v: None if len(v) == 2 and all(isinstance(x, int) and not isinstance(x, bool)
+                                                                   and x >= 2 for x in v)
+                             else "must be [orbits, phases], integers >= 2"),
+        "window": Key(_LIST, [800, 600], "Animation size [width, height] in pixels.", _window),
+        "fps": Key(_NUM, 20, "Frames per second of the animations.", _positive),
+    },
+}
+
+#: ``[geometry]`` keys taken from the geometry dataclasses (the parametric shape).
+GEOMETRY_FIELDS = {
+    "blade": tuple(f.name for f in dataclasses.fields(BladeGeometry)),
+    "plate": tuple(f.name for f in dataclasses.fields(PlateGeometry)),
+}
+
+
+@dataclass(frozen=True)
+class Study:
+    """A validated study: every section with its defaults filled in.
+
+    Attributes
+    ----------
+    config : dict
+        ``section → key → value`` (``[geometry]`` or ``[mesh]``, never both).
+    source : str
+        The study file (or ``"<demo>"``) for messages.
+    base : Path
+        Folder that relative paths in the study (the mesh file) are relative to.
+    """
+
+    config: dict
+    source: str = "<string>"
+    base: Path = field(default_factory=Path.cwd)
+
+    def __getitem__(self, section: str) -> dict:
+        return self.config[section]
+
+    @property
+    def name(self) -> str:
+        return self.config["study"]["name"]
+
+    @property
+    def parametric(self) -> bool:
+        """True when the blade is generated from ``[geometry]`` (else read from ``[mesh]``)."""
+        return "geometry" in self.config
+
+    def geometry(self) -> BladeGeometry | PlateGeometry:
+        """The parametric geometry of ``[geometry]``."""
+        g = self.config["geometry"]
+        cls = BladeGeometry if g["kind"] == "blade" else PlateGeometry
+        args = {k: (tuple(v) if isinstance(v, list) else v) for k, v in g.items() if k in GEOMETRY_FIELDS[g["kind"]]}
+        return cls(**args)
+
+    def mesh_path(self) -> Path:
+        """The mesh file of ``[mesh]``, resolved against :attr:`base`."""
+        return (self.base / self.config["mesh"]["path"]).resolve()
+
+    def output_dir(self, override: str | os.PathLike | None = None) -> Path:
+        """The output directory: ``override`` (command line), else ``[output] directory``, else ``results/<name>``."""
+        if override is not None:
+            return Path(override)
+        d = self.config["output"]["directory"]
+        return Path(d) if d is not None else Path("results") / self.name
+
+
+def _type_name(types: tuple) -> str:
+    names = {str: "a string", int: "an integer", float: "a number", bool: "true/false", list: "a list"}
+    if types == _NUM:
+        return "a number"
+    return " or ".join(names[t] for t in types)
+
+
+def _check_value(section: str, key: str, spec: Key, value) -> Any:
+    where = f"[{section}] {key}"
+    ok = any(isinstance(value, t) and not (t in (int, float) and isinstance(value, bool)) for t in spec.types)
+    if not ok:
+        raise StudyError(f"{where}: expected {_type_name(spec.types)}, got {type(value).__name__} {value!r}")
+    if isinstance(value, float) and not math.isfinite(value):
+        raise StudyError(f"{where}: must be finite, got {value!r}")
+    if spec.check is not None:
+        message = spec.check(value)
+        if message:
+            raise StudyError(f"{where}: {message}, got {value!r}")
+    return value
+
+
+def _geometry_section(raw: dict) -> dict:
+    kind = raw.get("kind", "blade")
+    _check_value("geometry", "kind", SCHEMA["geometry"]["kind"], kind)
+    out = {}
+    allowed = set(SCHEMA["geometry"]) | set(GEOMETRY_FIELDS[kind])
+    for key, value in raw.items():
+        if key not in allowed:
+            raise StudyError(
+                f"[geometry] {key}: unknown key for kind = {kind!r} (valid: {', '.join(sorted(allowed))})")
+        if key in SCHEMA["geometry"]:
+            out[key] = _check_value("geometry", key, SCHEMA["geometry"][key], value)
+        else:
+            if isinstance(value, dict):
+                raise StudyError(f"[geometry] {key}: expected a number, string or list, got a table")
+            out[key] = value
+    for key, spec in SCHEMA["geometry"].items():
+        out.setdefault(key, spec.default)
+    try:  # the dataclass validates the shape and names the offending field
+        Study({"geometry": out}).geometry()
+    except TypeError as exc:
+        missing = re.findall(r"'(\w+)'", str(exc))
+        raise StudyError(f"[geometry] {', '.join(missing) or '?'}: required for kind = {kind!r} ({exc})") from None
+    except ValueError as exc:
+        raise StudyError(f"[geometry] {exc}") from None
+    return out
+
+
+def validate(raw: dict, source: str = "<string>", base: str | os.PathLike | None = None) -> Study:
+    """Check a parsed study (a dict as from ``tomllib``) and fill in the defaults.
+
+    Raises
+    ------
+    StudyError
+        An unknown section or key, a wrong type or value, a missing required
+        key, both or neither of ``[geometry]`` and ``[mesh]``, or an
+        inconsistent combination (the message names the key).
+    """
+    if not isinstance(raw, dict):
+        raise StudyError(f"{source}: a study is a TOML table, got {type(raw).__name__}")
+    unknown = set(raw) - set(SCHEMA)
+    if unknown:
+        key = sorted(unknown)[0]
+        raise StudyError(f"[{key}]: unknown section (valid: {', '.join(SCHEMA)})")
+    if ("geometry" in raw) == ("mesh" in raw):
+        raise StudyError("[geometry] / [mesh]: give exactly one: a parametric blade ([geometry]) or a mesh "
+                         "file ([mesh] path = ...)")
+    config: dict[str, dict] = {}
+    for section, keys in SCHEMA.items():
+        if section in ("geometry", "mesh") and section not in raw:
+            continue
+        given = raw.get(section, {})
+        if not isinstance(given, dict):
+            raise StudyError(f"[{section}]: must be a table ([{section}] with keys), got {type(given).__name__}")
+        if section == "geometry":
+            config[section] = _geometry_section(given)
+            continue
+        out = {}
+        for key, value in given.items():
+            if key not in keys:
+                raise StudyError(f"[{section}] {key}: unknown key (valid: {', '.join(keys)})")
+            out[key] = _check_value(section, key, keys[key], value)
+        for key, spec in keys.items():
+            if key not in out:
+                if spec.default is REQUIRED:
+                    raise StudyError(f"[{section}] {key}: required ({spec.doc})")
+                out[key] = list(spec.default) if isinstance(spec.default, list) else spec.default
+        config[section] = out
+    _cross_checks(config)
+    return Study(config=config, source=source, base=Path(base) if base is not None else Path.cwd())
+
+
+def _cross_checks(c: dict) -> None:
+    m = c["material"]
+    given = [k for k in ("E", "nu", "rho") if m[k] is not None]
+    if given and len(given) != 3:
+        missing = [k for k in ("E", "nu", "rho") if m[k] is None]
+        raise StudyError(f"[material] {', '.join(missing)}: give E, nu and rho together (or only 'preset')")
+    ct = c["contact"]
+    pickers = [k for k in ("node", "farthest", "nearest") if ct[k] is not None]
+    if len(pickers) > 1:
+        raise StudyError(f"[contact] {pickers[1]}: give at most one of node, farthest, nearest (got {pickers})")
+    r = c["reduction"]
+    if r["method"] == "full":
+        r["size"] = None
+    o = c["output"]
+    if "mp4" in o["formats"] and "gif" not in o["formats"]:
+        pass  # MP4 alone is fine
+    if c.get("geometry", {}).get("kind") == "plate" or "mesh" in c:
+        pass  # 2-D thickness is checked once the mesh is known (pipeline)
+    s = c["search"]
+    if s["period_unit"] == "s" and s["periods"][1] > 10.0:
+        raise StudyError(f"[search] periods: {s['periods']} seconds is not a blade's vibration period; "
+                         "did you mean period_unit = 'T1'?")
+    for i, item in enumerate(o["orbits"]):
+        if item["ipp"] not in s["ipp"]:
+            raise StudyError(f"[output] orbits: item {i} asks for ipp = {item['ipp']}, which [search] ipp = "
+                             f"{s['ipp']} does not look for")
+
+
+def loads(text: str, source: str = "<string>", base: str | os.PathLike | None = None) -> Study:
+    """Parse and validate a study from TOML text."""
+    try:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise StudyError(f"{source}: not valid TOML: {exc}") from None
+    return validate(raw, source=source, base=base)
+
+
+def load_study(path: str | os.PathLike) -> Study:
+    """Read and validate a study file; relative paths in it are relative to its folder."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise StudyError(f"cannot read study file {str(path)!r}: {exc}") from None
+    return loads(text, source=str(path), base=path.resolve().parent)
+
+
+def demo_text() -> str:
+    """The TOML text of the embedded demo study (``bladecase demo``)."""
+    return resources.files("bladecase").joinpath("studies/demo.toml").read_text(encoding="utf-8")
+
+
+def demo_study() -> Study:
+    """The embedded demo study: a twisted, leaned 3-D blade of a few thousand dofs."""
+    return loads(demo_text(), source="<demo>")
