@@ -260,25 +260,26 @@ def choose_orbits(study: Study, families: list[Family], unit: float) -> list[Cho
 
 
 def frame_times(orbit: PeriodicOrbit, frames: int) -> tuple[np.ndarray, np.ndarray]:
-    """``frames`` instants over one period, with the frames nearest the impacts moved onto them.
+    """``frames`` instants over one period, with one frame moved onto each impact instant.
 
-    Returns the times (increasing, in ``[0, T)``) and the impact-frame mask
-    (``t = 0`` is always an impact: the orbit is at the casing there).
+    Each impact takes the nearest frame that is not already an impact and
+    can move there without reordering the frames (so close impacts get
+    neighbouring frames).  Returns the times (increasing, in ``[0, T)``) and
+    the impact-frame mask; ``t = 0`` (``= t_k = T``) is always an impact.
     """
     T = orbit.T
     t = np.arange(frames) * T / frames
     impact = np.zeros(frames, dtype=bool)
-    for ti in np.mod(orbit.impact_times, T):
-        j = int(round(ti / T * frames)) % frames
-        if j == 0 or (0 < j < frames - 1 and impact[j]):
-            impact[j] = True
-            continue
-        lo = t[j - 1] if j > 0 else 0.0
-        hi = t[j + 1] if j + 1 < frames else T
-        if lo < ti < hi:
-            t[j] = ti
-        impact[j] = True
     impact[0] = True
+    edges = np.append(t, T)
+    for ti in np.sort(np.mod(orbit.impact_times, T)):
+        if ti <= 1e-12 * T or ti >= T * (1 - 1e-12):
+            continue  # the impact at t = 0
+        for j in np.argsort(np.abs(t - ti), kind="stable"):
+            if j > 0 and not impact[j] and edges[j - 1] < ti < edges[j + 1]:
+                t[j] = edges[j] = ti
+                impact[j] = True
+                break
     return t, impact
 
 
@@ -505,7 +506,10 @@ def verify(orbit: PeriodicOrbit) -> dict:
     x0, v0 = orbit.state(np.array([0.0]))
     x0, v0 = x0[:, 0], v0[:, 0]
     flights = np.diff(np.concatenate([[0.0], orbit.impact_times]))
-    traj = simulate(orbit.system, x0, v0, T + 0.5 * flights.min())
+    try:
+        traj = simulate(orbit.system, x0, v0, T + 0.5 * flights.min())
+    except ValueError as exc:  # e.g. the orbit's state at t = 0 is not at/behind the casing
+        return {"return_error": float("inf"), "impacts": 0, "ok": False, "reason": str(exc)}
     hits = np.flatnonzero((traj.impact_times > 0) & (traj.impact_times <= T + 0.25 * flights.min()))
     if hits.size == 0:
         return {"return_error": float("inf"), "impacts": 0, "ok": False}
@@ -591,7 +595,7 @@ def _render(study: Study, reduced: ReducedModel, families: list[Family], choice:
         if o["manifold"]:
             fam = families[choice.family]
             try:
-                entry["manifold"] = _manifold(reduced, fam, staging / "vtk" / f"{choice.stem}_manifold.vtu",
+                entry["manifold"] = _manifold(reduced, fam, orbit.T, staging / "vtk" / f"{choice.stem}_manifold.vtu",
                                               *o["manifold_size"])
             except ValueError as exc:
                 log.warning("manifold of family %d not written: %s", choice.family, exc)
@@ -600,22 +604,55 @@ def _render(study: Study, reduced: ReducedModel, families: list[Family], choice:
     return entry
 
 
-def _manifold(reduced: ReducedModel, fam: Family, path: Path, n_orbits: int, n_times: int) -> str:
-    """Manifold samples projected on (contact displacement, contact velocity, period)."""
+def arc_orbits(fam: Family, T: float, count: int) -> list[PeriodicOrbit]:
+    """``count`` admissible orbits evenly spread in period over the admissible arc of ``fam`` containing ``T``.
+
+    Each is re-solved at its period (:meth:`Family.orbit_at`); where the curve
+    crosses a period several times, the orbit closest in impact phases to the
+    previous one is kept, so the samples follow one arc.
+    """
+    arcs = [a for a in fam.arcs if a.T_lo <= T <= a.T_hi] or sorted(fam.arcs, key=lambda a: a.T_lo - a.T_hi)[:1]
+    if not arcs:
+        return []
+    arc = arcs[0]
+    pad = 1e-6 * (arc.T_hi - arc.T_lo)
+    out: list[PeriodicOrbit] = []
+    for Tj in np.linspace(arc.T_lo + pad, arc.T_hi - pad, count):
+        try:
+            cands = [o for o in fam.orbit_at(Tj) if o.admissible]
+        except ValueError:  # a resonant period
+            continue
+        if not cands:
+            continue
+        if out:
+            ref = out[-1].impact_times / out[-1].T
+            cands.sort(key=lambda o: np.abs(o.impact_times / o.T - ref).max())
+        out.append(cands[0])
+    return out
+
+
+def _manifold(reduced: ReducedModel, fam: Family, T: float, path: Path, n_orbits: int, n_times: int) -> str:
+    """Manifold samples over the admissible arc through ``T``, projected on
+    (contact displacement ν·u, contact velocity × T/2π, period)."""
     from .export import write_manifold
 
-    T, theta, x, v = fam.manifold(n_orbits=n_orbits, n_times=n_times)
-    if T.size < 2:
-        raise ValueError("fewer than two admissible orbits in the family")
+    orbits = arc_orbits(fam, T, n_orbits)
+    if len(orbits) < 2:
+        raise ValueError("fewer than two admissible orbits on the arc (a single-point arc)")
+    theta = np.arange(n_times) / n_times
+    Ts = np.array([o.T for o in orbits])
+    states = [o.state(theta * o.T) for o in orbits]
+    x = np.stack([st[0] for st in states], axis=1)  # (n, n_orbits, n_times)
+    v = np.stack([st[1] for st in states], axis=1)
     w = reduced.system.w
-    xc = np.einsum("i,ijk->jk", w, x)  # ν·u at the contact node
+    xc = np.einsum("i,ijk->jk", w, x)
     vc = np.einsum("i,ijk->jk", w, v)
-    coords = np.stack([xc, vc * (T[:, None] / (2 * np.pi)), np.broadcast_to(T[:, None], xc.shape)], axis=-1)
-    q = np.moveaxis(x, 0, -1)
-    write_manifold(path, coords, point_data={"period": np.broadcast_to(T[:, None], xc.shape).copy(),
-                                             "phase": np.broadcast_to(theta[None, :], xc.shape).copy(),
-                                             "contact_displacement": xc, "contact_velocity": vc,
-                                             "reduced_state": q})
+    period = np.broadcast_to(Ts[:, None], xc.shape).copy()
+    coords = np.stack([xc, vc * period / (2 * np.pi), period], axis=-1)
+    energy = np.broadcast_to(np.array([o.energy for o in orbits])[:, None], xc.shape).copy()
+    write_manifold(path, coords, point_data={
+        "period": period, "phase": np.broadcast_to(theta[None, :], xc.shape).copy(), "energy": energy,
+        "contact_displacement": xc, "contact_velocity": vc, "reduced_state": np.moveaxis(x, 0, -1)})
     return f"vtk/{path.name}"
 
 

@@ -1,0 +1,337 @@
+"""End to end: study file → mesh → FE → reduced model → nonsmooth modes → animations, VTK, report.
+
+* The demo study at tiny resolution (coarser mesh, 6 Lanczos steps, 4 start
+  periods, 8 frames of 320×240) runs through :func:`bladecase.pipeline.run`
+  and writes every result; each file is read back and checked against the
+  physics: at frame 0 (an impact) the contact node is at the casing, ``ν·u =
+  d`` to 1e-9·d, and ``ν·u <= d`` on every frame; the event-driven simulator
+  started from each animated orbit's post-impact state returns to it
+  (``VERIFY_RTOL`` = 1e-8; measured 1e-14–4e-11).
+* A user mesh (``meshes/plate.vtu``, not ``.msh``) study runs, through
+  ``bladecase run`` and through the stage commands (mesh → assemble →
+  reduce → modes → animate) with the same families.
+* A run that fails while rendering leaves the previous results untouched and
+  no staging folder.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+from pathlib import Path
+
+import imageio.v3 as iio
+import meshio
+import numpy as np
+import pytest
+
+import bladecase as bc
+from bladecase import pipeline
+from bladecase.cli import main
+from bladecase.export import read_time_series
+from bladecase.fem import load_model, save_model
+from bladecase.reduction import load_reduced, reduce, save_reduced
+from bladecase.study import demo_study, loads, validate
+from bladecase.viz import mp4_available
+
+ROOT = Path(__file__).resolve().parent.parent
+FRAMES = 8
+WINDOW = (320, 240)
+
+
+def tiny_demo():
+    c = copy.deepcopy(demo_study().config)
+    c["geometry"].update(size=0.006, tip_size=0.003)
+    c["reduction"]["size"] = 6
+    c["search"]["scan"] = 4
+    c["output"].update(frames=FRAMES, window=list(WINDOW), manifold_size=[10, 16])
+    raw = {s: {k: v for k, v in keys.items() if v is not None} for s, keys in c.items()}
+    return validate(raw, source="<tiny demo>")
+
+
+@pytest.fixture(scope="module")
+def demo_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("demo")
+    return pipeline.run(tiny_demo(), out=out, progress=False)
+
+
+def test_demo_writes_every_file(demo_run):
+    out = demo_run.directory
+    s = json.loads((out / "summary.json").read_text())
+    assert s == json.loads(json.dumps(demo_run.summary))
+    for name in ("summary.json", "report.md", "modes.json", "frequency_energy.png", "mesh.vtu"):
+        assert (out / name).stat().st_size > 0, name
+    anims = s["files"]["animations"]
+    assert len(anims) == 2
+    for a in anims:
+        assert (out / a["gif"]).exists() and (out / a["pvd"]).exists() and (out / a["manifold"]).exists()
+        assert ("mp4" in a) == mp4_available()
+        if "mp4" in a:
+            assert (out / a["mp4"]).stat().st_size > 1000
+    # nothing hidden left behind (staging folders, temporary files)
+    assert not [p for p in out.rglob(".*")]
+    report = (out / "report.md").read_text()
+    for a in anims:
+        assert a["gif"] in report
+    assert "Linear frequencies" in report and "Nonsmooth modes" in report
+
+
+def test_summary_model_and_families(demo_run):
+    s = demo_run.summary
+    m = s["model"]
+    assert m["dim"] == 3 and m["mass_matrix"] == "lumped" and m["dofs"] > 1000
+    assert m["material"]["name"] == "Ti-6Al-4V"
+    f = np.array(m["linear_frequencies_hz"])
+    assert np.all(np.diff(f) > 0) and 300 < f[0] < 600  # a 15 cm titanium blade
+    # shift-invert Lanczos resolves the lowest modes: reduced = FE to 1e-8
+    assert s["reduction"]["relative_error_vs_fe"][0] < 1e-8
+    fams = s["families"]
+    assert {f["ipp"] for f in fams} == {1, 2}
+    assert sum(len(f["admissible_arcs"]) for f in fams) >= 2
+    T_unit = s["search"]["period_unit_s"]
+    assert T_unit == pytest.approx(1 / s["reduction"]["frequencies_hz"][0], rel=1e-12)
+    for fam in fams:
+        for arc in fam["admissible_arcs"]:
+            assert 0.9 * T_unit * (1 - 1e-9) <= arc["T_lo"] <= arc["T_hi"] <= 0.9999 * T_unit * (1 + 1e-9)
+    for a in s["files"]["animations"]:
+        assert a["verification"]["ok"] and a["verification"]["return_error"] < 1e-8
+        assert a["verification"]["impacts"] == a["ipp"]
+
+
+def test_modes_json_reloads(demo_run):
+    reduced = pipeline.build_reduced(*_demo_model_and_contact())
+    fams = pipeline.load_families(demo_run.directory / "modes.json", reduced.system)
+    assert len(fams) == len(demo_run.families)
+    for a, b in zip(fams, demo_run.families):
+        assert a.k == b.k and np.array_equal(a.T, b.T) and np.array_equal(a.admissible, b.admissible)
+
+
+def _demo_model_and_contact():
+    st = tiny_demo()
+    model = pipeline.build_model(st, pipeline.build_mesh(st))
+    return st, model, pipeline.build_contact(st, model)
+
+
+def test_time_series_reads_back(demo_run):
+    out = demo_run.directory
+    s = demo_run.summary
+    mesh = bc.load_mesh(out / "mesh.vtu")
+    node = s["contact"]["node"]
+    nu = np.array(s["contact"]["normal"])
+    d = s["contact"]["clearance_m"]
+    for a in s["files"]["animations"]:
+        times, files = read_time_series(out / a["pvd"])
+        assert len(files) == FRAMES and np.all(np.diff(times) > 0)
+        assert times[0] == 0.0 and times[-1] < a["T"]
+        # impacts are frames: t = 0 and each impact instant (moved onto its nearest frame)
+        for ti in np.mod(a["impact_times"], a["T"]):
+            assert np.min(np.abs(times - ti)) < 1e-12 * a["T"] or ti == 0.0
+        gaps = []
+        for t, f in zip(times, files):
+            frame = meshio.read(f)
+            assert frame.points.shape == mesh.points.shape
+            u = frame.point_data["displacement"]
+            v = frame.point_data["velocity"]
+            assert u.shape == (len(mesh.points), 3) and v.shape == u.shape
+            assert np.allclose(frame.point_data["displacement_magnitude"], np.linalg.norm(u, axis=1), rtol=1e-12)
+            assert float(frame.field_data["time"][0]) == t
+            assert float(frame.field_data["period"][0]) == a["T"]
+            gaps.append(float(u[node] @ nu))
+        gaps = np.array(gaps)
+        assert gaps[0] == pytest.approx(d, rel=1e-9)  # t = 0: the contact node is at the casing
+        assert gaps.max() <= d * (1 + 1e-9)           # never through it
+        # the clamped root does not move
+        root = mesh.group("root")
+        assert np.abs(meshio.read(files[3]).point_data["displacement"][root]).max() == 0.0
+
+
+def test_time_series_opens_in_pyvista(demo_run):
+    pv = pytest.importorskip("pyvista")
+    a = demo_run.summary["files"]["animations"][0]
+    reader = pv.get_reader(str(demo_run.directory / a["pvd"]))
+    times, _ = read_time_series(demo_run.directory / a["pvd"])
+    assert np.allclose(reader.time_values, times, rtol=1e-15, atol=0)
+    reader.set_active_time_value(reader.time_values[2])
+    data = reader.read()
+    block = data[0] if isinstance(data, pv.MultiBlock) else data
+    assert {"displacement", "velocity"} <= set(block.point_data.keys())
+    ref = meshio.read(read_time_series(demo_run.directory / a["pvd"])[1][2]).point_data["displacement"]
+    assert np.array_equal(np.asarray(block.point_data["displacement"]), ref)
+
+
+def test_manifold_samples(demo_run):
+    out = demo_run.directory
+    for a in demo_run.summary["files"]["animations"]:
+        m = meshio.read(out / a["manifold"])
+        n = int(m.point_data["orbit"].max()) + 1  # orbits re-solved on the arc (<= 10 asked; a failed one is skipped)
+        assert 8 <= n <= 10
+        assert len(m.points) == n * 16 and m.cells_dict["quad"].shape == ((n - 1) * 16, 4)
+        xc = m.point_data["contact_displacement"]
+        d = demo_run.summary["contact"]["clearance_m"]
+        assert xc.max() <= d * (1 + 1e-9) and xc.max() == pytest.approx(d, rel=1e-9)  # admissible, impacts at d
+        assert np.allclose(m.points[:, 0], xc)
+        T = m.point_data["period"]
+        assert np.all((T >= 0.9 * demo_run.summary["search"]["period_unit_s"] * (1 - 1e-9)))
+        E = m.point_data["energy"].reshape(n, 16)
+        assert np.allclose(E, E[:, :1], rtol=1e-12)  # one energy per orbit
+
+
+def test_gif_frames(demo_run):
+    out = demo_run.directory
+    for a in demo_run.summary["files"]["animations"]:
+        frames = iio.imread(out / a["gif"], index=None)
+        assert frames.shape[0] == FRAMES
+        assert frames.shape[1:3] == (WINDOW[1], WINDOW[0])
+        f = frames.astype(float)
+        assert all(fr.std() > 5.0 for fr in f)  # not blank
+        diffs = [np.abs(f[i] - f[0]).max() for i in range(1, FRAMES)]
+        assert max(diffs) > 50  # the blade moves
+        # impact frame 0: the casing is drawn red (more strongly red pixels than a flight frame)
+        red = [((fr[..., 0] > 180) & (fr[..., 1] < 140) & (fr[..., 2] < 140)).sum() for fr in f]
+        flight = [i for i in range(FRAMES) if not np.any(np.isclose(
+            i * a["T"] / FRAMES, np.mod(a["impact_times"], a["T"]), rtol=0, atol=a["T"] / FRAMES))]
+        assert red[0] > 2 * max(red[i] for i in flight)
+
+
+def test_frame_times_put_impacts_on_frames(two_dof):
+    orbits = bc.orbits_kipp(two_dof, 13.5, 2)
+    orbit = [o for o in orbits if o.admissible][0]
+    t, impact = pipeline.frame_times(orbit, 20)
+    assert t.size == 20 and np.all(np.diff(t) > 0) and t[0] == 0.0
+    assert impact.sum() == 2 and impact[0]
+    assert np.min(np.abs(t[impact][1:] - orbit.impact_times[0])) == 0.0
+
+
+def test_verify_rejects_a_wrong_orbit(two_dof):
+    orbit = bc.orbit_1ipp(two_dof, 5.0)
+    assert pipeline.verify(orbit)["ok"]
+    wrong = bc.make_orbit(two_dof, 5.0, orbit.impact_times, orbit.impulses * (1 + 1e-5))
+    check = pipeline.verify(wrong)
+    assert not check["ok"] and check["return_error"] > 1e-7
+
+
+# ----------------------------------------------------------------------------- user mesh, stage commands
+
+PLATE = """
+[study]
+name = "plate"
+[mesh]
+path = "meshes/plate.vtu"
+[fem]
+order = 1
+mass = "lumped"
+thickness = 0.002
+[contact]
+clearance = 1e-4
+[reduction]
+method = "modal"
+size = 10
+compare = [{method = "lanczos-si", size = 10}]
+[search]
+ipp = [1]
+periods = [0.5, 0.9999]
+[output]
+frames = 10
+window = [240, 180]
+formats = ["gif", "vtu", "png"]
+"""
+
+
+@pytest.fixture(scope="module")
+def plate_study(tmp_path_factory):
+    d = tmp_path_factory.mktemp("plate")
+    f = d / "plate.toml"
+    f.write_text(PLATE.replace("meshes/plate.vtu", str(ROOT / "meshes" / "plate.vtu")))
+    return f
+
+
+def test_user_mesh_study_cli(plate_study, tmp_path, capsys):
+    out = tmp_path / "run"
+    assert main(["run", str(plate_study), "--out", str(out), "--quiet", "--no-progress"]) == 0
+    assert capsys.readouterr().out.strip() == str(out / "report.md")
+    s = json.loads((out / "summary.json").read_text())
+    assert s["model"]["dim"] == 2 and s["model"]["dofs"] == 1084
+    assert s["model"]["mesh"]["source"].endswith("plate.vtu")
+    assert len(s["compare"]) == 1 and s["compare"][0]["method"] == "lanczos-si"
+    # modal (10 modes) vs FE: the lowest frequency to round-off
+    assert s["reduction"]["relative_error_vs_fe"][0] < 1e-9
+    anims = s["files"]["animations"]
+    assert len(anims) == 2 and all("mp4" not in a for a in anims)  # mp4 not asked for
+    for a in anims:
+        assert a["verification"]["ok"]
+        frames = iio.imread(out / a["gif"], index=None)
+        assert frames.shape == (10, 180, 240, 3)
+
+    # the same analysis through the stage commands
+    st = tmp_path / "stages"
+    st.mkdir()
+    run = lambda *args: main([*args, "--quiet", "--no-progress"])
+    assert run("mesh", str(plate_study), "-o", str(st / "plate.inp")) == 0
+    assert run("assemble", str(plate_study), "--mesh", str(st / "plate.inp"), "-o", str(st / "model.npz")) == 0
+    assert run("reduce", str(plate_study), "--model", str(st / "model.npz"), "-o", str(st / "red.npz")) == 0
+    assert run("modes", str(plate_study), "--reduced", str(st / "red.npz"), "-o", str(st / "modes.json"),
+               "--plot", str(st / "fe.png")) == 0
+    assert run("animate", str(plate_study), "--reduced", str(st / "red.npz"), "--modes", str(st / "modes.json"),
+               "--out", str(st / "anim")) == 0
+    modes = json.loads((st / "modes.json").read_text())
+    ref = json.loads((out / "modes.json").read_text())
+    assert len(modes["families"]) == len(ref["families"])
+    for a, b in zip(modes["families"], ref["families"]):
+        Ta = np.array([o["T"] for o in a["orbits"]])
+        Tb = np.array([o["T"] for o in b["orbits"]])
+        assert np.allclose(Ta, Tb, rtol=1e-12)
+        assert [x["T_lo"] for x in a["arcs"]] == pytest.approx([x["T_lo"] for x in b["arcs"]], rel=1e-9)
+    assert sorted(p.name for p in (st / "anim" / "animations").iterdir()) == \
+        sorted(Path(a["gif"]).name for a in anims)
+
+
+def test_stage_modes_from_user_matrices(plate_study, tmp_path):
+    system = bc.chain(3, k=1.0, m=1 / 3, gap=1.0)
+    np.savez(tmp_path / "sys.npz", M=system.M.toarray(), K=system.K.toarray(), w=system.w, gap=1.0)
+    study = tmp_path / "s.toml"
+    study.write_text(PLATE.replace("meshes/plate.vtu", str(ROOT / "meshes" / "plate.vtu")))
+    code = main(["modes", str(study), "--matrices", str(tmp_path / "sys.npz"), "-o", str(tmp_path / "m.json"),
+                 "--quiet", "--no-progress"])
+    assert code == 0
+    data = json.loads((tmp_path / "m.json").read_text())
+    assert data["system_dofs"] == 3 and data["families"][0]["ipp"] == 1
+
+
+def test_failed_run_keeps_previous_results(plate_study, tmp_path, monkeypatch):
+    st = loads(plate_study.read_text(), base=plate_study.parent)
+    out = tmp_path / "out"
+    pipeline.run(st, out=out, progress=False)
+    before = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    from bladecase import viz
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("renderer crashed")
+
+    monkeypatch.setattr(viz, "animate", broken)
+    with pytest.raises(RuntimeError, match="renderer crashed"):
+        pipeline.run(st, out=out, progress=False)
+    after = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    assert after == before
+
+
+def test_model_and_reduced_files_round_trip(tmp_path):
+    mesh = bc.load_mesh(ROOT / "meshes" / "plate.msh")
+    model = bc.assemble(mesh, "Ti-6Al-4V", order=2, thickness=0.002)
+    save_model(model, tmp_path / "m.npz")
+    back = load_model(tmp_path / "m.npz")
+    assert (abs(back.K - model.K)).max() == 0 and (abs(back.M - model.M)).max() == 0
+    assert back.total_mass == model.total_mass and np.array_equal(back.dofs.fe_index, model.dofs.fe_index)
+    contact = bc.Contact(int(mesh.group("contact")[0]), None, 1e-4)
+    for method, size in (("lanczos-si", 8), ("craig-bampton", 5)):
+        r = reduce(model, contact, method, size)
+        save_reduced(r, tmp_path / "r.npz")
+        r2 = load_reduced(tmp_path / "r.npz")
+        o = bc.orbit_1ipp(r.system, 0.97 * r.system.spectrum.periods[0])
+        o2 = bc.orbit_1ipp(r2.system, o.T)
+        assert o2.energy == o.energy
+        t = np.linspace(0, o.T, 5)
+        assert np.array_equal(r.expand(o, t)[0], r2.expand(o2, t)[0])
+    with pytest.raises(ValueError, match="not a bladecase reduced-model file"):
+        load_reduced(tmp_path / "m.npz")
+    with pytest.raises(ValueError, match="not a bladecase FE model file"):
+        load_model(tmp_path / "r.npz")
