@@ -42,3 +42,9 @@ __all__ += [
 from .reduction import FULL_LIMIT, ReducedModel, reduce
 
 __all__ += ["FULL_LIMIT", "ReducedModel", "reduce"]
+
+# Studies: a TOML file through every stage, and the results (animations, VTK, report).
+from .pipeline import RunResult, run
+from .study import Study, StudyError, demo_study, load_study
+
+__all__ += ["RunResult", "Study", "StudyError", "demo_study", "load_study", "run"]

@@ -242,6 +242,8 @@ def _length(x: float) -> str:
 def _render(pts, mesh, dim, warped, mag, umax, corners, contact_node, impact, phase, title, texts,
             window_size, size, bounds, normal, e1):
     """The ``(F, h, w, 3)`` uint8 frames, rendered with one plotter whose actors are updated in place."""
+    if not os.environ.get("DISPLAY"):  # headless: go straight to EGL rather than failing over from X11 noisily
+        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     import pyvista as pv
 
     body = np.asarray(mesh.cells[mesh.body_type])[:, : dim + 1]
