@@ -85,6 +85,19 @@ def free_nodes(model: FEModel) -> np.ndarray:
     return np.unique(nodes[nodes >= 0])
 
 
+def _in_group(model: FEModel, nodes: np.ndarray, group: str | None) -> np.ndarray:
+    """``nodes`` restricted to mesh group ``group`` (all of them for ``None``)."""
+    if group is None:
+        return nodes
+    members = model.mesh.group(group)
+    nodes = nodes[np.isin(nodes, members)]
+    if nodes.size == 0:
+        raise ValueError(
+            f"group {group!r} has no free node (all {len(members)} of its nodes are clamped or off the body)"
+        )
+    return nodes
+
+
 @dataclass(frozen=True)
 class Contact:
     """A unilateral contact ``ν·u_node <= gap`` on one mesh node.
@@ -135,16 +148,18 @@ class Contact:
 
     @classmethod
     def nearest(
-        cls, model: FEModel, point: Sequence[float], normal: Sequence[float] | None = None, gap: float | None = None
+        cls, model: FEModel, point: Sequence[float], normal: Sequence[float] | None = None,
+        gap: float | None = None, group: str | None = None,
     ) -> "Contact":
         """The contact on the free node of ``model`` nearest ``point`` (lowest index on a tie).
 
         ``point`` has ``model.dim`` coordinates (``(x, y, 0)`` is accepted in 2-D).
+        ``group``: search only the free nodes of this mesh group.
         """
         _check_model(model)
         dim = model.dim
         p = _in_dim("point", _finite_vector("point", point), dim)
-        nodes = free_nodes(model)
+        nodes = _in_group(model, free_nodes(model), group)
         dist = np.linalg.norm(model.mesh.points[nodes, :dim] - p, axis=1)
         return cls.at(model, int(nodes[np.argmin(dist)]), normal, gap)
 
@@ -167,14 +182,7 @@ class Contact:
         _check_model(model)
         dim = model.dim
         u = _in_dim("direction", _unit("direction", direction), dim)
-        nodes = free_nodes(model)
-        if group is not None:
-            members = model.mesh.group(group)
-            nodes = nodes[np.isin(nodes, members)]
-            if nodes.size == 0:
-                raise ValueError(
-                    f"group {group!r} has no free node (all {len(members)} of its nodes are clamped or off the body)"
-                )
+        nodes = _in_group(model, free_nodes(model), group)
         reach = model.mesh.points[nodes, :dim] @ u
         return cls.at(model, int(nodes[np.argmax(reach)]), normal, gap)
 

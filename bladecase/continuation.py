@@ -571,7 +571,7 @@ def _bisect_curve(curve: _Curve, z_in, z_out, maxiter: int = 80) -> tuple[float,
 
 
 def _one_ipp_families(system, T_range, scan, refine) -> list[Family]:
-    """k = 1: the family is the 1-ipp backbone, one family per resonance-free stretch."""
+    """k = 1: the family is the 1-ipp backbone (one family; its admissible arcs never span a resonance)."""
     from .scan import backbone
 
     bb = backbone(system, np.linspace(T_range[0], T_range[1], max(scan, 200)))

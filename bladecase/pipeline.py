@@ -45,9 +45,9 @@ def build_mesh(study: Study, path: str | os.PathLike | None = None) -> Mesh:
     The clamp group and, when the contact is picked by group, the contact group must exist.
     """
     need = [study["fem"]["clamp"]]
-    c = study["contact"]
-    if c["node"] is None and c["nearest"] is None:
-        need.append(c["group"] if c["farthest"] is None or c["group"] != "contact" else "tip")
+    group = contact_group(study)
+    if group is not None:
+        need.append(group)
     if study.parametric:
         g = study["geometry"]
         try:
@@ -92,21 +92,39 @@ def build_model(study: Study, mesh: Mesh) -> FEModel:
                     thickness=f["thickness"], plane=f["plane"])
 
 
+def contact_group(study: Study) -> str | None:
+    """The mesh group ``[contact]`` selects from (``None``: a node index, or every free node)."""
+    c = study["contact"]
+    if c["node"] is not None:
+        return None
+    if c["farthest"] is not None:
+        return c["group"] or "tip"
+    if c["nearest"] is not None:
+        return c["group"]
+    return c["group"] or "contact"
+
+
 def build_contact(study: Study, model: FEModel) -> Contact:
-    """The contact of ``[contact]`` on ``model`` (node checked to be free)."""
+    """The contact of ``[contact]`` on ``model`` (node checked to be free).
+
+    ``node`` → that node; ``farthest`` → the free node of ``group`` (default
+    ``tip``) farthest along the direction; ``nearest`` → the free node nearest
+    the point (within ``group`` if given); otherwise the node of the one-node
+    ``group`` (default ``contact``).
+    """
     c = study["contact"]
     normal, gap = c["normal"], c["clearance"]
+    group = contact_group(study)
     try:
         if c["node"] is not None:
             return Contact.at(model, c["node"], normal, gap)
         if c["farthest"] is not None:
-            group = "tip" if c["group"] == "contact" and "contact" not in model.mesh.groups else c["group"]
             return Contact.farthest(model, c["farthest"], normal, gap, group=group)
         if c["nearest"] is not None:
-            return Contact.nearest(model, c["nearest"], normal, gap)
-        nodes = model.mesh.group(c["group"])
+            return Contact.nearest(model, c["nearest"], normal, gap, group=group)
+        nodes = model.mesh.group(group)
         if len(nodes) != 1:
-            raise StudyError(f"[contact] group: group {c['group']!r} has {len(nodes)} nodes; the contact is one "
+            raise StudyError(f"[contact] group: group {group!r} has {len(nodes)} nodes; the contact is one "
                              "node: name a one-node group, or add farthest = [dx, dy, dz] or nearest = [x, y, z]")
         return Contact.at(model, int(nodes[0]), normal, gap)
     except StudyError:
@@ -140,10 +158,15 @@ def period_unit(study: Study, system: LinearSystem) -> tuple[float, str]:
     return float(2 * np.pi / omega[j - 1]), unit
 
 
-def search(study: Study, system: LinearSystem, progress: bool = False) -> list[Family]:
-    """Every family of every ``[search] ipp`` in the study's period range."""
+def search(study: Study, system: LinearSystem, progress: bool = False, unit: float | None = None) -> list[Family]:
+    """Every family of every ``[search] ipp`` in the study's period range.
+
+    ``unit``: seconds per period unit (default: from ``system``; comparison
+    models pass the primary model's, so that every model searches the same
+    periods).
+    """
     s = study["search"]
-    scale, _ = period_unit(study, system)
+    scale = period_unit(study, system)[0] if unit is None else unit
     T_range = (s["periods"][0] * scale, s["periods"][1] * scale)
     families: list[Family] = []
     for k in s["ipp"]:
@@ -242,7 +265,6 @@ def choose_orbits(study: Study, families: list[Family], unit: float) -> list[Cho
     # Widest arcs first, one per family; then further arcs of the same families if fewer families than asked.
     order = [x for x in arcs if x[1] not in {y[1] for y in arcs[:arcs.index(x)]}]
     order += [x for x in arcs if x not in order]
-    used: set[tuple[int, int]] = set()
     for width, i, n in order:
         if len(chosen) >= o["animate"]:
             break
@@ -254,7 +276,6 @@ def choose_orbits(study: Study, families: list[Family], unit: float) -> list[Cho
             if not candidates:
                 continue
             orbit = candidates[len(candidates) // 2]
-        used.add((i, n))
         chosen.append(Choice(i, orbit))
     return chosen
 
@@ -403,7 +424,7 @@ def run(study: Study, out: str | os.PathLike | None = None, progress: bool = Tru
         stage("search")
         unit, unit_name = period_unit(study, reduced.system)
         families = search(study, reduced.system, progress=progress)
-        compare_families = [search(study, r.system, progress=progress) for r in compares]
+        compare_families = [search(study, r.system, progress=progress, unit=unit) for r in compares]
         write_json(staging / "modes.json", families_document(families, reduced.system))
         files["modes"] = "modes.json"
         done("search")

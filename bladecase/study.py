@@ -173,10 +173,11 @@ SCHEMA: dict[str, dict[str, Key]] = {
     "contact": {
         "clearance": Key(_NUM, REQUIRED, "Clearance d between the contact node at rest and the casing (m).",
                          lambda v: None if math.isfinite(v) and v > 0 else "must be > 0 (metres)"),
-        "group": Key(_STR, "contact", "Mesh group holding the contact node (a one-node group), or the group "
-                     "searched by 'farthest'/'nearest'."),
+        "group": Key(_STR, None, "Mesh group of the contact node: alone, a one-node group (default "
+                     "'contact'); with 'farthest', the group searched (default 'tip'); with 'nearest', the group "
+                     "searched (default: every free node)."),
         "node": Key(_INT, None, "Mesh node index of the contact (overrides group).", _int_at_least(0)),
-        "farthest": Key(_LIST, None, "Pick the node of 'group' (default 'tip' here) farthest along this "
+        "farthest": Key(_LIST, None, "Pick the free node of 'group' (default 'tip') farthest along this "
                         "direction, e.g. [-1, 0, 0].", _vector),
         "nearest": Key(_LIST, None, "Pick the free node nearest this point (within 'group' if given).", _vector),
         "normal": Key(_LIST, None, "Casing normal, from the blade towards the casing; default: radial "
@@ -385,15 +386,7 @@ def _cross_checks(c: dict) -> None:
     r = c["reduction"]
     if r["method"] == "full":
         r["size"] = None
-    o = c["output"]
-    if "mp4" in o["formats"] and "gif" not in o["formats"]:
-        pass  # MP4 alone is fine
-    if c.get("geometry", {}).get("kind") == "plate" or "mesh" in c:
-        pass  # 2-D thickness is checked once the mesh is known (pipeline)
-    s = c["search"]
-    if s["period_unit"] == "s" and s["periods"][1] > 10.0:
-        raise StudyError(f"[search] periods: {s['periods']} seconds is not a blade's vibration period; "
-                         "did you mean period_unit = 'T1'?")
+    o, s = c["output"], c["search"]
     for i, item in enumerate(o["orbits"]):
         if item["ipp"] not in s["ipp"]:
             raise StudyError(f"[output] orbits: item {i} asks for ipp = {item['ipp']}, which [search] ipp = "

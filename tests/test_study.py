@@ -85,7 +85,6 @@ BAD = [
     ("bad periods", lambda r: r["search"].update(periods=[1.0, 0.9]), "[search] periods"),
     ("bad ipp", lambda r: r["search"].update(ipp=[0]), "[search] ipp"),
     ("bad unit", lambda r: r["search"].update(period_unit="ms"), "[search] period_unit"),
-    ("seconds too long", lambda r: r["search"].update(period_unit="s", periods=[1.0, 20.0]), "[search] periods"),
     ("bad format", lambda r: r["output"].update(formats=["gif", "avi"]), "[output] formats"),
     ("bad window", lambda r: r["output"].update(window=[10, 10]), "[output] window"),
     ("bad scale", lambda r: r["output"].update(scale="big"), "[output] scale"),
@@ -130,6 +129,8 @@ def _write(tmp_path, text: str) -> Path:
     (lambda t: t.replace('mass = "lumped"', 'mass = "lumped"\nclamp = "hub"'), "[fem] clamp: the mesh"),
     (lambda t: t.replace("thickness = 0.002\n", ""), "[fem] thickness: required for a 2-D"),
     (lambda t: t.replace("clearance = 1e-4", 'clearance = 1e-4\ngroup = "tip"'), "[contact] group: group 'tip' has"),
+    (lambda t: t.replace("clearance = 1e-4", 'clearance = 1e-4\nfarthest = [1, 0]\ngroup = "hub"'),
+     "[contact] group: the mesh"),
     (lambda t: t.replace("size = 10", "size = 5000"), "[reduction]"),
 ])
 def test_cli_run_fails_fast_and_writes_nothing(tmp_path, capsys, edit, words):
@@ -147,3 +148,34 @@ def test_cli_demo_print_study(capsys):
     assert main(["demo", "--print-study"]) == 0
     text = capsys.readouterr().out
     assert loads(text).config == demo_study().config
+
+
+@pytest.mark.parametrize("lines, expect", [
+    ("", "contact"),                                   # the one-node group 'contact'
+    ('node = 4', 4),
+    ('farthest = [1, 0]', "max-x tip"),                # searches 'tip' by default, not the 'contact' group
+    ('nearest = [0.0, 0.05]', "nearest all"),
+    ('nearest = [0.0, 0.05]\ngroup = "tip"', "nearest tip"),
+])
+def test_contact_selectors(lines, expect):
+    import numpy as np
+
+    from bladecase import pipeline
+
+    st = loads(PLATE.replace("clearance = 1e-4", "clearance = 1e-4\n" + lines), base=ROOT)
+    mesh = pipeline.build_mesh(st)
+    model = pipeline.build_model(st, mesh)
+    node = pipeline.build_contact(st, model).node
+    pts, tip = mesh.points, mesh.group("tip")
+    free = np.unique(model.dofs.node[model.dofs.node >= 0])
+    if expect == "contact":
+        assert node == mesh.group("contact")[0]
+    elif expect == "max-x tip":
+        assert node in tip and pts[node, 0] == pts[tip, 0].max()
+    elif expect == "nearest all":
+        dist = np.linalg.norm(pts[free, :2] - [0.0, 0.05], axis=1)
+        assert node == free[np.argmin(dist)] and pts[node, 1] < 0.09  # mid-span
+    elif expect == "nearest tip":
+        assert node in tip and pts[node, 1] == pytest.approx(0.1)
+    else:
+        assert node == expect
