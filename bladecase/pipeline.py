@@ -320,8 +320,17 @@ def _staging(out: Path) -> Path:
     return Path(tempfile.mkdtemp(prefix=".bladecase-run-", dir=out))
 
 
-def _publish(staging: Path, out: Path) -> None:
-    """Move every entry of ``staging`` into ``out`` (replacing older results of the same name)."""
+#: Top-level result names a run owns in its output directory (older ones it did not write are removed).
+RUN_RESULTS = ("summary.json", "report.md", "modes.json", "frequency_energy.png", "mesh.vtu", "animations", "vtk")
+
+
+def _publish(staging: Path, out: Path, owned: tuple[str, ...] = ()) -> None:
+    """Move every entry of ``staging`` into ``out`` (replacing older results of the same name);
+    remove the ``owned`` names this run did not write (stale results of an older run)."""
+    for name in owned:
+        stale = out / name
+        if not (staging / name).exists() and stale.exists():
+            shutil.rmtree(stale) if stale.is_dir() and not stale.is_symlink() else stale.unlink()
     for entry in sorted(staging.iterdir()):
         target = out / entry.name
         if target.is_dir() and not target.is_symlink():
@@ -471,7 +480,7 @@ def run(study: Study, out: str | os.PathLike | None = None, progress: bool = Tru
     try:
         write_json(staging / "summary.json", summary)
         write_text(staging / "report.md", report(summary))
-        _publish(staging, out)
+        _publish(staging, out, RUN_RESULTS)
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
         raise
@@ -502,7 +511,7 @@ def animate_families(study: Study, reduced: ReducedModel, families: list[Family]
     staging = _staging(out)
     try:
         entries = _animations(study, reduced, families, staging, progress)
-        _publish(staging, out)
+        _publish(staging, out, ("animations", "vtk"))
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
         raise

@@ -335,3 +335,18 @@ def test_model_and_reduced_files_round_trip(tmp_path):
         load_reduced(tmp_path / "m.npz")
     with pytest.raises(ValueError, match="not a bladecase FE model file"):
         load_model(tmp_path / "r.npz")
+
+
+def test_rerun_replaces_results_and_drops_stale_ones(plate_study, tmp_path):
+    st = loads(plate_study.read_text(), base=plate_study.parent)
+    out = tmp_path / "out"
+    pipeline.run(st, out=out, progress=False)
+    (out / "notes.txt").write_text("mine")  # a user's file: never touched
+    raw = copy.deepcopy(st.config)
+    raw["output"]["formats"] = ["gif"]
+    raw = {k: {kk: vv for kk, vv in v.items() if vv is not None} for k, v in raw.items()}
+    raw["mesh"]["path"] = str(st.mesh_path())
+    pipeline.run(validate(raw), out=out, progress=False)
+    names = sorted(p.name for p in out.iterdir())
+    assert names == ["animations", "mesh.vtu", "modes.json", "notes.txt", "report.md", "summary.json"]
+    assert (out / "notes.txt").read_text() == "mine"

@@ -179,3 +179,14 @@ def test_contact_selectors(lines, expect):
         assert node in tip and pts[node, 1] == pytest.approx(0.1)
     else:
         assert node == expect
+
+
+def test_readme_study_example_is_valid():
+    import re
+
+    text = (ROOT / "README.md").read_text()
+    blocks = [b for b in re.findall(r"```toml\n(.*?)```", text, flags=re.S) if "[study]" in b]
+    assert blocks, "README has no study example"
+    for b in blocks:
+        st = loads(b, base=ROOT)
+        assert st.mesh_path().exists()
