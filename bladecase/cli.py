@@ -193,13 +193,16 @@ def _setup(args) -> bool:
     import logging
 
     logger = logging.getLogger("bladecase")
-    if not any(getattr(h, "_bladecase", False) for h in logger.handlers):
+    handler = next((h for h in logger.handlers if getattr(h, "_bladecase", False)), None)
+    if handler is None:
         handler = logging.StreamHandler(sys.stderr)
         handler.setFormatter(logging.Formatter("bladecase: %(message)s"))
         handler._bladecase = True
         logger.addHandler(handler)
         logger.propagate = False
-    logger.setLevel(logging.WARNING if args.quiet else logging.INFO)
+    handler.stream = sys.stderr  # the current stderr (no flush of an old, possibly closed one)
+    handler.setLevel(logging.WARNING if args.quiet else logging.INFO)
+    logger.setLevel(logging.INFO)
     return not args.no_progress and not args.quiet and sys.stderr.isatty()
 
 

@@ -385,7 +385,8 @@ def nonsmooth_mode(
     Returns
     -------
     list of Family
-        Each family's orbits in curve order, certified, with admissible arcs.
+        Each family's orbits in curve order (all within ``T_range``), certified,
+        with admissible arcs.
         A family crossing a later scan period is not started again there.
     """
     if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
@@ -422,6 +423,8 @@ def nonsmooth_mode(
         zs = bwd[::-1] + [z0] + fwd
         orbits = []
         for z in zs:
+            if not T_lo <= z[k - 1] * curve.T0 <= T_hi:
+                continue  # the step that left the period range: not part of the family
             try:
                 orbits.append(_polished_orbit(curve, z))
             except (ValueError, np.linalg.LinAlgError):
@@ -430,18 +433,8 @@ def nonsmooth_mode(
             if not covered[m] and _passes(curve, zs, starts[m]):
                 covered[m] = True
         arcs = _arcs(curve, [curve.join(o.impact_times) for o in orbits], orbits, refine)
-        arcs = [_clip(a, T_lo, T_hi) for a in arcs if a.T_hi >= T_lo and a.T_lo <= T_hi]
         families.append(Family(system=system, k=k, orbits=orbits, arcs=arcs))
     return families
-
-
-def _clip(arc: Arc, T_lo: float, T_hi: float) -> Arc:
-    """The arc restricted to the period range (a curve's last point may lie just outside it);
-    a clipped end is not an admissibility boundary."""
-    if arc.T_lo >= T_lo and arc.T_hi <= T_hi:
-        return arc
-    return Arc(arc.start, arc.stop, max(arc.T_lo, T_lo), min(arc.T_hi, T_hi),
-               arc.refined_lo and arc.T_lo >= T_lo, arc.refined_hi and arc.T_hi <= T_hi)
 
 
 def _polished_orbit(curve: _Curve, z) -> PeriodicOrbit:

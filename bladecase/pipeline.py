@@ -321,7 +321,8 @@ def _staging(out: Path) -> Path:
 
 
 #: Top-level result names a run owns in its output directory (older ones it did not write are removed).
-RUN_RESULTS = ("summary.json", "report.md", "modes.json", "frequency_energy.png", "mesh.vtu", "animations", "vtk")
+RUN_RESULTS = ("summary.json", "report.md", "run.log", "modes.json", "frequency_energy.png", "mesh.vtu", "animations",
+               "vtk")
 
 
 def _publish(staging: Path, out: Path, owned: tuple[str, ...] = ()) -> None:
@@ -378,7 +379,7 @@ def run(study: Study, out: str | os.PathLike | None = None, progress: bool = Tru
     """Run the whole study; write every result into the output directory.
 
     Files (in ``out``, default ``[output] directory``): ``summary.json``,
-    ``report.md``, ``modes.json`` (every family, every orbit),
+    ``report.md``, ``run.log``, ``modes.json`` (every family, every orbit),
     ``frequency_energy.png``, ``mesh.vtu`` (the mesh with its groups),
     ``animations/<stem>.gif`` / ``.mp4``, ``vtk/<stem>.pvd`` with
     ``vtk/<stem>/`` (one ``.vtu`` per frame) and ``vtk/<stem>_manifold.vtu``.
@@ -389,6 +390,14 @@ def run(study: Study, out: str | os.PathLike | None = None, progress: bool = Tru
     o = study["output"]
     t_start = time.perf_counter()
     staging = _staging(out)
+    logfile = logging.FileHandler(staging / "run.log", encoding="utf-8")
+    logfile.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(message)s"))
+    logfile.setLevel(logging.INFO)
+    level = log.level
+    log.addHandler(logfile)
+    if log.getEffectiveLevel() > logging.INFO:
+        log.setLevel(logging.INFO)  # the file gets the whole log; console handlers keep their own levels
+    log.info("study %s (%s) → %s", study.name, study.source, out)
     files: dict[str, object] = {}
     timings: dict[str, float] = {}
     stages = tqdm(total=6, desc="bladecase run", unit="stage", disable=not progress, leave=False)
@@ -449,9 +458,11 @@ def run(study: Study, out: str | os.PathLike | None = None, progress: bool = Tru
         done("render")
     except BaseException:
         stages.close()
+        _detach(logfile, level)
         shutil.rmtree(staging, ignore_errors=True)
         raise
     stages.close()
+    files["log"] = "run.log"
 
     summary = {
         "study": study.name,
@@ -478,13 +489,14 @@ def run(study: Study, out: str | os.PathLike | None = None, progress: bool = Tru
     }
     summary["timings_s"]["total"] = round(time.perf_counter() - t_start, 3)
     try:
+        log.info("results in %s (%.1f s)", out, summary["timings_s"]["total"])
+        _detach(logfile, level)
         write_json(staging / "summary.json", summary)
         write_text(staging / "report.md", report(summary))
         _publish(staging, out, RUN_RESULTS)
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
         raise
-    log.info("results in %s (%.1f s)", out, summary["timings_s"]["total"])
     return RunResult(directory=out, summary=summary, families=families)
 
 
@@ -548,6 +560,12 @@ def verify(orbit: PeriodicOrbit) -> dict:
     err = max(np.abs(traj.x[:, last] - x0).max() / sx, np.abs(traj.v[:, last] - v0).max() / sv,
               abs(traj.impact_times[last] - T) / T)
     return {"return_error": float(err), "impacts": int(hits.size), "ok": bool(err <= VERIFY_RTOL and hits.size == k)}
+
+
+def _detach(handler: logging.Handler, level: int) -> None:
+    log.removeHandler(handler)
+    handler.close()
+    log.setLevel(level)
 
 
 def _version() -> str:

@@ -59,7 +59,7 @@ def test_demo_writes_every_file(demo_run):
     out = demo_run.directory
     s = json.loads((out / "summary.json").read_text())
     assert s == json.loads(json.dumps(demo_run.summary))
-    for name in ("summary.json", "report.md", "modes.json", "frequency_energy.png", "mesh.vtu"):
+    for name in ("summary.json", "report.md", "run.log", "modes.json", "frequency_energy.png", "mesh.vtu"):
         assert (out / name).stat().st_size > 0, name
     anims = s["files"]["animations"]
     assert len(anims) == 2
@@ -348,5 +348,25 @@ def test_rerun_replaces_results_and_drops_stale_ones(plate_study, tmp_path):
     raw["mesh"]["path"] = str(st.mesh_path())
     pipeline.run(validate(raw), out=out, progress=False)
     names = sorted(p.name for p in out.iterdir())
-    assert names == ["animations", "mesh.vtu", "modes.json", "notes.txt", "report.md", "summary.json"]
+    assert names == ["animations", "mesh.vtu", "modes.json", "notes.txt", "report.md", "run.log", "summary.json"]
     assert (out / "notes.txt").read_text() == "mine"
+
+
+def test_explicit_orbit_requests(plate_study):
+    st = loads(plate_study.read_text(), base=plate_study.parent)
+    mesh = pipeline.build_mesh(st)
+    model = pipeline.build_model(st, mesh)
+    reduced = pipeline.build_reduced(st, model, pipeline.build_contact(st, model))
+    fams = pipeline.search(st, reduced.system)
+    unit, _ = pipeline.period_unit(st, reduced.system)
+    arc = max((a for f in fams for a in f.arcs), key=lambda a: a.T_hi - a.T_lo)
+    inside = 0.5 * (arc.T_lo + arc.T_hi) / unit
+    raw = copy.deepcopy(st.config)
+    raw["output"]["orbits"] = [{"ipp": 1, "T": inside}, {"ipp": 1, "T": 0.6}]
+    raw = {k: {kk: vv for kk, vv in v.items() if vv is not None} for k, v in raw.items()}
+    chosen = pipeline.choose_orbits(validate(raw, base=plate_study.parent), fams, unit)
+    assert len(chosen) == 2
+    assert chosen[0].orbit.T == pytest.approx(inside * unit, rel=1e-14) and chosen[0].orbit.admissible
+    # T = 0.6 T1 is not admissible: the nearest admissible stored orbit is taken
+    adm = [o.T for f in fams for o in f.orbits if o.admissible]
+    assert chosen[1].orbit.T == min(adm, key=lambda T: abs(T - 0.6 * unit))
