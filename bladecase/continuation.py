@@ -356,6 +356,7 @@ def nonsmooth_mode(
     max_points: int = 400,
     refine: bool = True,
     progress: bool = False,
+    resolution: int | None = None,
 ) -> list[Family]:
     """Follow every k-ipp family (nonsmooth mode) found in ``T_range``.
 
@@ -381,6 +382,9 @@ def nonsmooth_mode(
         (relative precision ``ARC_RTOL`` in ``T``).
     progress : bool
         Progress bar over the starting periods.
+    resolution : int or None
+        Grid points per impact time of the k >= 3 multistart search at each
+        starting period (:func:`orbits_kipp`); ``None`` for its default.
 
     Returns
     -------
@@ -405,7 +409,7 @@ def nonsmooth_mode(
     starts = []
     for T in it:
         try:
-            sols = orbits_kipp(system, T, k)
+            sols = orbits_kipp(system, T, k, resolution=resolution)
         except ValueError:
             continue
         starts.extend((T, o) for o in sols if o.repeats == 1)

@@ -172,7 +172,7 @@ def search(study: Study, system: LinearSystem, progress: bool = False, unit: flo
     for k in s["ipp"]:
         t0 = time.perf_counter()
         found = nonsmooth_mode(system, k, T_range, scan=s["scan"], step=s["step"], max_points=s["max_points"],
-                               progress=progress)
+                               progress=progress, resolution=s["resolution"])
         n_arcs = sum(len(f.arcs) for f in found)
         log.info("%d-ipp: %d families, %d admissible arcs (%.1f s)", k, len(found), n_arcs, time.perf_counter() - t0)
         families.extend(found)

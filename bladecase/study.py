@@ -197,6 +197,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
                            "reduced model that sees the contact.", _period_unit),
         "scan": Key(_INT, 24, "Starting periods scanned for k >= 2 (1 ipp scans max(scan, 200)).",
                     _int_at_least(2)),
+        "resolution": Key(_INT, None, "Grid points per impact time of the k >= 3 start search at each scanned "
+                          "period; default: 4 per period of the highest mode, clipped to [16, 48].",
+                          _int_at_least(4)),
         "step": Key(_NUM, 0.01, "Initial continuation step (scaled arclength).", _positive),
         "max_points": Key(_INT, 400, "Cap on continuation points per direction of each family.",
                           _int_at_least(2)),
