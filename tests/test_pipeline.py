@@ -41,7 +41,7 @@ WINDOW = (320, 240)
 
 def tiny_demo():
     c = copy.deepcopy(demo_study().config)
-    c["geometry"].update(size=0.006, tip_size=0.003)
+    c["geometry"].update(size=0.01, tip_size=0.005)
     c["reduction"]["size"] = 6
     c["search"]["scan"] = 4
     c["output"].update(frames=FRAMES, window=list(WINDOW), manifold_size=[10, 16])
@@ -79,10 +79,10 @@ def test_demo_writes_every_file(demo_run):
 def test_summary_model_and_families(demo_run):
     s = demo_run.summary
     m = s["model"]
-    assert m["dim"] == 3 and m["mass_matrix"] == "lumped" and m["dofs"] > 1000
+    assert m["dim"] == 3 and m["mass_matrix"] == "lumped" and m["order"] == 2 and m["dofs"] > 1000
     assert m["material"]["name"] == "Ti-6Al-4V"
     f = np.array(m["linear_frequencies_hz"])
-    assert np.all(np.diff(f) > 0) and 300 < f[0] < 600  # a 15 cm titanium blade
+    assert np.all(np.diff(f) > 0) and 150 < f[0] < 300  # a 15 cm titanium blade (converged P2: 213.6 Hz)
     # shift-invert Lanczos resolves the lowest modes: reduced = FE to 1e-8
     assert s["reduction"]["relative_error_vs_fe"][0] < 1e-8
     fams = s["families"]
@@ -125,7 +125,9 @@ def test_time_series_reads_back(demo_run):
         assert times[0] == 0.0 and times[-1] < a["T"]
         # impacts are frames: t = 0 and each impact instant (moved onto its nearest frame)
         for ti in np.mod(a["impact_times"], a["T"]):
-            assert np.min(np.abs(times - ti)) < 1e-12 * a["T"] or ti == 0.0
+            if min(ti, a["T"] - ti) <= 1e-12 * a["T"]:
+                continue  # t_k = T: the impact at t = 0
+            assert np.min(np.abs(times - ti)) < 1e-12 * a["T"]
         gaps = []
         for t, f in zip(times, files):
             frame = meshio.read(f)
