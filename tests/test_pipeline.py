@@ -372,3 +372,23 @@ def test_explicit_orbit_requests(plate_study):
     # T = 0.6 T1 is not admissible: the nearest admissible stored orbit is taken
     adm = [o.T for f in fams for o in f.orbits if o.admissible]
     assert chosen[1].orbit.T == min(adm, key=lambda T: abs(T - 0.6 * unit))
+
+
+def test_search_resolution_reaches_the_start_search(plate_study, monkeypatch):
+    from bladecase import continuation
+
+    seen = []
+    real = continuation.orbits_kipp
+
+    def spy(system, T, k, resolution=None):
+        seen.append(resolution)
+        return real(system, T, k, resolution=resolution)
+
+    monkeypatch.setattr(continuation, "orbits_kipp", spy)
+    raw = copy.deepcopy(loads(PLATE, base=ROOT).config)
+    raw["search"].update(ipp=[3], scan=2, resolution=20, periods=[0.9, 0.95])
+    raw = {k: {kk: vv for kk, vv in v.items() if vv is not None} for k, v in raw.items()}
+    st = validate(raw, base=ROOT)
+    system = bc.chain(3, k=1.0, m=1 / 3, gap=1.0)
+    pipeline.search(st, system)
+    assert seen == [20, 20]
