@@ -170,7 +170,8 @@ def _study_commands(sub) -> None:
     src = modes.add_mutually_exclusive_group(required=True)
     src.add_argument("--reduced", type=Path, metavar="REDUCED.npz")
     src.add_argument("--matrices", type=Path, metavar="FILE.npz",
-                     help="user system: arrays M, K (n×n), w (n,) or an integer contact dof, gap")
+                     help="user system: arrays M, K (n×n), w (n,) or an integer contact dof, gap; the study "
+                          "then needs only [search] (and [study])")
     modes.add_argument("-o", "--output", type=Path, required=True, metavar="MODES.json")
     modes.add_argument("--plot", type=Path, metavar="FILE.png", help="also write the frequency–energy plot")
     _progress_options(modes)
@@ -206,10 +207,10 @@ def _setup(args) -> bool:
     return not args.no_progress and not args.quiet and sys.stderr.isatty()
 
 
-def _study(path: Path):
+def _study(path: Path, model: bool = True):
     from .study import load_study
 
-    return load_study(path)
+    return load_study(path, model=model)
 
 
 def _cmd_run(args) -> int:
@@ -292,7 +293,7 @@ def _cmd_modes(args) -> int:
     from .pipeline import families_document, search
 
     progress = _setup(args)
-    study = _study(args.study)
+    study = _study(args.study, model=args.reduced is not None)  # with --matrices: [search] is enough
     if args.reduced is not None:
         from .reduction import load_reduced
 

@@ -332,8 +332,13 @@ def _geometry_section(raw: dict) -> dict:
     return out
 
 
-def validate(raw: dict, source: str = "<string>", base: str | os.PathLike | None = None) -> Study:
+def validate(raw: dict, source: str = "<string>", base: str | os.PathLike | None = None,
+             model: bool = True) -> Study:
     """Check a parsed study (a dict as from ``tomllib``) and fill in the defaults.
+
+    ``model=False`` is for studies that only drive the search on a given
+    system (``bladecase modes --matrices``): the blade (``[geometry]`` /
+    ``[mesh]``) and the contact clearance may then be left out.
 
     Raises
     ------
@@ -348,7 +353,7 @@ def validate(raw: dict, source: str = "<string>", base: str | os.PathLike | None
     if unknown:
         key = sorted(unknown)[0]
         raise StudyError(f"[{key}]: unknown section (valid: {', '.join(SCHEMA)})")
-    if ("geometry" in raw) == ("mesh" in raw):
+    if ("geometry" in raw) == ("mesh" in raw) and (model or "geometry" in raw):
         raise StudyError("[geometry] / [mesh]: give exactly one: a parametric blade ([geometry]) or a mesh "
                          "file ([mesh] path = ...)")
     config: dict[str, dict] = {}
@@ -368,6 +373,9 @@ def validate(raw: dict, source: str = "<string>", base: str | os.PathLike | None
             out[key] = _check_value(section, key, keys[key], value)
         for key, spec in keys.items():
             if key not in out:
+                if spec.default is REQUIRED and not model:
+                    out[key] = None  # not needed without a model
+                    continue
                 if spec.default is REQUIRED:
                     raise StudyError(f"[{section}] {key}: required ({spec.doc})")
                 out[key] = list(spec.default) if isinstance(spec.default, list) else spec.default
@@ -396,23 +404,25 @@ def _cross_checks(c: dict) -> None:
                              f"{s['ipp']} does not look for")
 
 
-def loads(text: str, source: str = "<string>", base: str | os.PathLike | None = None) -> Study:
-    """Parse and validate a study from TOML text."""
+def loads(text: str, source: str = "<string>", base: str | os.PathLike | None = None, model: bool = True) -> Study:
+    """Parse and validate a study from TOML text (``model``: see :func:`validate`)."""
     try:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise StudyError(f"{source}: not valid TOML: {exc}") from None
-    return validate(raw, source=source, base=base)
+    return validate(raw, source=source, base=base, model=model)
 
 
-def load_study(path: str | os.PathLike) -> Study:
-    """Read and validate a study file; relative paths in it are relative to its folder."""
+def load_study(path: str | os.PathLike, model: bool = True) -> Study:
+    """Read and validate a study file; relative paths in it are relative to its folder.
+
+    ``model=False``: a search-only study (see :func:`validate`)."""
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise StudyError(f"cannot read study file {str(path)!r}: {exc}") from None
-    return loads(text, source=str(path), base=path.resolve().parent)
+    return loads(text, source=str(path), base=path.resolve().parent, model=model)
 
 
 def demo_text() -> str:
