@@ -30,7 +30,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from .io import atomic_path
+from .io import atomic_path, replace_dir
 from .mesh import GROUP_PREFIX, Mesh
 
 #: Point-data names :func:`write_time_series` writes itself (plus ``group:<name>``).
@@ -160,7 +160,7 @@ def write_time_series(
         text = _pvd_text(times, [f"{stem}/{name}" for name in names])
         with atomic_path(pvd) as pvd_tmp:
             pvd_tmp.write_text(text, encoding="utf-8")
-            _swap_in(tmp, target)
+            replace_dir(tmp, target)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
@@ -246,23 +246,6 @@ def _make_ordinary(folder: Path) -> None:
     umask = os.umask(0)
     os.umask(umask)
     os.chmod(folder, 0o777 & ~umask)
-
-
-def _swap_in(new: Path, target: Path) -> None:
-    """Rename folder ``new`` to ``target``; an existing ``target`` is moved aside first, deleted after."""
-    if not os.path.lexists(target):
-        os.rename(new, target)
-        return
-    aside = Path(tempfile.mkdtemp(prefix=f".{target.name}.old-", dir=target.parent))
-    old = aside / target.name
-    os.rename(target, old)
-    try:
-        os.rename(new, target)
-    except BaseException:
-        os.rename(old, target)  # put the previous result back
-        shutil.rmtree(aside, ignore_errors=True)
-        raise
-    shutil.rmtree(aside, ignore_errors=True)
 
 
 # ----------------------------------------------------------------------------- manifold

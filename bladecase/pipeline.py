@@ -27,7 +27,7 @@ from .contact import Contact
 from .continuation import Arc, Family, nonsmooth_mode
 from .fem import FEModel, Material, assemble, natural_frequencies
 from .geometry import blade_mesh
-from .io import save_figure, write_json, write_text
+from .io import replace_dir, save_figure, write_json, write_text
 from .mesh import Mesh, load_mesh
 from .model import LinearSystem
 from .nsm import PeriodicOrbit
@@ -335,10 +335,7 @@ def _publish(staging: Path, out: Path, owned: tuple[str, ...] = ()) -> None:
     for entry in sorted(staging.iterdir()):
         target = out / entry.name
         if target.is_dir() and not target.is_symlink():
-            old = Path(tempfile.mkdtemp(prefix=f".{entry.name}.old-", dir=out))
-            os.replace(target, old / entry.name)
-            os.replace(entry, target)
-            shutil.rmtree(old, ignore_errors=True)
+            replace_dir(entry, target)
         else:
             os.replace(entry, target)
     staging.rmdir()
