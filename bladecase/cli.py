@@ -289,7 +289,7 @@ def _cmd_reduce(args) -> int:
 
 
 def _cmd_modes(args) -> int:
-    from .io import save_figure, write_json
+    from .io import write_json
     from .pipeline import families_document, search
 
     progress = _setup(args)
@@ -308,18 +308,7 @@ def _cmd_modes(args) -> int:
             print(f"family {i}: " + fam.table())
     print(f"{args.output}: {len(families)} families, {sum(len(f.arcs) for f in families)} admissible arcs")
     if args.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        from .plot import frequency_energy
-
-        if not families:
-            raise ValueError("nothing to plot: no family found")
-        fig = frequency_energy(families)
-        save_figure(fig, args.plot, dpi=150)
-        plt.close(fig)
+        _save_plot(families, args.plot)
     return 0
 
 
@@ -365,7 +354,7 @@ def _load_system(args):
 
 
 def _cmd_backbone(args) -> int:
-    from .io import save_figure, write_json, write_text
+    from .io import write_json, write_text
     from .scan import backbone
 
     system = _load_system(args)
@@ -400,22 +389,28 @@ def _cmd_backbone(args) -> int:
     if args.json:
         write_json(args.json, data)
     if args.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        from .plot import frequency_energy
-
-        if not curves:
-            raise ValueError("nothing to plot: no family found")
-        fig = frequency_energy(curves)
-        save_figure(fig, args.plot, dpi=150)
-        plt.close(fig)
+        _save_plot(curves, args.plot)
     for label, path in (("table", args.table), ("json", args.json), ("plot", args.plot)):
         if path:
             print(f"wrote {label}: {path}", file=sys.stderr)
     return 0
+
+
+def _save_plot(curves, path: Path) -> None:
+    """The frequency–energy plot of backbones/families, written atomically."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .io import save_figure
+    from .plot import frequency_energy
+
+    if not curves:
+        raise ValueError("nothing to plot: no family found")
+    fig = frequency_energy(curves)
+    save_figure(fig, path, dpi=150)
+    plt.close(fig)
 
 
 def _family_table(family) -> str:
