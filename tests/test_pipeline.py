@@ -26,6 +26,8 @@ import numpy as np
 import pytest
 
 import bladecase as bc
+from _studies import PLATE as PLATE_BASE
+from _studies import ROOT, absolute, as_raw
 from bladecase import pipeline
 from bladecase.cli import main
 from bladecase.export import read_time_series
@@ -34,7 +36,6 @@ from bladecase.reduction import load_reduced, reduce, save_reduced
 from bladecase.study import demo_study, loads, validate
 from bladecase.viz import mp4_available
 
-ROOT = Path(__file__).resolve().parent.parent
 FRAMES = 8
 WINDOW = (320, 240)
 
@@ -45,8 +46,7 @@ def tiny_demo():
     c["reduction"]["size"] = 6
     c["search"]["scan"] = 4
     c["output"].update(frames=FRAMES, window=list(WINDOW), manifold_size=[10, 16])
-    raw = {s: {k: v for k, v in keys.items() if v is not None} for s, keys in c.items()}
-    return validate(raw, source="<tiny demo>")
+    return validate(as_raw(c), source="<tiny demo>")
 
 
 @pytest.fixture(scope="module")
@@ -214,24 +214,7 @@ def test_verify_rejects_a_wrong_orbit(two_dof):
 
 # ----------------------------------------------------------------------------- user mesh, stage commands
 
-PLATE = """
-[study]
-name = "plate"
-[mesh]
-path = "meshes/plate.vtu"
-[fem]
-order = 1
-mass = "lumped"
-thickness = 0.002
-[contact]
-clearance = 1e-4
-[reduction]
-method = "modal"
-size = 10
-compare = [{method = "lanczos-si", size = 10}]
-[search]
-ipp = [1]
-periods = [0.5, 0.9999]
+PLATE = PLATE_BASE.replace("size = 10\n", 'size = 10\ncompare = [{method = "lanczos-si", size = 10}]\n') + """\
 [output]
 frames = 10
 window = [240, 180]
@@ -243,7 +226,7 @@ formats = ["gif", "vtu", "png"]
 def plate_study(tmp_path_factory):
     d = tmp_path_factory.mktemp("plate")
     f = d / "plate.toml"
-    f.write_text(PLATE.replace("meshes/plate.vtu", str(ROOT / "meshes" / "plate.vtu")))
+    f.write_text(absolute(PLATE))
     return f
 
 
@@ -346,7 +329,7 @@ def test_rerun_replaces_results_and_drops_stale_ones(plate_study, tmp_path):
     (out / "notes.txt").write_text("mine")  # a user's file: never touched
     raw = copy.deepcopy(st.config)
     raw["output"]["formats"] = ["gif"]
-    raw = {k: {kk: vv for kk, vv in v.items() if vv is not None} for k, v in raw.items()}
+    raw = as_raw(raw)
     raw["mesh"]["path"] = str(st.mesh_path())
     pipeline.run(validate(raw), out=out, progress=False)
     names = sorted(p.name for p in out.iterdir())
@@ -365,7 +348,7 @@ def test_explicit_orbit_requests(plate_study):
     inside = 0.5 * (arc.T_lo + arc.T_hi) / unit
     raw = copy.deepcopy(st.config)
     raw["output"]["orbits"] = [{"ipp": 1, "T": inside}, {"ipp": 1, "T": 0.6}]
-    raw = {k: {kk: vv for kk, vv in v.items() if vv is not None} for k, v in raw.items()}
+    raw = as_raw(raw)
     chosen = pipeline.choose_orbits(validate(raw, base=plate_study.parent), fams, unit)
     assert len(chosen) == 2
     assert chosen[0].orbit.T == pytest.approx(inside * unit, rel=1e-14) and chosen[0].orbit.admissible
@@ -387,7 +370,7 @@ def test_search_resolution_reaches_the_start_search(plate_study, monkeypatch):
     monkeypatch.setattr(continuation, "orbits_kipp", spy)
     raw = copy.deepcopy(loads(PLATE, base=ROOT).config)
     raw["search"].update(ipp=[3], scan=2, resolution=20, periods=[0.9, 0.95])
-    raw = {k: {kk: vv for kk, vv in v.items() if vv is not None} for k, v in raw.items()}
+    raw = as_raw(raw)
     st = validate(raw, base=ROOT)
     system = bc.chain(3, k=1.0, m=1 / 3, gap=1.0)
     pipeline.search(st, system)

@@ -8,34 +8,15 @@ from pathlib import Path
 import pytest
 
 from bladecase.cli import main
+from _studies import PLATE, ROOT, absolute, as_raw
 from bladecase.study import SCHEMA, StudyError, demo_study, demo_text, load_study, loads, validate
 
-ROOT = Path(__file__).resolve().parent.parent
 
-PLATE = """
-[study]
-name = "plate"
-[mesh]
-path = "meshes/plate.vtu"
-[fem]
-order = 1
-mass = "lumped"
-thickness = 0.002
-[contact]
-clearance = 1e-4
-[reduction]
-method = "modal"
-size = 10
-[search]
-ipp = [1]
-periods = [0.5, 0.9999]
-"""
 
 
 def raw_demo() -> dict:
     """The demo study as a plain dict (keys left at None removed, as a user would write it)."""
-    c = copy.deepcopy(demo_study().config)
-    return {s: {k: v for k, v in keys.items() if v is not None} for s, keys in c.items()}
+    return as_raw(copy.deepcopy(demo_study().config))
 
 
 def test_demo_study_defaults():
@@ -60,7 +41,7 @@ def test_user_mesh_study_resolves_relative_to_its_file(tmp_path):
     assert st.output_dir() == Path("results") / "plate"
     assert st.output_dir(tmp_path) == tmp_path
     f = tmp_path / "s.toml"
-    f.write_text(PLATE.replace("meshes/plate.vtu", str(ROOT / "meshes" / "plate.vtu")))
+    f.write_text(absolute(PLATE))
     assert load_study(f).mesh_path().exists()
 
 
@@ -134,7 +115,7 @@ def _write(tmp_path, text: str) -> Path:
     (lambda t: t.replace("size = 10", "size = 5000"), "[reduction]"),
 ])
 def test_cli_run_fails_fast_and_writes_nothing(tmp_path, capsys, edit, words):
-    text = edit(PLATE.replace("meshes/plate.vtu", str(ROOT / "meshes" / "plate.vtu")))
+    text = edit(absolute(PLATE))
     out = tmp_path / "out"
     code = main(["run", str(_write(tmp_path, text)), "--out", str(out), "--quiet", "--no-progress"])
     err = capsys.readouterr().err
