@@ -38,7 +38,7 @@ import scipy.sparse.linalg as spla
 
 import bladecase
 from bench_core import fmt_time, line, machine, verdict
-from bladecase.mesh import Mesh
+from bladecase.fe.mesh import Mesh
 
 #: Target: assembly + eigen-solution in under this many seconds (2-core machine).
 TARGET_SECONDS = 60.0

@@ -44,7 +44,7 @@ import numpy as np
 
 import bladecase
 from bench_core import fmt_time, line, machine, verdict
-from bladecase.contact import Contact
+from bladecase.reduction.contact import Contact
 from bladecase.reduction import METHODS, reduce
 
 #: Target: each reduction in under this many seconds (2-core machine).

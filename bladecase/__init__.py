@@ -12,14 +12,14 @@ Public API (a contract for later stages and external scripts), in the order data
 - simulate: :func:`simulate` → :class:`Trajectory` — exact event-driven simulation (the independent check).
 """
 
-from .continuation import Arc, Family, nonsmooth_mode
-from .fem import DofMap, FEModel, Material, assemble, natural_frequencies
-from .geometry import BladeGeometry, PlateGeometry, blade_mesh
-from .mesh import Mesh, load_mesh, save_mesh
-from .model import LinearSystem, Spectrum, chain
-from .nsm import PeriodicOrbit, impact_matrices, make_orbit, orbit_1ipp, orbits_kipp
-from .scan import Backbone, Interval, backbone
-from .simulate import Trajectory, simulate
+from .nsm.branches import Arc, Family, nonsmooth_mode
+from .fe.assembly import DofMap, FEModel, Material, assemble, natural_frequencies
+from .fe.geometry import BladeGeometry, PlateGeometry, blade_mesh
+from .fe.mesh import Mesh, load_mesh, save_mesh
+from .nsm.system import LinearSystem, Spectrum, chain
+from .nsm.orbits import PeriodicOrbit, impact_matrices, make_orbit, orbit_1ipp, orbits_kipp
+from .nsm.scan import Backbone, Interval, backbone
+from .nsm.simulation import Trajectory, simulate
 
 __all__ = [
     "Arc", "Backbone", "BladeGeometry", "DofMap", "FEModel", "Family", "Interval", "LinearSystem", "Material",
@@ -30,8 +30,8 @@ __all__ = [
 __version__ = "0.1.0"
 
 # Reduction layer: the contact of an FE model and the Lanczos chain (theory §2).
-from .contact import Contact, radial_normal
-from .lanczos import LanczosChain, MassFactor, PerDofDefect, SymmetryBasis, lanczos_chain, mass_factor, per_dof_defect
+from .reduction.contact import Contact, radial_normal
+from .reduction.lanczos import LanczosChain, MassFactor, PerDofDefect, SymmetryBasis, lanczos_chain, mass_factor, per_dof_defect
 
 __all__ += [
     "Contact", "LanczosChain", "MassFactor", "PerDofDefect", "SymmetryBasis",
@@ -39,12 +39,12 @@ __all__ += [
 ]
 
 # Reduction layer: the front door, FE model + contact -> the reduced system the solver consumes.
-from .reduction import FULL_LIMIT, ReducedModel, reduce
+from .reduction.methods import FULL_LIMIT, ReducedModel, reduce
 
 __all__ += ["FULL_LIMIT", "ReducedModel", "reduce"]
 
 # Studies: a TOML file through every stage, and the results (animations, VTK, report).
-from .pipeline import RunResult, run
-from .study import Study, StudyError, demo_study, load_study
+from .study.pipeline import RunResult, run
+from .study.schema import Study, StudyError, demo_study, load_study
 
 __all__ += ["RunResult", "Study", "StudyError", "demo_study", "load_study", "run"]

@@ -208,13 +208,13 @@ def _setup(args) -> bool:
 
 
 def _study(path: Path, model: bool = True):
-    from .study import load_study
+    from .study.schema import load_study
 
     return load_study(path, model=model)
 
 
 def _cmd_run(args) -> int:
-    from .pipeline import run
+    from .study.pipeline import run
 
     progress = _setup(args)
     result = run(_study(args.study), out=args.out, progress=progress)
@@ -223,8 +223,8 @@ def _cmd_run(args) -> int:
 
 
 def _cmd_demo(args) -> int:
-    from .pipeline import run
-    from .study import demo_study, demo_text
+    from .study.pipeline import run
+    from .study.schema import demo_study, demo_text
 
     if args.print_study:
         print(demo_text(), end="")
@@ -236,8 +236,8 @@ def _cmd_demo(args) -> int:
 
 
 def _cmd_mesh(args) -> int:
-    from .mesh import save_mesh
-    from .pipeline import build_mesh
+    from .fe.mesh import save_mesh
+    from .study.pipeline import build_mesh
 
     _setup(args)
     study = _study(args.study)
@@ -253,9 +253,9 @@ def _cmd_mesh(args) -> int:
 
 
 def _cmd_assemble(args) -> int:
-    from .fem import natural_frequencies, save_model
-    from .mesh import load_mesh
-    from .pipeline import build_mesh, build_model
+    from .fe.assembly import natural_frequencies, save_model
+    from .fe.mesh import load_mesh
+    from .study.pipeline import build_mesh, build_model
 
     _setup(args)
     study = _study(args.study)
@@ -272,9 +272,9 @@ def _cmd_assemble(args) -> int:
 
 
 def _cmd_reduce(args) -> int:
-    from .fem import load_model
-    from .pipeline import build_contact, build_reduced
-    from .reduction import save_reduced
+    from .fe.assembly import load_model
+    from .study.pipeline import build_contact, build_reduced
+    from .reduction.methods import save_reduced
 
     _setup(args)
     study = _study(args.study)
@@ -290,12 +290,12 @@ def _cmd_reduce(args) -> int:
 
 def _cmd_modes(args) -> int:
     from .io import write_json
-    from .pipeline import families_document, search
+    from .study.pipeline import families_document, search
 
     progress = _setup(args)
     study = _study(args.study, model=args.reduced is not None)  # with --matrices: [search] is enough
     if args.reduced is not None:
-        from .reduction import load_reduced
+        from .reduction.methods import load_reduced
 
         system = load_reduced(args.reduced).system
     else:
@@ -313,8 +313,8 @@ def _cmd_modes(args) -> int:
 
 
 def _cmd_animate(args) -> int:
-    from .pipeline import animate_families, load_families
-    from .reduction import load_reduced
+    from .study.pipeline import animate_families, load_families
+    from .reduction.methods import load_reduced
 
     progress = _setup(args)
     study = _study(args.study)
@@ -330,7 +330,7 @@ def _cmd_animate(args) -> int:
 
 
 def _load_system(args):
-    from .model import LinearSystem, chain
+    from .nsm.system import LinearSystem, chain
 
     if (args.chain is None) == (args.matrices is None):
         raise ValueError("give exactly one of --chain N or --matrices FILE.npz")
@@ -355,7 +355,7 @@ def _load_system(args):
 
 def _cmd_backbone(args) -> int:
     from .io import write_json, write_text
-    from .scan import backbone
+    from .nsm.scan import backbone
 
     system = _load_system(args)
     progress = not args.no_progress and sys.stderr.isatty()
@@ -366,7 +366,7 @@ def _cmd_backbone(args) -> int:
         summary = table.split("\n\n", 1)[-1]
         data = result.to_dict()
     else:
-        from .continuation import nonsmooth_mode
+        from .nsm.branches import nonsmooth_mode
 
         P = args.periods
         if P.size < 2 or P[0] == P[-1]:
@@ -404,7 +404,7 @@ def _save_plot(curves, path: Path) -> None:
     import matplotlib.pyplot as plt
 
     from .io import save_figure
-    from .plot import frequency_energy
+    from .post.plots import frequency_energy
 
     if not curves:
         raise ValueError("nothing to plot: no family found")

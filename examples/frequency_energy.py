@@ -7,7 +7,7 @@ System: ``bladecase.chain(2, k=1, m=1/2, gap=1)`` (Sec. 1.4 of the paper;
 * the 1-ipp backbone, ``bladecase.backbone(sys, np.linspace(1, 14.5, N))``;
 * the 2-ipp families, ``bladecase.nonsmooth_mode(sys, 2, (3, 14.5), scan=24)``,
 
-drawn together with ``bladecase.plot.frequency_energy([backbone, *families])``
+drawn together with ``bladecase.post.plots.frequency_energy([backbone, *families])``
 (admissible orbits solid, non-admissible faint dots, one colour per number of
 impacts per period).  The energy of non-admissible orbits diverges at the
 resonances ``T = 2πj/ω_i``, and the admissible 1-ipp branches also end at
@@ -34,7 +34,7 @@ import numpy as np  # noqa: E402
 
 import bladecase  # noqa: E402
 from bladecase.io import save_figure  # noqa: E402
-from bladecase.plot import frequency_energy  # noqa: E402
+from bladecase.post.plots import frequency_energy  # noqa: E402
 
 _HERE = str(pathlib.Path(__file__).resolve().parent)
 if _HERE not in sys.path:  # for examples/_paper.py, also when the script is loaded by path (tests)

@@ -36,7 +36,7 @@ import numpy as np
 import pytest
 
 import bladecase as bc
-from bladecase.nsm import _Modal
+from bladecase.nsm.orbits import _Modal
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 NAMES = ["fig2_impact_time_map", "fig3_trajectories", "fig4_manifold", "frequency_energy"]

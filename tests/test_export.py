@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import bladecase as bc
-from bladecase.export import read_time_series, write_manifold, write_time_series
+from bladecase.post.vtk import read_time_series, write_manifold, write_time_series
 
 MESHES = Path(__file__).resolve().parents[1] / "meshes"
 T = 2.37e-3

@@ -19,7 +19,7 @@ References (independent of bladecase):
   ``ElementVector``: the matrices must agree to round-off.
 
 Meshes are built from scikit-fem's generators (``MeshTet.init_tensor``,
-``MeshTri.init_tensor``) or plain numpy and converted to ``bladecase.mesh.Mesh``.
+``MeshTri.init_tensor``) or plain numpy and converted to ``bladecase.fe.mesh.Mesh``.
 """
 
 from __future__ import annotations
@@ -38,8 +38,8 @@ from skfem.helpers import dot
 from skfem.models.elasticity import linear_elasticity, plane_stress
 
 import bladecase as bc
-from bladecase.fem import AL6061T6, INCONEL718, STEEL, TI6AL4V, FEModel, Material
-from bladecase.mesh import Mesh
+from bladecase.fe.assembly import AL6061T6, INCONEL718, STEEL, TI6AL4V, FEModel, Material
+from bladecase.fe.mesh import Mesh
 
 EB_BETA_L2 = np.array([3.5160, 22.0345, 61.6972])
 
@@ -552,7 +552,7 @@ def test_argument_errors():
         (lambda: bc.assemble(mesh2, STEEL, thickness=-0.01), "thickness must be a finite number > 0, got -0.01"),
         (lambda: bc.assemble(mesh2, STEEL, thickness=float("inf")), "thickness"),
         (lambda: bc.assemble(mesh3, STEEL, thickness=0.01), "thickness applies to 2-D models only"),
-        (lambda: bc.assemble("mesh.msh", STEEL), "mesh must be a bladecase.mesh.Mesh"),
+        (lambda: bc.assemble("mesh.msh", STEEL), "mesh must be a bladecase.Mesh"),
     ]
     for call, pattern in cases:
         with pytest.raises(ValueError, match=pattern):

@@ -1,7 +1,7 @@
 """End to end: study file → mesh → FE → reduced model → nonsmooth modes → animations, VTK, report.
 
 * The demo study at tiny resolution (coarser mesh, 6 Lanczos steps, 4 start
-  periods, 8 frames of 320×240) runs through :func:`bladecase.pipeline.run`
+  periods, 8 frames of 320×240) runs through :func:`bladecase.study.pipeline.run`
   and writes every result; each file is read back and checked against the
   physics: at frame 0 (an impact) the contact node is at the casing, ``ν·u =
   d`` to 1e-9·d, and ``ν·u <= d`` on every frame; the event-driven simulator
@@ -28,13 +28,13 @@ import pytest
 import bladecase as bc
 from _studies import PLATE as PLATE_BASE
 from _studies import ROOT, absolute, as_raw
-from bladecase import pipeline
+from bladecase.study import pipeline
 from bladecase.cli import main
-from bladecase.export import read_time_series
-from bladecase.fem import load_model, save_model
+from bladecase.post.vtk import read_time_series
+from bladecase.fe.assembly import load_model, save_model
 from bladecase.reduction import load_reduced, reduce, save_reduced
-from bladecase.study import demo_study, loads, validate
-from bladecase.viz import mp4_available
+from bladecase.study.schema import demo_study, loads, validate
+from bladecase.post.animation import mp4_available
 
 FRAMES = 8
 WINDOW = (320, 240)
@@ -287,7 +287,7 @@ def test_failed_run_keeps_previous_results(plate_study, tmp_path, monkeypatch):
     out = tmp_path / "out"
     pipeline.run(st, out=out, progress=False)
     before = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
-    from bladecase import viz
+    from bladecase.post import animation as viz
 
     def broken(*args, **kwargs):
         raise RuntimeError("renderer crashed")
@@ -358,7 +358,7 @@ def test_explicit_orbit_requests(plate_study):
 
 
 def test_search_resolution_reaches_the_start_search(plate_study, monkeypatch):
-    from bladecase import continuation
+    from bladecase.nsm import branches as continuation
 
     seen = []
     real = continuation.orbits_kipp

@@ -35,7 +35,7 @@ import scipy.sparse as sp
 from pathlib import Path
 
 import bladecase as bc
-from bladecase.contact import Contact
+from bladecase.reduction.contact import Contact
 from bladecase.reduction import FULL_LIMIT, METHODS, ReducedModel, reduce
 
 MESHES = Path(__file__).resolve().parent.parent / "meshes"
@@ -397,7 +397,7 @@ def test_contact_node_without_free_dof(plate):
 def test_model_and_contact_types(plate, contact, full):
     with pytest.raises(ValueError, match="model must be an FEModel"):
         reduce(full.system, contact, "modal", 5)
-    with pytest.raises(ValueError, match="contact must be a bladecase.contact.Contact"):
+    with pytest.raises(ValueError, match="contact must be a bladecase.Contact"):
         reduce(plate, contact.node, "modal", 5)
 
 

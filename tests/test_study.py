@@ -9,7 +9,7 @@ import pytest
 
 from bladecase.cli import main
 from _studies import PLATE, ROOT, absolute, as_raw
-from bladecase.study import SCHEMA, StudyError, demo_study, demo_text, load_study, loads, validate
+from bladecase.study.schema import SCHEMA, StudyError, demo_study, demo_text, load_study, loads, validate
 
 
 
@@ -141,7 +141,7 @@ def test_cli_demo_print_study(capsys):
 def test_contact_selectors(lines, expect):
     import numpy as np
 
-    from bladecase import pipeline
+    from bladecase.study import pipeline
 
     st = loads(PLATE.replace("clearance = 1e-4", "clearance = 1e-4\n" + lines), base=ROOT)
     mesh = pipeline.build_mesh(st)

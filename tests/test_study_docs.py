@@ -1,4 +1,4 @@
-"""docs/study.md stays in step with the study schema (bladecase.study.SCHEMA).
+"""docs/study.md stays in step with the study schema (bladecase.study.schema.SCHEMA).
 
 * every section of SCHEMA has a heading containing ``[section]``;
 * every key of every section, and every field of BladeGeometry and
@@ -17,8 +17,8 @@ from pathlib import Path
 
 import pytest
 
-from bladecase.geometry import BladeGeometry, PlateGeometry
-from bladecase.study import GEOMETRY_FIELDS, REQUIRED, SCHEMA, demo_text, loads
+from bladecase.fe.geometry import BladeGeometry, PlateGeometry
+from bladecase.study.schema import GEOMETRY_FIELDS, REQUIRED, SCHEMA, demo_text, loads
 
 ROOT = Path(__file__).resolve().parent.parent
 DOC = ROOT / "docs" / "study.md"

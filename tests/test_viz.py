@@ -17,7 +17,7 @@ pytest.importorskip("pyvista")
 imageio = pytest.importorskip("imageio.v3")
 
 import bladecase as bc
-from bladecase import viz
+from bladecase.post import animation as viz
 
 MESHES = Path(__file__).resolve().parents[1] / "meshes"
 F = 12

@@ -50,8 +50,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .contact import Contact
-from .fem import FEModel
-from .model import LinearSystem, _diagonal, _is_sparse
+from ..fe.assembly import FEModel
+from ..nsm.system import LinearSystem, _diagonal, _is_sparse
 
 #: Lanczos stops (invariant subspace reached) when the next off-diagonal
 #: ``β_j <= BREAKDOWN_RTOL · ‖A‖`` (``‖A‖`` estimated by the largest

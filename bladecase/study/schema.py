@@ -24,8 +24,8 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from .geometry import BladeGeometry, PlateGeometry
-from .reduction import METHODS
+from ..fe.geometry import BladeGeometry, PlateGeometry
+from ..reduction.methods import METHODS
 
 REQUIRED = object()  #: marks a key without a default
 
@@ -427,7 +427,7 @@ def load_study(path: str | os.PathLike, model: bool = True) -> Study:
 
 def demo_text() -> str:
     """The TOML text of the embedded demo study (``bladecase demo``)."""
-    return resources.files("bladecase").joinpath("studies/demo.toml").read_text(encoding="utf-8")
+    return resources.files("bladecase").joinpath("study/studies/demo.toml").read_text(encoding="utf-8")
 
 
 def demo_study() -> Study:

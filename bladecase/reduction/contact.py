@@ -1,10 +1,10 @@
 """The blade–casing contact of a finite-element model: one node, a normal, a gap.
 
 A :class:`Contact` says which mesh node touches the casing, along which unit
-normal ``ν`` and after which clearance ``d``.  On an :class:`~bladecase.fem.FEModel`
+normal ``ν`` and after which clearance ``d``.  On an :class:`~bladecase.fe.assembly.FEModel`
 it becomes the constraint vector ``w`` of theory §1 (``wᵀx = ν·u_node``, the
 normal components on that node's free dofs, zero elsewhere) and the
-:class:`~bladecase.model.LinearSystem` the solver and the reduction layer consume.
+:class:`~bladecase.nsm.system.LinearSystem` the solver and the reduction layer consume.
 
 Picking the node:
 
@@ -27,8 +27,8 @@ from typing import Sequence
 
 import numpy as np
 
-from .fem import FEModel, _positive
-from .model import LinearSystem
+from ..fe.assembly import FEModel, _positive
+from ..nsm.system import LinearSystem
 
 
 def radial_normal(dim: int) -> np.ndarray:
@@ -234,8 +234,8 @@ class Contact:
         """The FULL model with this contact: ``LinearSystem(model.M, model.K, w, gap)``.
 
         Sparse matrices are kept (the constructor checks positive definiteness
-        with a sparse LDLᵀ).  Its :attr:`~bladecase.model.LinearSystem.spectrum`
-        is dense and limited to :data:`bladecase.model.DENSE_LIMIT` dofs; reduce
+        with a sparse LDLᵀ).  Its :attr:`~bladecase.nsm.system.LinearSystem.spectrum`
+        is dense and limited to :data:`bladecase.nsm.system.DENSE_LIMIT` dofs; reduce
         larger models first (:func:`bladecase.lanczos_chain`).
         """
         return LinearSystem(model.M, model.K, self.w(model), self.gap)

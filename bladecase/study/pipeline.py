@@ -1,6 +1,6 @@
 """A study run end to end: mesh → FE model → contact → reduced model(s) → nonsmooth modes → results.
 
-Each stage is a plain function of the validated :class:`~bladecase.study.Study`
+Each stage is a plain function of the validated :class:`~bladecase.study.schema.Study`
 and the previous stage's data, so the command line can run one stage from
 files (``bladecase mesh / assemble / reduce / modes / animate``) or all of
 them (``bladecase run``, :func:`run`).
@@ -23,16 +23,16 @@ from pathlib import Path
 
 import numpy as np
 
-from .contact import Contact
-from .continuation import Arc, Family, nonsmooth_mode
-from .fem import FEModel, Material, assemble, natural_frequencies
-from .geometry import blade_mesh
-from .io import replace_dir, save_figure, write_json, write_text
-from .mesh import Mesh, load_mesh
-from .model import LinearSystem
-from .nsm import PeriodicOrbit
-from .reduction import ReducedModel, reduce
-from .study import Study, StudyError
+from ..reduction.contact import Contact
+from ..nsm.branches import Arc, Family, nonsmooth_mode
+from ..fe.assembly import FEModel, Material, assemble, natural_frequencies
+from ..fe.geometry import blade_mesh
+from ..io import replace_dir, save_figure, write_json, write_text
+from ..fe.mesh import Mesh, load_mesh
+from ..nsm.system import LinearSystem
+from ..nsm.orbits import PeriodicOrbit
+from ..reduction.methods import ReducedModel, reduce
+from .schema import Study, StudyError
 
 log = logging.getLogger("bladecase")
 
@@ -61,7 +61,7 @@ def build_mesh(study: Study, path: str | os.PathLike | None = None) -> Mesh:
             raise StudyError(f"[mesh] path: no such file {str(source)!r}")
         mesh = load_mesh(source)
         if path is not None:
-            from .mesh import save_mesh
+            from ..fe.mesh import save_mesh
 
             save_mesh(mesh, path)
     for name, key in zip(need, ("[fem] clamp", "[contact] group")):
@@ -410,7 +410,7 @@ def run(study: Study, out: str | os.PathLike | None = None, progress: bool = Tru
     try:
         stage("mesh")
         mesh = build_mesh(study)
-        from .mesh import save_mesh
+        from ..fe.mesh import save_mesh
 
         save_mesh(mesh, staging / "mesh.vtu")
         files["mesh"] = "mesh.vtu"
@@ -539,7 +539,7 @@ def verify(orbit: PeriodicOrbit) -> dict:
     Returns ``{"return_error": ‖z(T) − z(0)‖/‖z(0)‖ (state (x, v) scaled by
     its component ranges), "impacts": impacts found in (0, T], "ok": bool}``.
     """
-    from .simulate import simulate
+    from ..nsm.simulation import simulate
 
     T, k = orbit.T, orbit.k
     x0, v0 = orbit.state(np.array([0.0]))
@@ -566,7 +566,7 @@ def _detach(handler: logging.Handler, level: int) -> None:
 
 
 def _version() -> str:
-    from . import __version__
+    from .. import __version__
 
     return __version__
 
@@ -577,7 +577,7 @@ def _plot(study, families, compares, compare_families, reduced, f_fe, path: Path
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
 
-    from .plot import frequency_energy
+    from ..post.plots import frequency_energy
 
     models = [(reduced, families)] + list(zip(compares, compare_families))
     fig, axes = plt.subplots(len(models), 1, figsize=(8, 4.6 * len(models)), layout="constrained", squeeze=False)
@@ -600,7 +600,7 @@ def _plot(study, families, compares, compare_families, reduced, f_fe, path: Path
 
 def _render(study: Study, reduced: ReducedModel, families: list[Family], choice: Choice, staging: Path,
             progress: bool) -> dict:
-    from . import export, viz
+    from ..post import animation as viz, vtk as export
 
     o = study["output"]
     orbit = choice.orbit
@@ -679,7 +679,7 @@ def arc_orbits(fam: Family, T: float, count: int) -> list[PeriodicOrbit]:
 def _manifold(reduced: ReducedModel, fam: Family, T: float, path: Path, n_orbits: int, n_times: int) -> str:
     """Manifold samples over the admissible arc through ``T``, projected on
     (contact displacement ν·u, contact velocity × T/2π, period)."""
-    from .export import write_manifold
+    from ..post.vtk import write_manifold
 
     orbits = arc_orbits(fam, T, n_orbits)
     if len(orbits) < 2:

@@ -1,4 +1,4 @@
-"""Finite-element model of a structure: stiffness and mass from a :class:`~bladecase.mesh.Mesh`.
+"""Finite-element model of a structure: stiffness and mass from a :class:`~bladecase.fe.mesh.Mesh`.
 
 :func:`assemble` turns a simplex mesh (tetrahedra in 3-D, triangles in 2-D
 plane stress or plane strain) and a :class:`Material` into the sparse
@@ -364,7 +364,7 @@ def assemble(
         selects no node of the body, degenerate cells.
     """
     if not isinstance(mesh, Mesh):
-        raise ValueError(f"mesh must be a bladecase.mesh.Mesh, got {type(mesh).__name__}")
+        raise ValueError(f"mesh must be a bladecase.Mesh, got {type(mesh).__name__}")
     if mesh.dim not in (2, 3):
         raise ValueError(f"mesh.dim must be 2 or 3, got {mesh.dim!r}")
     dim = mesh.dim
@@ -706,7 +706,7 @@ def model_from_arrays(data, prefix: str = "", source: str = "") -> FEModel:
     key = f"{prefix}format"
     if key not in data or str(data[key]) != MODEL_FORMAT:
         raise ValueError(f"{source or 'data'} is not a bladecase FE model file (expected format {MODEL_FORMAT!r}; "
-                         "write one with 'bladecase assemble' or bladecase.fem.save_model)")
+                         "write one with 'bladecase assemble' or bladecase.fe.assembly.save_model)")
     E, nu, rho = (float(x) for x in data[f"{prefix}material"])
     thickness = float(data[f"{prefix}thickness"])
     dofs = DofMap(node=np.asarray(data[f"{prefix}dofs/node"]), direction=np.asarray(data[f"{prefix}dofs/direction"]),
@@ -724,7 +724,7 @@ def model_from_arrays(data, prefix: str = "", source: str = "") -> FEModel:
 
 def save_model(model: FEModel, path) -> None:
     """Write an :class:`FEModel` (matrices, dof map, mesh, material) to a ``.npz`` file, atomically."""
-    from .io import atomic_path
+    from ..io import atomic_path
 
     with atomic_path(path) as tmp, open(tmp, "wb") as fh:
         np.savez_compressed(fh, **model_to_arrays(model))

@@ -1,8 +1,8 @@
 """Reduction layer: from a finite-element model and its contact to the small system the solver consumes.
 
-:func:`reduce` turns an :class:`~bladecase.fem.FEModel` and a contact (a node,
-a casing normal and a clearance, :class:`bladecase.contact.Contact`) into a
-:class:`ReducedModel`: a :class:`~bladecase.model.LinearSystem` with dense
+:func:`reduce` turns an :class:`~bladecase.fe.assembly.FEModel` and a contact (a node,
+a casing normal and a clearance, :class:`bladecase.reduction.contact.Contact`) into a
+:class:`ReducedModel`: a :class:`~bladecase.nsm.system.LinearSystem` with dense
 reduced matrices ``M_r = VᵀMV``, ``K_r = VᵀKV``, constraint vector
 ``w_r = Vᵀw`` and the same clearance, plus the basis ``V`` (``x_free ≈ V q``)
 that maps a reduced orbit back to the mesh (:meth:`ReducedModel.expand`).
@@ -18,7 +18,7 @@ Methods (theory §2):
     ``size`` pairs ``(ω_j, b_j)`` exactly.
 ``"lanczos"``, ``"lanczos-si"``
     ``size`` Lanczos steps started at the contact
-    (:func:`bladecase.lanczos.lanczos_chain`, plain or shift-invert about 0):
+    (:func:`bladecase.reduction.lanczos.lanczos_chain`, plain or shift-invert about 0):
     a chain of unit masses, ``LinearSystem(I, J, |ŵ|e₁, d)``, with the
     impacting mass first.  Plain Lanczos matches the moments
     ``Σ b_j² ω_j^{2p}``, ``p < 2·size`` — it resolves the top of the FE
@@ -51,13 +51,13 @@ import scipy.sparse.linalg as spla
 from scipy.spatial import cKDTree
 
 from .contact import Contact
-from .fem import FEModel, natural_frequencies
+from ..fe.assembly import FEModel, natural_frequencies
 from .lanczos import LanczosChain, lanczos_chain
-from .mesh import _P2_EDGES
-from .model import LinearSystem
+from ..fe.mesh import _P2_EDGES
+from ..nsm.system import LinearSystem
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .nsm import PeriodicOrbit
+    from ..nsm.orbits import PeriodicOrbit
 
 #: Accepted values of ``method`` in :func:`reduce`.
 METHODS = ("full", "modal", "lanczos", "lanczos-si", "craig-bampton")
@@ -239,7 +239,7 @@ def reduce(model: FEModel, contact: Contact, method: str, size: int | None = Non
     model : FEModel
         A clamped model (:func:`bladecase.assemble`).
     contact : Contact
-        Contact node, casing normal and clearance (:class:`bladecase.contact.Contact`);
+        Contact node, casing normal and clearance (:class:`bladecase.reduction.contact.Contact`);
         ``contact.w(model)`` is the constraint vector on the free dofs.
     method : {"full", "modal", "lanczos", "lanczos-si", "craig-bampton"}
         See the module docstring.
@@ -269,7 +269,7 @@ def reduce(model: FEModel, contact: Contact, method: str, size: int | None = Non
         raise ValueError(f"unknown reduction method {method!r} (valid: {valid})")
     if not isinstance(contact, Contact):
         raise ValueError(
-            f"contact must be a bladecase.contact.Contact (node, normal, gap), got {type(contact).__name__}"
+            f"contact must be a bladecase.Contact (node, normal, gap), got {type(contact).__name__}"
         )
     n = model.n_dofs
     if method == "full":
@@ -326,7 +326,7 @@ def _check_count(method: str, size: int, available: int, what: str) -> bool:
 
 
 def _sign_convention(phi: np.ndarray) -> np.ndarray:
-    """Flip each column so that its largest component is positive (as :class:`~bladecase.model.Spectrum`)."""
+    """Flip each column so that its largest component is positive (as :class:`~bladecase.nsm.system.Spectrum`)."""
     idx = np.argmax(np.abs(phi), axis=0)
     return phi * np.sign(phi[idx, np.arange(phi.shape[1])])[None, :]
 
@@ -417,8 +417,8 @@ def save_reduced(reduced: ReducedModel, path) -> None:
 
     The Lanczos chain object is not stored (its Jacobi matrix is the reduced ``K``).
     """
-    from .fem import model_to_arrays, sparse_to_arrays
-    from .io import atomic_path
+    from ..fe.assembly import model_to_arrays, sparse_to_arrays
+    from ..io import atomic_path
 
     s, c = reduced.system, reduced.contact
     out = {"format": np.array(REDUCED_FORMAT), "method": np.array(reduced.method),
@@ -438,7 +438,7 @@ def save_reduced(reduced: ReducedModel, path) -> None:
 
 def load_reduced(path) -> ReducedModel:
     """Read a :class:`ReducedModel` written by :func:`save_reduced`."""
-    from .fem import model_from_arrays, sparse_from_arrays
+    from ..fe.assembly import model_from_arrays, sparse_from_arrays
 
     try:
         with np.load(path, allow_pickle=False) as data:

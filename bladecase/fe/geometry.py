@@ -5,7 +5,7 @@
 section with a blunt trailing edge, twist, stagger, sweep and lean.
 :class:`PlateGeometry` is the plane-stress membrane variant for fast studies.
 :func:`blade_mesh` meshes either one with simplices of order 1 or 2 and
-returns a :class:`~bladecase.mesh.Mesh` with the node groups ``root``
+returns a :class:`~bladecase.fe.mesh.Mesh` with the node groups ``root``
 (clamped), ``tip`` (facing the casing), ``blade`` (the body) and, when a
 contact point is asked for, ``contact`` (exactly one node).
 
@@ -29,7 +29,7 @@ from typing import Iterator, Sequence
 
 import numpy as np
 
-from .io import atomic_path
+from ..io import atomic_path
 from .mesh import Mesh, load_mesh
 
 #: Points per side (suction, pressure) of a NACA section, cosine-spaced.
@@ -508,7 +508,7 @@ def blade_mesh(
     Returns
     -------
     Mesh
-        Read back from the written file by :func:`~bladecase.mesh.load_mesh`,
+        Read back from the written file by :func:`~bladecase.fe.mesh.load_mesh`,
         with groups ``root``, ``tip``, ``blade`` and, if a contact point was
         given, ``contact``.
 

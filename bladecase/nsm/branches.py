@@ -15,8 +15,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .model import LinearSystem
-from .nsm import (
+from .system import LinearSystem
+from .orbits import (
     REPEAT_RTOL,
     PeriodicOrbit,
     _matrices,

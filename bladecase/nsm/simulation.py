@@ -3,7 +3,7 @@
 Free flight is integrated exactly in modal coordinates (each mode is a
 rotation in its phase plane).  The next impact is the FIRST root of
 ``wᵀx(t) - d`` after the current time, found by
-:func:`bladecase.trigsum.first_upcrossing`, which proves every skipped
+:func:`bladecase.nsm.signals.first_upcrossing`, which proves every skipped
 interval free of contact (no grazing contact missed) and refines the root to
 machine precision.  The impact law is Moreau's (theory §1), valid for any SPD
 ``M``: ``v⁺ = v⁻ - (1+e) M⁻¹w (wᵀv⁻)/(wᵀM⁻¹w)``; in modal coordinates
@@ -17,8 +17,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .model import LinearSystem
-from .trigsum import TrigSum, first_upcrossing
+from .system import LinearSystem
+from .signals import TrigSum, first_upcrossing
 
 #: Relative tolerance (of ``gap``) within which a state counts as "at the obstacle"
 #: (raised to the round-off of ``wᵀx`` for large amplitudes).

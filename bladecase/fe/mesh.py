@@ -18,7 +18,7 @@ from typing import Sequence
 
 import numpy as np
 
-from .io import atomic_path
+from ..io import atomic_path
 
 #: meshio cell types accepted as the body of a model, by dimension and order.
 VOLUME_TYPES = {3: {1: "tetra", 2: "tetra10"}, 2: {1: "triangle", 2: "triangle6"}}

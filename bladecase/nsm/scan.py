@@ -12,8 +12,8 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from .model import LinearSystem
-from .nsm import PeriodicOrbit, orbit_1ipp
+from .system import LinearSystem
+from .orbits import PeriodicOrbit, orbit_1ipp
 
 #: Relative precision in ``T`` of the refined ends of admissible intervals.
 BISECTION_RTOL = 1e-9
@@ -118,8 +118,8 @@ class Backbone:
         }
 
     def plot(self, ax=None, **kwargs):
-        """Frequency–energy plot (see :func:`bladecase.plot.frequency_energy`)."""
-        from .plot import frequency_energy
+        """Frequency–energy plot (see :func:`bladecase.post.plots.frequency_energy`)."""
+        from ..post.plots import frequency_energy
 
         return frequency_energy([self], ax=ax, **kwargs)
 

@@ -18,8 +18,8 @@ from functools import cached_property
 
 import numpy as np
 
-from .model import LinearSystem
-from .trigsum import TrigSum, certified_max
+from .system import LinearSystem
+from .signals import TrigSum, certified_max
 
 #: ``T`` is resonant when ``|ω_j T - 2πm| <= RESONANCE_RTOL · ω_j T`` for an
 #: integer ``m >= 1`` and a mode with ``b_j ≠ 0``: within the accuracy of the
@@ -101,7 +101,7 @@ class PeriodicOrbit:
         ``½vᵀMv + ½xᵀKx`` (constant along the orbit).
     admissible : bool
         ``Λ_i >= 0`` and ``wᵀx(t) <= d(1 + ADMISSIBILITY_RTOL)`` proved on the
-        whole period (:func:`bladecase.trigsum.certified_max`).
+        whole period (:func:`bladecase.nsm.signals.certified_max`).
     max_violation : float
         Largest ``wᵀx - d`` over the period (``0`` at the impacts, so it is
         ``>= 0``; ``<= ADMISSIBILITY_RTOL·d`` when admissible).
@@ -434,7 +434,7 @@ def orbits_kipp(system: LinearSystem, T: float, k: int, resolution: int | None =
     (theory §4).  k = 1: :func:`orbit_1ipp`.  k = 2: the condition is the
     scalar ``s(t₁) = 0`` (the paper's Eq. 15, ``Pf(Π) = Π₁₂``); all its sign
     changes on ``(0, T)`` are found with certified root exclusion
-    (:func:`bladecase.trigsum.all_roots`), then ``Λ = Σ⁻¹ d·1``.  k >= 3
+    (:func:`bladecase.nsm.signals.all_roots`), then ``Λ = Σ⁻¹ d·1``.  k >= 3
     (``Pf(Π) = 0`` and a two-dimensional null space for even k, the null
     vector of ``Π`` for odd k): Newton on ``(t₁…t_{k-1}, Λ)`` started from
     every cell of a grid on the ordered times, ``resolution`` points per time
@@ -576,7 +576,7 @@ def _multistart(md: _Modal, k: int, d: float, resolution: int | None) -> list[tu
 
 def _k2_roots(md: _Modal) -> np.ndarray:
     """Every ``t₁`` in ``(0, T)`` with ``s(t₁) = 0`` (the k = 2 condition)."""
-    from .trigsum import all_roots
+    from .signals import all_roots
 
     T = md.T
     c = md.b**2 / 2
