@@ -35,9 +35,9 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from bench_core import fmt_time, line, machine, verdict
 
 import bladecase
-from bench_core import fmt_time, line, machine, verdict
 from bladecase.fe.mesh import Mesh
 
 #: Target: assembly + eigen-solution in under this many seconds (2-core machine).

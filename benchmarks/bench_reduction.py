@@ -41,11 +41,11 @@ import time
 from pathlib import Path
 
 import numpy as np
+from bench_core import fmt_time, line, machine, verdict
 
 import bladecase
-from bench_core import fmt_time, line, machine, verdict
-from bladecase.reduction.contact import Contact
 from bladecase.reduction import METHODS, reduce
+from bladecase.reduction.contact import Contact
 
 #: Target: each reduction in under this many seconds (2-core machine).
 TARGET_SECONDS = 30.0

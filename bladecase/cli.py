@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 
@@ -208,13 +208,13 @@ def _setup(args) -> bool:
 
 
 def _study(path: Path, model: bool = True):
-    from .study.schema import load_study
+    from .study import load_study
 
     return load_study(path, model=model)
 
 
 def _cmd_run(args) -> int:
-    from .study.pipeline import run
+    from .study import run
 
     progress = _setup(args)
     result = run(_study(args.study), out=args.out, progress=progress)
@@ -223,7 +223,7 @@ def _cmd_run(args) -> int:
 
 
 def _cmd_demo(args) -> int:
-    from .study.pipeline import run
+    from .study import run
     from .study.schema import demo_study, demo_text
 
     if args.print_study:
@@ -236,7 +236,7 @@ def _cmd_demo(args) -> int:
 
 
 def _cmd_mesh(args) -> int:
-    from .fe.mesh import save_mesh
+    from .fe import save_mesh
     from .study.pipeline import build_mesh
 
     _setup(args)
@@ -253,8 +253,7 @@ def _cmd_mesh(args) -> int:
 
 
 def _cmd_assemble(args) -> int:
-    from .fe.assembly import natural_frequencies, save_model
-    from .fe.mesh import load_mesh
+    from .fe import load_mesh, natural_frequencies, save_model
     from .study.pipeline import build_mesh, build_model
 
     _setup(args)
@@ -272,9 +271,9 @@ def _cmd_assemble(args) -> int:
 
 
 def _cmd_reduce(args) -> int:
-    from .fe.assembly import load_model
+    from .fe import load_model
+    from .reduction import save_reduced
     from .study.pipeline import build_contact, build_reduced
-    from .reduction.methods import save_reduced
 
     _setup(args)
     study = _study(args.study)
@@ -295,7 +294,7 @@ def _cmd_modes(args) -> int:
     progress = _setup(args)
     study = _study(args.study, model=args.reduced is not None)  # with --matrices: [search] is enough
     if args.reduced is not None:
-        from .reduction.methods import load_reduced
+        from .reduction import load_reduced
 
         system = load_reduced(args.reduced).system
     else:
@@ -313,8 +312,8 @@ def _cmd_modes(args) -> int:
 
 
 def _cmd_animate(args) -> int:
+    from .reduction import load_reduced
     from .study.pipeline import animate_families, load_families
-    from .reduction.methods import load_reduced
 
     progress = _setup(args)
     study = _study(args.study)
@@ -330,7 +329,7 @@ def _cmd_animate(args) -> int:
 
 
 def _load_system(args):
-    from .nsm.system import LinearSystem, chain
+    from .nsm import LinearSystem, chain
 
     if (args.chain is None) == (args.matrices is None):
         raise ValueError("give exactly one of --chain N or --matrices FILE.npz")
@@ -355,7 +354,7 @@ def _load_system(args):
 
 def _cmd_backbone(args) -> int:
     from .io import write_json, write_text
-    from .nsm.scan import backbone
+    from .nsm import backbone
 
     system = _load_system(args)
     progress = not args.no_progress and sys.stderr.isatty()
@@ -366,7 +365,7 @@ def _cmd_backbone(args) -> int:
         summary = table.split("\n\n", 1)[-1]
         data = result.to_dict()
     else:
-        from .nsm.branches import nonsmooth_mode
+        from .nsm import nonsmooth_mode
 
         P = args.periods
         if P.size < 2 or P[0] == P[-1]:

@@ -123,7 +123,7 @@ def main(out_dir: str = "results/examples", resolution: str = "full") -> list[pa
     _map(az, system, ZOOM_T1, ZOOM_T, n_zoom)
     for a in (ax, az):
         lo, hi = a.get_xlim()
-        for Tr, i, j in resonant_periods(system):
+        for Tr, _i, _j in resonant_periods(system):
             if abs(Tr - T5) > 1e-9:
                 a.axhline(Tr, color="0.55", ls=(0, (3, 3)), lw=0.6, zorder=0)
         a.axhline(T5, color="tab:blue", ls="--", lw=1.3, zorder=1)

@@ -19,10 +19,9 @@ matplotlib.use("Agg")  # headless: no display in CI
 
 import numpy as np
 import pytest
+from _util import random_spd_system
 
 import bladecase as bc
-
-from _util import random_spd_system
 
 
 @pytest.fixture(scope="session")

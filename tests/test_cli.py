@@ -6,11 +6,10 @@ import json
 
 import numpy as np
 import pytest
+from _util import dense, random_spd_system
 
 import bladecase as bc
 from bladecase.cli import main
-
-from _util import dense, random_spd_system
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 TWO_DOF_ARGS = ["backbone", "--chain", "2", "--k", "1", "--m", "0.5", "--gap", "1", "--periods", "1:12:111"]
@@ -91,7 +90,8 @@ def test_matrices_file(tmp_path, capsys):
         (["backbone", "--chain", "2", "--gap", "1", "--periods", "1:5:0"], "COUNT must be >= 1"),
         (["backbone", "--chain", "0", "--gap", "1", "--periods", "1:5:3"], "expected a positive integer"),
         (["backbone", "--gap", "1", "--periods", "1:5:3"], "exactly one of --chain N or --matrices"),
-        (["backbone", "--chain", "2", "--k", "1,2,3", "--gap", "1", "--periods", "1:5:3"], "k must be a scalar or have 2"),
+        (["backbone", "--chain", "2", "--k", "1,2,3", "--gap", "1", "--periods", "1:5:3"],
+         "k must be a scalar or have 2"),
         (["backbone", "--chain", "2", "--k", "x", "--gap", "1", "--periods", "1:5:3"], "expected a number"),
         (["backbone", "--chain", "2", "--gap", "1", "--periods", "2:2:1", "--ipp", "2"], "period range"),
         (["backbone", "--matrices", "/nonexistent/sys.npz", "--periods", "1:5:3"], "cannot read"),

@@ -22,16 +22,13 @@ Regression tests of bugs fixed in 3fb26e6 are marked as such in comments.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 import scipy.linalg as sla
+from _util import dense, stacked
 from scipy.optimize import brentq
 
 import bladecase as bc
-
-from _util import dense, stacked
 
 # ---------------------------------------------------------------------------
 # Independent references (numpy / scipy only)

@@ -6,11 +6,9 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 import scipy.sparse as sp
-
-import bladecase as bc
-
 from _util import dense, random_spd_system, two_dof_exact
 
+import bladecase as bc
 
 # ---------------------------------------------------------------------------
 # chain(): the paper's Fig. 1 spring–mass chain, theory §1

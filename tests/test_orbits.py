@@ -12,11 +12,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from _util import dense, flow, stacked, two_dof_exact
 from scipy.optimize import fsolve
 
 import bladecase as bc
-
-from _util import dense, flow, stacked, two_dof_exact
 
 # ---------------------------------------------------------------------------
 # 1-dof oscillator: closed form (theory §4 with one mode)

@@ -24,17 +24,17 @@ import imageio.v3 as iio
 import meshio
 import numpy as np
 import pytest
-
-import bladecase as bc
 from _studies import PLATE as PLATE_BASE
 from _studies import ROOT, absolute, as_raw
-from bladecase.study import pipeline
+
+import bladecase as bc
 from bladecase.cli import main
-from bladecase.post.vtk import read_time_series
 from bladecase.fe.assembly import load_model, save_model
-from bladecase.reduction import load_reduced, reduce, save_reduced
-from bladecase.study.schema import demo_study, loads, validate
 from bladecase.post.animation import mp4_available
+from bladecase.post.vtk import read_time_series
+from bladecase.reduction import load_reduced, reduce, save_reduced
+from bladecase.study import pipeline
+from bladecase.study.schema import demo_study, loads, validate
 
 FRAMES = 8
 WINDOW = (320, 240)
@@ -173,7 +173,7 @@ def test_manifold_samples(demo_run):
         assert xc.max() <= d * (1 + 1e-9) and xc.max() == pytest.approx(d, rel=1e-9)  # admissible, impacts at d
         assert np.allclose(m.points[:, 0], xc)
         T = m.point_data["period"]
-        assert np.all((T >= 0.9 * demo_run.summary["search"]["period_unit_s"] * (1 - 1e-9)))
+        assert np.all(T >= 0.9 * demo_run.summary["search"]["period_unit_s"] * (1 - 1e-9))
         E = m.point_data["energy"].reshape(n, 16)
         assert np.allclose(E, E[:, :1], rtol=1e-12)  # one energy per orbit
 
@@ -250,7 +250,8 @@ def test_user_mesh_study_cli(plate_study, tmp_path, capsys):
     # the same analysis through the stage commands
     st = tmp_path / "stages"
     st.mkdir()
-    run = lambda *args: main([*args, "--quiet", "--no-progress"])
+    def run(*args):
+        return main([*args, "--quiet", "--no-progress"])
     assert run("mesh", str(plate_study), "-o", str(st / "plate.inp")) == 0
     assert run("assemble", str(plate_study), "--mesh", str(st / "plate.inp"), "-o", str(st / "model.npz")) == 0
     assert run("reduce", str(plate_study), "--model", str(st / "model.npz"), "-o", str(st / "red.npz")) == 0

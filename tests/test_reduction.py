@@ -28,15 +28,16 @@ Measured on this model (the tolerances keep a margin of 10–100 unless said):
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 import scipy.linalg as sla
 import scipy.sparse as sp
-from pathlib import Path
 
 import bladecase as bc
-from bladecase.reduction.contact import Contact
 from bladecase.reduction import FULL_LIMIT, METHODS, ReducedModel, reduce
+from bladecase.reduction.contact import Contact
 
 MESHES = Path(__file__).resolve().parent.parent / "meshes"
 GAP = 1e-4

@@ -8,11 +8,10 @@ import matplotlib.figure
 import matplotlib.pyplot as plt
 import numpy as np
 import pytest
+from _util import two_dof_exact
 from scipy.optimize import brentq, fsolve
 
 import bladecase as bc
-
-from _util import two_dof_exact
 
 
 def _two_dof_references():

@@ -13,10 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from _util import dense, floquet_multipliers, flow, resimulate, stacked
 
 import bladecase as bc
-
-from _util import dense, floquet_multipliers, flow, resimulate, stacked
 
 
 def _in_some_interval(bb, T):

@@ -6,12 +6,10 @@ import copy
 from pathlib import Path
 
 import pytest
+from _studies import PLATE, ROOT, absolute, as_raw
 
 from bladecase.cli import main
-from _studies import PLATE, ROOT, absolute, as_raw
 from bladecase.study.schema import SCHEMA, StudyError, demo_study, demo_text, load_study, loads, validate
-
-
 
 
 def raw_demo() -> dict:
@@ -57,7 +55,8 @@ BAD = [
     ("unknown key", lambda r: r["contact"].update(gapp=1e-4), "[contact] gapp: unknown key"),
     ("negative clearance", lambda r: r["contact"].update(clearance=-1e-4), "[contact] clearance: must be > 0"),
     ("zero clearance", lambda r: r["contact"].update(clearance=0.0), "[contact] clearance"),
-    ("clearance as string", lambda r: r["contact"].update(clearance="0.1 mm"), "[contact] clearance: expected a number"),
+    ("clearance as string", lambda r: r["contact"].update(clearance="0.1 mm"),
+     "[contact] clearance: expected a number"),
     ("missing clearance", lambda r: r["contact"].pop("clearance"), "[contact] clearance: required"),
     ("NaN size", lambda r: r["geometry"].update(size=float("nan")), "[geometry] size"),
     ("bool as integer", lambda r: r["reduction"].update(size=True), "[reduction] size: expected an integer"),

@@ -29,9 +29,9 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Callable, Sequence, Union
 
 import numpy as np
 import scipy.sparse as sp
@@ -55,7 +55,7 @@ CHUNK_CELLS = 4096
 #: A cell whose volume is below this fraction of the largest one is degenerate.
 DEGENERATE_RTOL = 1e-12
 
-Clamp = Union[str, Sequence[int], np.ndarray, Callable[[np.ndarray], np.ndarray], None]
+Clamp = str | Sequence[int] | np.ndarray | Callable[[np.ndarray], np.ndarray] | None
 
 _ELEMENTS = {
     (3, 1): ElementTetP1, (3, 2): ElementTetP2,
@@ -129,7 +129,7 @@ class Material:
         object.__setattr__(self, "nu", nu)
 
     @classmethod
-    def preset(cls, name: str) -> "Material":
+    def preset(cls, name: str) -> Material:
         """A preset by name, case and punctuation ignored.
 
         Names: ``"Ti-6Al-4V"`` (also ``"titanium"``), ``"steel"``,
@@ -714,7 +714,8 @@ def model_from_arrays(data, prefix: str = "", source: str = "") -> FEModel:
                   n_total=int(data[f"{prefix}dofs/n_total"]))
     return FEModel(
         K=sparse_from_arrays(data, f"{prefix}K"), M=sparse_from_arrays(data, f"{prefix}M"), dofs=dofs,
-        mesh=mesh_from_arrays(data, f"{prefix}mesh/"), material=Material(E, nu, rho, str(data[f"{prefix}material_name"])),
+        mesh=mesh_from_arrays(data, f"{prefix}mesh/"),
+        material=Material(E, nu, rho, str(data[f"{prefix}material_name"])),
         order=int(data[f"{prefix}order"]), mass=str(data[f"{prefix}mass"]),
         thickness=None if math.isnan(thickness) else thickness, plane=str(data[f"{prefix}plane"]) or None,
         clamped=np.asarray(data[f"{prefix}clamped"]), volume=float(data[f"{prefix}volume"]),

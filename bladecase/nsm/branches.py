@@ -15,7 +15,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .system import LinearSystem
 from .orbits import (
     REPEAT_RTOL,
     PeriodicOrbit,
@@ -24,10 +23,10 @@ from .orbits import (
     _solve_times,
     canonical_rotation,
     check_period,
-    kipp_residual,
     make_orbit,
     orbits_kipp,
 )
+from .system import LinearSystem
 
 #: Relative precision in ``T`` of the refined ends of admissible arcs.
 ARC_RTOL = 1e-9
@@ -283,7 +282,7 @@ def _repetition_offsets(times, T) -> list[np.ndarray]:
     return [np.mod(np.roll(times, -(k // j)) - times, T) - T / j for j in range(2, k + 1) if k % j == 0]
 
 
-def _crosses_repetition(curve: "_Curve", z_a, z_b) -> bool:
+def _crosses_repetition(curve: _Curve, z_a, z_b) -> bool:
     """Does the segment ``z_a → z_b`` cross a repeated orbit (all offsets flip sign)?"""
     for da, db in zip(_repetition_offsets(*curve.times(z_a)[::-1]), _repetition_offsets(*curve.times(z_b)[::-1])):
         if np.all(np.sign(da) * np.sign(db) < 0):

@@ -18,8 +18,8 @@ from functools import cached_property
 
 import numpy as np
 
-from .system import LinearSystem
 from .signals import TrigSum, certified_max
+from .system import LinearSystem
 
 #: ``T`` is resonant when ``|ω_j T - 2πm| <= RESONANCE_RTOL · ω_j T`` for an
 #: integer ``m >= 1`` and a mode with ``b_j ≠ 0``: within the accuracy of the
@@ -68,7 +68,7 @@ class _Modal:
     T: float
 
     @classmethod
-    def of(cls, system: LinearSystem, T: float) -> "_Modal":
+    def of(cls, system: LinearSystem, T: float) -> _Modal:
         omega, b, phi = system.spectrum.contact_modes
         return cls(omega=omega, b=b, phi=phi, sin_half=np.sin(omega * T / 2), T=T)
 

@@ -7,13 +7,13 @@ the frequency–energy data, and refines the maximal admissible intervals of
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Callable, Sequence
 
 import numpy as np
 
-from .system import LinearSystem
 from .orbits import PeriodicOrbit, orbit_1ipp
+from .system import LinearSystem
 
 #: Relative precision in ``T`` of the refined ends of admissible intervals.
 BISECTION_RTOL = 1e-9

@@ -17,8 +17,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .system import LinearSystem
 from .signals import TrigSum, first_upcrossing
+from .system import LinearSystem
 
 #: Relative tolerance (of ``gap``) within which a state counts as "at the obstacle"
 #: (raised to the round-off of ``wᵀx`` for large amplitudes).
@@ -200,7 +200,8 @@ def simulate(
         if len(times) >= max_impacts or tiny_flights > 50:
             complete = False
             why = "max_impacts reached" if len(times) >= max_impacts else "impacts accumulate (chattering)"
-            warnings.warn(f"simulate stopped at t = {t:.6g} after {len(times)} impacts: {why}", RuntimeWarning)
+            warnings.warn(f"simulate stopped at t = {t:.6g} after {len(times)} impacts: {why}", RuntimeWarning,
+                          stacklevel=2)
             break
     phi = sp.phi
     Q = np.array(qs).T if qs else np.zeros((n, 0))

@@ -12,16 +12,16 @@ participations ``b_j = wᵀφ_j``) is computed once, on first use, and cached.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Sequence, Union
 
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-ArrayLike = Union[np.ndarray, sp.spmatrix, sp.sparray]
+ArrayLike = np.ndarray | sp.spmatrix | sp.sparray
 
 #: Relative tolerance of the symmetry check ``max|A - Aᵀ| <= SYMMETRY_RTOL * max|A|``.
 SYMMETRY_RTOL = 1e-10

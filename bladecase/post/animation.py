@@ -17,8 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..fe import Mesh
 from ..io import atomic_path
-from ..fe.mesh import Mesh
 
 _FIELD = "magnitude of u (m)"  # VTK's fonts draw no "|"
 

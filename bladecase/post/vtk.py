@@ -30,8 +30,8 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from ..io import atomic_path, replace_dir
 from ..fe.mesh import GROUP_PREFIX, Mesh
+from ..io import atomic_path, replace_dir
 
 #: Point-data names :func:`write_time_series` writes itself (plus ``group:<name>``).
 TIME_SERIES_ARRAYS = ("displacement", "velocity", "displacement_magnitude")

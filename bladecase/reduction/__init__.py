@@ -7,7 +7,13 @@ reduced states back to the mesh.
 
 from .contact import Contact, radial_normal
 from .lanczos import (
-    LanczosChain, MassFactor, PerDofDefect, SymmetryBasis, lanczos_chain, mass_factor, per_dof_defect,
+    LanczosChain,
+    MassFactor,
+    PerDofDefect,
+    SymmetryBasis,
+    lanczos_chain,
+    mass_factor,
+    per_dof_defect,
 )
 from .methods import FULL_LIMIT, METHODS, ReducedModel, load_reduced, reduce, save_reduced
 

@@ -22,13 +22,13 @@ mesh oriented otherwise.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 
 from ..fe.assembly import FEModel, _positive
-from ..nsm.system import LinearSystem
+from ..nsm import LinearSystem
 
 
 def radial_normal(dim: int) -> np.ndarray:
@@ -141,7 +141,7 @@ class Contact:
     @classmethod
     def at(
         cls, model: FEModel, node: int, normal: Sequence[float] | None = None, gap: float | None = None
-    ) -> "Contact":
+    ) -> Contact:
         """The contact on mesh node ``node`` of ``model`` (checked), normal defaulted to the radial direction."""
         contact = cls(node, normal, gap)
         return contact._resolved(model)
@@ -150,7 +150,7 @@ class Contact:
     def nearest(
         cls, model: FEModel, point: Sequence[float], normal: Sequence[float] | None = None,
         gap: float | None = None, group: str | None = None,
-    ) -> "Contact":
+    ) -> Contact:
         """The contact on the free node of ``model`` nearest ``point`` (lowest index on a tie).
 
         ``point`` has ``model.dim`` coordinates (``(x, y, 0)`` is accepted in 2-D).
@@ -171,7 +171,7 @@ class Contact:
         normal: Sequence[float] | None = None,
         gap: float | None = None,
         group: str | None = "tip",
-    ) -> "Contact":
+    ) -> Contact:
         """The contact on the free node of ``group`` farthest along ``direction``.
 
         E.g. ``Contact.farthest(model, (-1, 0, 0), gap=1e-4)`` picks the tip
@@ -240,7 +240,7 @@ class Contact:
         """
         return LinearSystem(model.M, model.K, self.w(model), self.gap)
 
-    def _resolved(self, model: FEModel) -> "Contact":
+    def _resolved(self, model: FEModel) -> Contact:
         """This contact with its normal made explicit for ``model``, after checking the node."""
         self.dofs(model)
         return Contact(self.node, tuple(self.normal_for(model)), self.gap)

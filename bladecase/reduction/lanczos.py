@@ -49,9 +49,9 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .contact import Contact
-from ..fe.assembly import FEModel
+from ..fe import FEModel
 from ..nsm.system import LinearSystem, _diagonal, _is_sparse
+from .contact import Contact
 
 #: Lanczos stops (invariant subspace reached) when the next off-diagonal
 #: ``β_j <= BREAKDOWN_RTOL · ‖A‖`` (``‖A‖`` estimated by the largest
@@ -291,7 +291,7 @@ class SymmetryBasis:
         self._m_inv_w = self.factor.solve_t(self.w_hat)  # M⁻¹w = F⁻ᵀF⁻¹w
 
     @classmethod
-    def of(cls, system_or_model: LinearSystem | FEModel, contact: Contact | None = None) -> "SymmetryBasis":
+    def of(cls, system_or_model: LinearSystem | FEModel, contact: Contact | None = None) -> SymmetryBasis:
         """The basis of a :class:`LinearSystem`, or of an :class:`FEModel` with a :class:`Contact`."""
         M, _, w, _ = _operands(system_or_model, contact)
         return cls(M, w)

@@ -42,7 +42,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import TYPE_CHECKING, Union
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.linalg as sla
@@ -50,14 +50,14 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.spatial import cKDTree
 
-from .contact import Contact
-from ..fe.assembly import FEModel, natural_frequencies
-from .lanczos import LanczosChain, lanczos_chain
+from ..fe import FEModel, natural_frequencies
 from ..fe.mesh import _P2_EDGES
-from ..nsm.system import LinearSystem
+from ..nsm import LinearSystem
+from .contact import Contact
+from .lanczos import LanczosChain, lanczos_chain
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..nsm.orbits import PeriodicOrbit
+    from ..nsm import PeriodicOrbit
 
 #: Accepted values of ``method`` in :func:`reduce`.
 METHODS = ("full", "modal", "lanczos", "lanczos-si", "craig-bampton")
@@ -102,7 +102,7 @@ class ReducedModel:
     method: str
     size: int
     system: LinearSystem
-    basis: Union[np.ndarray, sp.csr_array] = field(repr=False)
+    basis: np.ndarray | sp.csr_array = field(repr=False)
     model: FEModel = field(repr=False)
     contact: Contact
     chain: LanczosChain | None = field(default=None, repr=False)
@@ -141,7 +141,7 @@ class ReducedModel:
         u = u.reshape(self.model.mesh.points.shape[0], self.model.dim, -1)
         return u if x.ndim == 2 else u[:, :, 0]
 
-    def expand(self, orbit: "PeriodicOrbit", t) -> tuple[np.ndarray, np.ndarray]:
+    def expand(self, orbit: PeriodicOrbit, t) -> tuple[np.ndarray, np.ndarray]:
         """Displacements and velocities of every mesh node along a periodic orbit of :attr:`system`.
 
         Parameters

@@ -23,15 +23,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..reduction.contact import Contact
-from ..nsm.branches import Arc, Family, nonsmooth_mode
-from ..fe.assembly import FEModel, Material, assemble, natural_frequencies
-from ..fe.geometry import blade_mesh
+from ..fe import FEModel, Material, Mesh, assemble, blade_mesh, load_mesh, natural_frequencies
 from ..io import replace_dir, save_figure, write_json, write_text
-from ..fe.mesh import Mesh, load_mesh
-from ..nsm.system import LinearSystem
-from ..nsm.orbits import PeriodicOrbit
-from ..reduction.methods import ReducedModel, reduce
+from ..nsm import Arc, Family, LinearSystem, PeriodicOrbit, nonsmooth_mode
+from ..reduction import Contact, ReducedModel, reduce
 from .schema import Study, StudyError
 
 log = logging.getLogger("bladecase")
@@ -61,7 +56,7 @@ def build_mesh(study: Study, path: str | os.PathLike | None = None) -> Mesh:
             raise StudyError(f"[mesh] path: no such file {str(source)!r}")
         mesh = load_mesh(source)
         if path is not None:
-            from ..fe.mesh import save_mesh
+            from ..fe import save_mesh
 
             save_mesh(mesh, path)
     for name, key in zip(need, ("[fem] clamp", "[contact] group")):
@@ -265,7 +260,7 @@ def choose_orbits(study: Study, families: list[Family], unit: float) -> list[Cho
     # Widest arcs first, one per family; then further arcs of the same families if fewer families than asked.
     order = [x for x in arcs if x[1] not in {y[1] for y in arcs[:arcs.index(x)]}]
     order += [x for x in arcs if x not in order]
-    for width, i, n in order:
+    for _width, i, n in order:
         if len(chosen) >= o["animate"]:
             break
         fam = families[i]
@@ -410,7 +405,7 @@ def run(study: Study, out: str | os.PathLike | None = None, progress: bool = Tru
     try:
         stage("mesh")
         mesh = build_mesh(study)
-        from ..fe.mesh import save_mesh
+        from ..fe import save_mesh
 
         save_mesh(mesh, staging / "mesh.vtu")
         files["mesh"] = "mesh.vtu"
@@ -539,7 +534,7 @@ def verify(orbit: PeriodicOrbit) -> dict:
     Returns ``{"return_error": ‖z(T) − z(0)‖/‖z(0)‖ (state (x, v) scaled by
     its component ranges), "impacts": impacts found in (0, T], "ok": bool}``.
     """
-    from ..nsm.simulation import simulate
+    from ..nsm import simulate
 
     T, k = orbit.T, orbit.k
     x0, v0 = orbit.state(np.array([0.0]))
@@ -600,7 +595,8 @@ def _plot(study, families, compares, compare_families, reduced, f_fe, path: Path
 
 def _render(study: Study, reduced: ReducedModel, families: list[Family], choice: Choice, staging: Path,
             progress: bool) -> dict:
-    from ..post import animation as viz, vtk as export
+    from ..post import animation as viz
+    from ..post import vtk as export
 
     o = study["output"]
     orbit = choice.orbit

@@ -24,8 +24,8 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from ..fe.geometry import BladeGeometry, PlateGeometry
-from ..reduction.methods import METHODS
+from ..fe import BladeGeometry, PlateGeometry
+from ..reduction import METHODS
 
 REQUIRED = object()  #: marks a key without a default
 
