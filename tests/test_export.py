@@ -130,7 +130,7 @@ def test_time_series_opens_in_pyvista(which, tmp_path, request):
         assert block.n_cells == len(mesh.cells[mesh.body_type])
         close(block.point_data["displacement"], pad3(u[:, :, j]))
         close(block.point_data["velocity"], pad3(v[:, :, j]))
-        # VTK reads the field data written beside meshio's output.
+        # VTK reads the field data.
         np.testing.assert_allclose(block.field_data["time"], [times[j]], rtol=1e-15, atol=0)
         np.testing.assert_allclose(block.field_data["period"], [T], rtol=1e-15, atol=0)
 
@@ -152,16 +152,19 @@ def test_rewrite_replaces_old_frames(blade, tmp_path):
 
 
 def _fail_after(monkeypatch, n_ok: int):
-    real = meshio.write
+    """The frame writer (VTK's, through ``pyvista.UnstructuredGrid.save``) fails after ``n_ok`` frames."""
+    import pyvista as pv
+
+    real = pv.UnstructuredGrid.save
     calls = {"n": 0}
 
-    def failing(*args, **kwargs):
+    def failing(self, *args, **kwargs):
         calls["n"] += 1
         if calls["n"] > n_ok:
             raise OSError("disk full (simulated)")
-        return real(*args, **kwargs)
+        return real(self, *args, **kwargs)
 
-    monkeypatch.setattr(meshio, "write", failing)
+    monkeypatch.setattr(pv.UnstructuredGrid, "save", failing)
     return calls
 
 
@@ -313,3 +316,59 @@ def test_manifold_rejects_other_suffix(tmp_path):
     coords, _ = manifold_samples()
     with pytest.raises(ValueError, match=r"\.vtu"):
         write_manifold(tmp_path / "m.vtk", coords)
+
+
+# ----------------------------------------------------------------------------- P2 models: every FE node
+
+
+@pytest.fixture(scope="module", params=["plate", "blade"])
+def p2_model(request) -> bc.FEModel:
+    if request.param == "plate":
+        return bc.assemble(bc.load_mesh(MESHES / "plate.vtu"), "steel", order=2, thickness=0.002)
+    return bc.assemble(request.getfixturevalue("blade"), "Ti-6Al-4V", order=2)
+
+
+def test_p2_series_has_all_nodes_and_quadratic_cells(p2_model, tmp_path):
+    """A P2 field written on ``fe_grid``: all FE nodes (vertices and edge midpoints) and quadratic cells,
+    read back with meshio and with pyvista's PVD reader; the field at every node is the model's dof value."""
+    pv = pytest.importorskip("pyvista")
+    from bladecase.post.grid import fe_grid, nodal_field
+
+    model, dim = p2_model, p2_model.dim
+    grid = fe_grid(model)
+    n_vertices = len(np.unique(model.mesh.cells[model.mesh.body_type][:, : dim + 1]))
+    assert len(grid.points) == model.dofs.n_total // dim > n_vertices
+    # u at the dofs: the synthetic orbit, evaluated at each dof's location
+    times = np.arange(F) * T / F
+    d = model.dofs
+    s = d.coords[:, dim - 1] / d.coords[:, dim - 1].max()
+    amp = np.where(d.direction == 0, AMP, 0.2 * AMP) * s**2
+    x = amp[:, None] * np.cos(2 * np.pi * times / T + 0.3 * d.direction[:, None])
+    u, v = nodal_field(model, x), nodal_field(model, -x)
+    pvd = write_time_series(tmp_path, "p2", grid, times, u, v, field_data={"period": T})
+
+    body = grid.body_type
+    assert body == ("tetra10" if dim == 3 else "triangle6")
+    expected = np.zeros((len(grid.points), dim, F))
+    expected[d.fe_index // dim, d.direction] = x
+    _, files = read_time_series(pvd)
+    for j, f in enumerate(files):
+        m = meshio.read(f)
+        np.testing.assert_array_equal(m.points, grid.points)
+        assert [c.type for c in m.cells] == [body]
+        np.testing.assert_array_equal(m.cells[0].data, grid.cells[body])
+        close(m.point_data["displacement"], pad3(expected[:, :, j]))
+        close(m.point_data["velocity"], pad3(-expected[:, :, j]))
+        np.testing.assert_allclose(m.field_data["time"], [times[j]], rtol=1e-15, atol=0)
+    reader = pv.get_reader(str(pvd))
+    quadratic = pv.CellType.QUADRATIC_TETRA if dim == 3 else pv.CellType.QUADRATIC_TRIANGLE
+    for j, t in enumerate(reader.time_values):
+        reader.set_active_time_value(t)
+        data = reader.read()
+        block = data[0] if isinstance(data, pv.MultiBlock) else data
+        assert block.n_points == len(grid.points)
+        assert set(np.asarray(block.celltypes)) == {int(quadratic)}
+        close(block.point_data["displacement"], pad3(expected[:, :, j]))
+        np.testing.assert_allclose(block.field_data["period"], [T], rtol=1e-15, atol=0)
+        size = block.compute_cell_sizes(length=False, area=dim == 2, volume=dim == 3)
+        assert np.asarray(size.cell_data["Volume" if dim == 3 else "Area"]).min() > 0

@@ -213,3 +213,66 @@ def test_no_offscreen_rendering_is_a_clear_error(plate, tmp_path, monkeypatch):
     with pytest.raises(RuntimeError, match="off-screen rendering is not available.*xvfb"):
         viz.animate(**_kwargs(plate, tmp_path))
     assert list(tmp_path.iterdir()) == []
+
+
+# ----------------------------------------------------------------------------- quadratic cells (P2 models)
+
+
+@pytest.fixture(scope="module", params=["plate", "blade"])
+def p2_grid(request):
+    """``(model, fe_grid(model))`` of a P2 model: all FE nodes, quadratic cells."""
+    from bladecase.post.grid import fe_grid
+
+    mesh = request.getfixturevalue(request.param)
+    model = bc.assemble(mesh, "steel", order=2, **({"thickness": 0.002} if mesh.dim == 2 else {}))
+    return model, fe_grid(model)
+
+
+def _quadratic(x: np.ndarray, dim: int, L: float) -> np.ndarray:
+    """A quadratic displacement field ``(n, dim)`` of ``x / L``, exact on P2 cells."""
+    y = x / L
+    cols = [y[:, 1] ** 2 + 0.3 * y[:, 0] * y[:, 1], 0.5 * y[:, 0] - y[:, 1] ** 2, y[:, 0] * y[:, 2] + y[:, 2] ** 2]
+    return GAP * np.column_stack(cols[:dim])
+
+
+def test_quadratic_surface_interpolates_the_p2_field(p2_grid):
+    """The drawn surface of quadratic cells: subdivided faces through all the boundary nodes, with the
+    displacement interpolated by the quadratic shape functions (exact for a quadratic field)."""
+    _, grid = p2_grid
+    dim, L = grid.dim, float(np.abs(grid.points).max())
+    u = _quadratic(grid.points, dim, L)
+    u3 = np.zeros((len(grid.points), 3, 2))
+    u3[:, :dim, 0] = u
+    u3[:, :dim, 1] = -2 * u
+    _, surf, ref, su = viz._surface(grid.points, grid, dim, u3)
+    assert surf.n_points == len(ref) == len(su)
+    if dim == 2:  # the whole plate is its surface: every node, plus the subdivision points
+        assert len(ref) > len(grid.points)
+    np.testing.assert_allclose(su[:, :dim, 0], _quadratic(ref, dim, L), rtol=0, atol=1e-12 * GAP)
+    np.testing.assert_allclose(su[:, :, 1], -2 * su[:, :, 0], rtol=0, atol=1e-15 * GAP)
+    # every node of the clamped root face (vertices and midside nodes) is a point of the drawn surface
+    root = grid.points[grid.groups["root"]]
+    from scipy.spatial import cKDTree
+
+    assert cKDTree(ref).query(root)[0].max() < 1e-12 * L
+
+
+def test_animate_p2_grid(p2_grid, tmp_path):
+    """A P2 field on the full grid (quadratic cells) renders like a linear mesh: one moving frame per time."""
+    from bladecase.post.grid import grid_index, nodal_field
+
+    model, grid = p2_grid
+    dim = grid.dim
+    s = model.dofs.coords[:, dim - 1] / model.dofs.coords[:, dim - 1].max()
+    shape = np.where(model.dofs.direction == 0, 20 * GAP, GAP) * s**2
+    times = np.arange(4) * PERIOD / 4
+    u = nodal_field(model, shape[:, None] * np.cos(2 * np.pi * times / PERIOD))
+    contact = grid_index(model, int(model.mesh.group("contact")[0]))
+    written = viz.animate(grid, u, times, period=PERIOD, impact_frames=np.arange(4) == 0, contact_node=contact,
+                          normal=np.eye(dim)[-1], gap=GAP, scale=viz.auto_scale(grid, u), gif=tmp_path / "p2.gif",
+                          window_size=(240, 180))
+    frames = imageio.imread(written["gif"], index=None)[..., :3]
+    assert frames.shape[:3] == (4, 180, 240)
+    assert all(img.std() > 10.0 for img in frames)
+    assert min(np.abs(frames[i].astype(int) - frames[0]).max() for i in range(1, 4)) > 0
+    assert _red(frames[0]) > _red(frames[2])

@@ -19,8 +19,12 @@ import numpy as np
 
 from ..fe import Mesh
 from ..io import atomic_path
+from .grid import VTK_CELL_TYPES
 
 _FIELD = "magnitude of u (m)"  # VTK's fonts draw no "|"
+
+#: Subdivision level of the faces of quadratic cells when drawn (each level splits a face in 4).
+SUBDIVISION = 2
 
 
 def mp4_available() -> bool:
@@ -93,8 +97,14 @@ def animate(
     Parameters
     ----------
     mesh : Mesh
-        Body cells tetra/tetra10 (3-D) or triangle/triangle6 (2-D, ``z = 0``);
-        quadratic cells are drawn straight, through their corner nodes.
+        Body cells tetra/tetra10 (3-D) or triangle/triangle6 (2-D, ``z = 0``).
+        Quadratic cells are drawn with all their nodes: their faces are
+        subdivided (:data:`SUBDIVISION`) and ``u`` is interpolated by the
+        quadratic shape functions, so a P2 field shows its bending within a
+        cell.  To draw everything a P2 model computed, pass
+        :func:`bladecase.post.grid.fe_grid` and
+        :func:`bladecase.post.grid.nodal_field` (a mesh's own ``tetra10``
+        midside nodes are not where the P2 edge dofs are).
     u : (n_nodes, dim, F) ndarray
         Displacement of every node at the ``F >= 2`` frames (m).
     times : (F,) ndarray
@@ -154,7 +164,7 @@ def animate(
         f"T = {period:.4g} s   f = {1.0 / period:.4g} Hz",
         f"displacements \u00d7 {scale:.4g} (casing at clearance {_length(gap)}, same scale)",
     ]
-    frames = _render(pts, mesh, dim, warped, mag, umax, corners, contact_node, impact, times / period, title,
+    frames = _render(pts, mesh, dim, u3, scale, warped, umax, corners, contact_node, impact, times / period, title,
                      texts, window_size, size, bounds, normal, e1)
     out = {"gif": Path(gif)}
     with atomic_path(gif) as tmp:
@@ -239,21 +249,49 @@ def _length(x: float) -> str:
     raise AssertionError  # unreachable
 
 
-def _render(pts, mesh, dim, warped, mag, umax, corners, contact_node, impact, phase, title, texts,
+def _surface(pts: np.ndarray, mesh: Mesh, dim: int, u3: np.ndarray):
+    """``(grid, surf, ref, su)``: the body as a ``pyvista.UnstructuredGrid``, its drawn surface, and the
+    reference coordinates ``(m, 3)`` and displacements ``(m, 3, F)`` of the surface points.
+
+    Quadratic cells are kept quadratic: their boundary faces are subdivided
+    :data:`SUBDIVISION` times (VTK's nonlinear subdivision), and the new points
+    get the coordinates and displacements interpolated by the cells' quadratic
+    shape functions (exact at the nodes).
+    """
+    import pyvista as pv
+
+    body_type = mesh.body_type
+    if body_type not in VTK_CELL_TYPES:
+        raise ValueError(f"mesh body cells {body_type!r} cannot be drawn; valid: {', '.join(VTK_CELL_TYPES)}")
+    body = np.asarray(mesh.cells[body_type], dtype=np.int64)
+    grid = pv.UnstructuredGrid({pv.CellType[VTK_CELL_TYPES[body_type]]: body}, pts.copy())
+    nframes = u3.shape[2]
+    grid.point_data["reference"] = pts
+    grid.point_data["u"] = u3.reshape(len(pts), 3 * nframes)
+    level = SUBDIVISION if body.shape[1] > dim + 1 else None
+    surf = grid.extract_surface(pass_pointid=False, pass_cellid=False, nonlinear_subdivision=level,
+                                algorithm="dataset_surface")
+    ref = np.array(surf.point_data["reference"], dtype=float)
+    su = np.array(surf.point_data["u"], dtype=float).reshape(-1, 3, nframes)
+    for name in ("reference", "u"):
+        surf.point_data.remove(name)
+        grid.point_data.remove(name)
+    surf.points = ref
+    return grid, surf, ref, su
+
+
+def _render(pts, mesh, dim, u3, scale, warped, umax, corners, contact_node, impact, phase, title, texts,
             window_size, size, bounds, normal, e1):
     """The ``(F, h, w, 3)`` uint8 frames, rendered with one plotter whose actors are updated in place."""
     if not os.environ.get("DISPLAY"):  # headless: go straight to EGL rather than failing over from X11 noisily
         os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     import pyvista as pv
 
-    body = np.asarray(mesh.cells[mesh.body_type])[:, : dim + 1]
-    celltype = pv.CellType.TETRA if dim == 3 else pv.CellType.TRIANGLE
-    grid = pv.UnstructuredGrid({celltype: body}, pts.copy())
-    surf = grid.extract_surface(pass_pointid=True, pass_cellid=False, algorithm="dataset_surface")
-    ids = np.asarray(surf.point_data["vtkOriginalPointIds"])
+    grid, surf, ref, su = _surface(pts, mesh, dim, u3)
+    smag = np.linalg.norm(su, axis=1)  # (m, F) true |u| at the surface points
     outline = surf.extract_feature_edges(boundary_edges=True, feature_edges=dim == 3, manifold_edges=False,
                                          non_manifold_edges=False, feature_angle=40.0)
-    surf.point_data[_FIELD] = mag[ids, 0]
+    surf.point_data[_FIELD] = smag[:, 0]
     sphere0 = pv.Sphere(radius=0.02 * size, center=(0.0, 0.0, 0.0))
     marker = sphere0.copy()
     casing = pv.PolyData(corners, faces=[4, 0, 1, 2, 3])
@@ -267,7 +305,7 @@ def _render(pts, mesh, dim, warped, mag, umax, corners, contact_node, impact, ph
                     scalar_bar_args=dict(title=_FIELD, fmt="%.2e", vertical=True, position_x=0.86, position_y=0.2,
                                          height=0.55, width=0.06, title_font_size=14, label_font_size=12))
         if dim == 2:  # the reference mesh, just behind the plane z = 0 (the warped mesh hides it)
-            outline = outline.merge(surf.extract_all_edges()).translate((0, 0, -0.01 * size))
+            outline = outline.merge(grid.extract_all_edges()).translate((0, 0, -0.01 * size))
         pl.add_mesh(outline, color="black", opacity=0.25 if dim == 3 else 0.12, line_width=1)
         casing_actor = pl.add_mesh(casing, color="grey", opacity=0.4 if dim == 3 else 0.8, lighting=False)
         pl.add_mesh(marker, color="magenta", lighting=False)
@@ -277,8 +315,8 @@ def _render(pts, mesh, dim, warped, mag, umax, corners, contact_node, impact, ph
         _camera(pl, dim, normal, e1, bounds)
         frames = []
         for i in range(nframes):
-            surf.points = warped[ids, :, i]
-            surf.point_data[_FIELD] = mag[ids, i]
+            surf.points = ref + scale * su[:, :, i]
+            surf.point_data[_FIELD] = smag[:, i]
             marker.points = sphere0.points + warped[contact_node, :, i]
             casing_actor.prop.color = "red" if impact[i] else "grey"
             hit.SetVisibility(bool(impact[i]))

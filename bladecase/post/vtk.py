@@ -17,6 +17,13 @@
 Every file is written atomically: a reader, or a crash, never sees a
 half-written result (frames go to a temporary folder renamed into place, the
 ``.pvd`` is renamed into place last).
+
+The frames are written by VTK's XML writer (``pyvista.UnstructuredGrid.save``,
+binary, zlib-compressed), which writes point data and field data alike; the
+manifold by meshio.  The ``.pvd`` is a short XML text written here.  To show
+the field of a P2 model at all its nodes, write it on
+:func:`bladecase.post.grid.fe_grid` (quadratic ``tetra10``/``triangle6`` cells)
+with :func:`bladecase.post.grid.nodal_field`.
 """
 
 from __future__ import annotations
@@ -32,6 +39,7 @@ import numpy as np
 
 from ..fe.mesh import GROUP_PREFIX, Mesh
 from ..io import atomic_path, replace_dir
+from .grid import VTK_CELL_TYPES
 
 #: Point-data names :func:`write_time_series` writes itself (plus ``group:<name>``).
 TIME_SERIES_ARRAYS = ("displacement", "velocity", "displacement_magnitude")
@@ -39,7 +47,7 @@ TIME_SERIES_ARRAYS = ("displacement", "velocity", "displacement_magnitude")
 #: Point-data names :func:`write_manifold` writes itself.
 MANIFOLD_ARRAYS = ("orbit", "phase_index")
 
-#: dtypes meshio's ``.vtu`` writer accepts as they are.
+#: dtypes the ``.vtu`` writers accept as they are.
 _VTU_DTYPES = frozenset(
     np.dtype(t) for t in (np.float32, np.float64, np.int8, np.int16, np.int32, np.int64,
                           np.uint8, np.uint16, np.uint32, np.uint64)
@@ -70,8 +78,10 @@ def write_time_series(
         Plain file name (no path separator): the collection is
         ``directory/stem.pvd``, the frames ``directory/stem/stem_0000.vtu`` …
     mesh : Mesh
-        The reference configuration; only its body cells (``mesh.body_type``)
-        are written.
+        The reference configuration; only its body cells (``mesh.body_type``:
+        ``tetra``, ``tetra10``, ``triangle`` or ``triangle6``) are written,
+        quadratic cells with all their nodes (e.g. the grid of
+        :func:`bladecase.post.grid.fe_grid`).
     times : (F,) array_like
         Time of each frame (s), finite and non-decreasing, ``F >= 1``.
     u, v : (n_nodes, mesh.dim, F) array_like
@@ -91,7 +101,7 @@ def write_time_series(
     Notes
     -----
     Each frame holds the reference points ``(n_nodes, 3)``, the body cells
-    (quadratic cells as quadratic VTK cells), the point data
+    (quadratic cells as quadratic VTK cells, :data:`VTK_CELL_TYPES`), the point data
     ``displacement`` and ``velocity`` (``(n_nodes, 3)``: planar fields get a
     zero ``z`` component, so ParaView's *Warp By Vector* works),
     ``displacement_magnitude``, the extra ``point_data``, each group as a
@@ -110,9 +120,26 @@ def write_time_series(
         A bad ``stem``, inconsistent shapes, non-finite values, decreasing
         times, bad ``point_data``/``field_data``; the message names the
         argument and what is valid.
-    """
-    import meshio
 
+    Examples
+    --------
+    One quadratic triangle moving rigidly along ``x``, three frames:
+
+    >>> import tempfile
+    >>> import numpy as np
+    >>> from bladecase.fe import Mesh
+    >>> from bladecase.post.vtk import read_time_series, write_time_series
+    >>> tri6 = Mesh(points=np.array([[0., 0, 0], [1, 0, 0], [0, 1, 0], [.5, 0, 0], [.5, .5, 0], [0, .5, 0]]),
+    ...             cells={"triangle6": np.array([[0, 1, 2, 3, 4, 5]])}, dim=2)
+    >>> t = np.array([0.0, 0.5, 1.0])
+    >>> u = np.zeros((6, 2, 3)); u[:, 0] = np.sin(t)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     pvd = write_time_series(folder, "orbit", tri6, t, u, np.zeros_like(u), field_data={"period": 1.0})
+    ...     times, files = read_time_series(pvd)
+    ...     names = [f.name for f in files]
+    >>> pvd.name, times.tolist(), names
+    ('orbit.pvd', [0.0, 0.5, 1.0], ['orbit_0000.vtu', 'orbit_0001.vtu', 'orbit_0002.vtu'])
+    """
     stem = _check_stem(stem)
     directory = Path(directory)
     body_type = mesh.body_type
@@ -137,24 +164,24 @@ def write_time_series(
         constant[GROUP_PREFIX + name] = mask
     width = max(4, len(str(n_frames - 1)))
     names = [f"{stem}_{j:0{width}d}.vtu" for j in range(n_frames)]
+    grid = _vtk_grid(points, body_type, body)
 
     directory.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{stem}.tmp-", dir=directory))
     try:
-        disp = np.zeros((n_nodes, 3))
-        vel = np.zeros((n_nodes, 3))
         for j in range(n_frames):
+            disp = np.zeros((n_nodes, 3))
+            vel = np.zeros((n_nodes, 3))
             disp[:, :dim] = u[:, :, j]
             vel[:, :dim] = v[:, :, j]
-            data = {
-                "displacement": disp,
-                "velocity": vel,
-                "displacement_magnitude": np.sqrt(np.einsum("ij,ij->i", disp, disp)),
-                **constant,
-            }
-            frame = tmp / names[j]
-            meshio.write(frame, meshio.Mesh(points, [(body_type, body)], point_data=data), file_format="vtu")
-            _add_field_data(frame, {"time": float(times[j]), **scalars})
+            grid.point_data.clear()
+            grid.field_data.clear()
+            for name, a in {"displacement": disp, "velocity": vel,
+                            "displacement_magnitude": np.sqrt(np.einsum("ij,ij->i", disp, disp)), **constant}.items():
+                grid.point_data[name] = a
+            for name, x in {"time": float(times[j]), **scalars}.items():
+                grid.field_data[name] = np.array([x], dtype=np.int64 if isinstance(x, int) else float)
+            _save(grid, tmp / names[j])
         _make_ordinary(tmp)
         pvd = directory / f"{stem}.pvd"
         text = _pvd_text(times, [f"{stem}/{name}" for name in names])
@@ -165,6 +192,22 @@ def write_time_series(
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     return pvd
+
+
+def _vtk_grid(points: np.ndarray, body_type: str, body: np.ndarray):
+    """A ``pyvista.UnstructuredGrid`` of the body cells (meshio cell type -> VTK cell type, same node order)."""
+    import pyvista as pv
+
+    if body_type not in VTK_CELL_TYPES:
+        raise ValueError(f"mesh body cells {body_type!r} cannot be written; valid: {', '.join(VTK_CELL_TYPES)}")
+    return pv.UnstructuredGrid({pv.CellType[VTK_CELL_TYPES[body_type]]: body}, points)
+
+
+def _save(grid, path: Path) -> None:
+    """Write ``grid`` as a binary ``.vtu`` (VTK's XML writer through pyvista); ``OSError`` if nothing was written."""
+    grid.save(path, binary=True)
+    if not path.is_file() or path.stat().st_size == 0:
+        raise OSError(f"the VTK writer wrote nothing to {path}")
 
 
 def read_time_series(pvd: str | os.PathLike) -> tuple[np.ndarray, list[Path]]:
@@ -220,25 +263,6 @@ def _pvd_text(times: np.ndarray, files: list[str]) -> str:
         f"  <Collection>\n{rows}  </Collection>\n"
         "</VTKFile>\n"
     )
-
-
-def _add_field_data(path: Path, values: dict[str, float]) -> None:
-    """Insert a ``<FieldData>`` block (ASCII, exact decimal) into a ``.vtu`` written by meshio.
-
-    meshio 5.3 reads ``FieldData`` but does not write it.
-    """
-    arrays = "".join(
-        f'<DataArray type="{"Int64" if isinstance(x, int) else "Float64"}" Name={quoteattr(name)} '
-        f'NumberOfTuples="1" format="ascii">\n{x!r}\n</DataArray>\n'
-        for name, x in values.items()
-    )
-    tag = b"<UnstructuredGrid>\n"
-    raw = path.read_bytes()
-    at = raw.find(tag)
-    if at < 0:
-        raise RuntimeError(f"unexpected .vtu layout in {path} (no <UnstructuredGrid> element)")
-    at += len(tag)
-    path.write_bytes(raw[:at] + f"<FieldData>\n{arrays}</FieldData>\n".encode() + raw[at:])
 
 
 def _make_ordinary(folder: Path) -> None:
