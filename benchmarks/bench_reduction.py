@@ -44,8 +44,7 @@ import numpy as np
 from bench_core import fmt_time, line, machine, verdict
 
 import bladecase
-from bladecase.reduction import METHODS, reduce
-from bladecase.reduction.contact import Contact
+from bladecase.reduction import METHODS, Contact, reduce
 
 #: Target: each reduction in under this many seconds (2-core machine).
 TARGET_SECONDS = 30.0

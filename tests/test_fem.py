@@ -1,4 +1,4 @@
-"""Finite-element assembly (``bladecase.fem``): validation against beam theory and exact solutions.
+"""Finite-element assembly (``bladecase.fe``): validation against beam theory and exact solutions.
 
 References (independent of bladecase):
 
@@ -19,7 +19,7 @@ References (independent of bladecase):
   ``ElementVector``: the matrices must agree to round-off.
 
 Meshes are built from scikit-fem's generators (``MeshTet.init_tensor``,
-``MeshTri.init_tensor``) or plain numpy and converted to ``bladecase.fe.mesh.Mesh``.
+``MeshTri.init_tensor``) or plain numpy and converted to ``bladecase.fe.Mesh``.
 """
 
 from __future__ import annotations
@@ -46,8 +46,7 @@ from skfem.helpers import dot
 from skfem.models.elasticity import linear_elasticity, plane_stress
 
 import bladecase as bc
-from bladecase.fe.assembly import AL6061T6, INCONEL718, STEEL, TI6AL4V, FEModel, Material
-from bladecase.fe.mesh import Mesh
+from bladecase.fe import AL6061T6, INCONEL718, STEEL, TI6AL4V, FEModel, Material, Mesh
 
 EB_BETA_L2 = np.array([3.5160, 22.0345, 61.6972])
 

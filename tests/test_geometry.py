@@ -21,7 +21,7 @@ from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTet
 
 import bladecase as bc
-from bladecase.fe.geometry import cad_volume, naca_section
+from bladecase.fe import cad_volume, naca_section
 from bladecase.fe.mesh import from_meshio, jacobian_dets, signed_measures
 
 MESHES = Path(__file__).resolve().parents[1] / "meshes"

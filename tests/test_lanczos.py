@@ -26,8 +26,8 @@ import scipy.sparse as sp
 from skfem import MeshTet, MeshTri
 
 import bladecase as bc
-from bladecase.fe.mesh import Mesh
-from bladecase.reduction.lanczos import chain_jacobi, per_dof_law
+from bladecase.fe import Mesh
+from bladecase.reduction import chain_jacobi, per_dof_law
 
 GAP = 1e-4  # 0.1 mm tip clearance
 

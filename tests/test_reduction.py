@@ -36,8 +36,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 import bladecase as bc
-from bladecase.reduction import FULL_LIMIT, METHODS, ReducedModel, reduce
-from bladecase.reduction.contact import Contact
+from bladecase.reduction import FULL_LIMIT, METHODS, Contact, ReducedModel, reduce
 
 MESHES = Path(__file__).resolve().parent.parent / "meshes"
 GAP = 1e-4

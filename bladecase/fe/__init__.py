@@ -2,13 +2,27 @@
 
 Data in: a parametric geometry or a mesh file. Data out: an :class:`FEModel` (sparse ``K``, ``M`` on the
 free dofs, the dof map) for the reduction layer.
+
+Modules: :mod:`~bladecase.fe.naca` (sections), :mod:`~bladecase.fe.geometry` (parametric blades,
+:func:`blade_mesh`), :mod:`~bladecase.fe.cad` (gmsh bodies), :mod:`~bladecase.fe.mesh` (:class:`Mesh`, files),
+:mod:`~bladecase.fe.material` (:class:`Material`, presets), :mod:`~bladecase.fe.model` (:class:`FEModel`,
+:class:`DofMap`), :mod:`~bladecase.fe.assembly` (:func:`assemble`), :mod:`~bladecase.fe.eigen`
+(:func:`natural_frequencies`, :func:`stiffness_factor`), :mod:`~bladecase.fe.storage` (stage files).
 """
 
-from .assembly import DofMap, FEModel, Material, assemble, load_model, natural_frequencies, save_model
-from .geometry import BladeGeometry, PlateGeometry, blade_mesh
+from .assembly import assemble
+from .eigen import natural_frequencies, stiffness_factor
+from .geometry import BladeGeometry, PlateGeometry, blade_mesh, cad_volume
+from .material import AL6061T6, INCONEL718, PRESETS, STEEL, TI6AL4V, Material
 from .mesh import Mesh, load_mesh, save_mesh
+from .model import DofMap, FEModel, node_operator
+from .naca import naca_parameters, naca_section
+from .storage import load_model, model_from_arrays, model_to_arrays, save_model, sparse_from_arrays, sparse_to_arrays
 
 __all__ = [
+    "AL6061T6", "INCONEL718", "PRESETS", "STEEL", "TI6AL4V",
     "BladeGeometry", "DofMap", "FEModel", "Material", "Mesh", "PlateGeometry",
-    "assemble", "blade_mesh", "load_mesh", "load_model", "natural_frequencies", "save_mesh", "save_model",
+    "assemble", "blade_mesh", "cad_volume", "load_mesh", "load_model", "model_from_arrays", "model_to_arrays",
+    "naca_parameters", "naca_section", "natural_frequencies", "node_operator", "save_mesh", "save_model",
+    "sparse_from_arrays", "sparse_to_arrays", "stiffness_factor",
 ]

@@ -1,10 +1,11 @@
-"""Finite-element model of a structure: stiffness and mass from a :class:`~bladecase.fe.mesh.Mesh`.
+"""Finite-element assembly: stiffness and mass of a clamped linear-elastic body from a :class:`~bladecase.fe.mesh.Mesh`.
 
 :func:`assemble` turns a simplex mesh (tetrahedra in 3-D, triangles in 2-D
-plane stress or plane strain) and a :class:`Material` into the sparse
-stiffness and mass matrices of linear elasticity, with the clamped degrees of
-freedom removed; :func:`natural_frequencies` gives the lowest eigenfrequencies
-by a sparse shift-invert eigen-solution.
+plane stress or plane strain) and a :class:`~bladecase.fe.material.Material`
+into an :class:`~bladecase.fe.model.FEModel`: the sparse stiffness and mass
+matrices of linear elasticity with the clamped degrees of freedom removed
+(:func:`~bladecase.fe.eigen.natural_frequencies` then gives its lowest
+eigenfrequencies).
 
 The discretisation is scikit-fem's: the mesh's vertices make a
 ``skfem.MeshTet``/``MeshTri`` (straight-sided cells; the extra nodes of
@@ -18,34 +19,46 @@ product over all cells instead of skfem's loop over the local basis pairs
 (about 20 times faster for P2 tetrahedra; the tests check that both give the
 same matrices).
 
-Degree-of-freedom numbering: the scalar dofs of skfem's basis, each carrying
-``dim`` displacement components, component ``c`` of scalar dof ``s`` being
-unclamped dof ``dim * s + c``.  A :class:`DofMap` says for each free dof its
-location, its direction and its mesh node (``-1`` for the edge dofs of
-quadratic elements).
+This module also re-exports, for the old import paths, the names that moved to
+:mod:`~bladecase.fe.material`, :mod:`~bladecase.fe.model`,
+:mod:`~bladecase.fe.eigen` and :mod:`~bladecase.fe.storage`.
 """
 
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
-from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 from scipy.sparse.csgraph import connected_components
 from skfem import CellBasis, ElementTetP1, ElementTetP2, ElementTriP1, ElementTriP2, MeshTet, MeshTri
-from skfem.models.elasticity import lame_parameters
 
+from ..checks import positive
+from .eigen import natural_frequencies
+from .material import AL6061T6, ALUMINIUM, INCONEL718, PLANE_KINDS, PRESETS, STEEL, TI6AL4V, Material
 from .mesh import Mesh
+from .model import DofMap, FEModel
+from .storage import (
+    MODEL_FORMAT,
+    load_model,
+    model_from_arrays,
+    model_to_arrays,
+    save_model,
+    sparse_from_arrays,
+    sparse_to_arrays,
+)
+
+__all__ = [
+    "CHUNK_CELLS", "DEGENERATE_RTOL", "MASS_KINDS", "ORDERS", "Clamp", "assemble",
+    # moved (old import paths of bladecase.fe.assembly)
+    "AL6061T6", "ALUMINIUM", "INCONEL718", "MODEL_FORMAT", "PLANE_KINDS", "PRESETS", "STEEL", "TI6AL4V",
+    "DofMap", "FEModel", "Material", "load_model", "model_from_arrays", "model_to_arrays", "natural_frequencies",
+    "save_model", "sparse_from_arrays", "sparse_to_arrays",
+]
 
 #: Accepted values of ``mass``.
 MASS_KINDS = ("consistent", "lumped")
-#: Accepted values of ``plane`` (2-D models).
-PLANE_KINDS = ("stress", "strain")
 #: Accepted values of ``order``.
 ORDERS = (1, 2)
 
@@ -61,256 +74,6 @@ _ELEMENTS = {
     (3, 1): ElementTetP1, (3, 2): ElementTetP2,
     (2, 1): ElementTriP1, (2, 2): ElementTriP2,
 }
-_DIRECTIONS = {"x": 0, "y": 1, "z": 2}
-
-
-def _positive(name: str, value, what: str = "> 0", noun: str = "number") -> float:
-    """``float(value)`` if it is a finite number > 0, else ``ValueError``
-    ("``name`` must be a [finite] ``noun`` ``what``, got …")."""
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number {what}, got {value!r}") from None
-    if isinstance(value, bool) or not math.isfinite(x) or x <= 0:
-        raise ValueError(f"{name} must be a finite {noun} {what}, got {value!r}")
-    return x
-
-
-@dataclass(frozen=True)
-class Material:
-    """An isotropic linear-elastic material (SI units).
-
-    Parameters
-    ----------
-    E : float
-        Young's modulus (Pa), > 0.
-    nu : float
-        Poisson's ratio, ``-1 < nu < 0.5``.
-    rho : float
-        Density (kg/m³), > 0.
-    name : str
-        Label for messages and reports.
-
-    Presets (:meth:`preset`, and the module constants :data:`TI6AL4V`,
-    :data:`STEEL`, :data:`INCONEL718`, :data:`AL6061T6`) hold typical
-    room-temperature handbook values (ASM Aerospace Specification Metals /
-    MatWeb data sheets, consistent with MMPDS typical values):
-
-    ============  =========  =====  =========  ===========================================
-    preset        E (GPa)    ν      ρ (kg/m³)  source
-    ============  =========  =====  =========  ===========================================
-    Ti-6Al-4V     113.8      0.342  4430       ASM data sheet, Ti-6Al-4V (Grade 5), annealed
-    steel         200        0.30   7850       typical carbon/structural steel handbook value
-    Inconel 718   200        0.294  8190       Special Metals INCONEL 718 data (ASM/MatWeb);
-                                               Special Metals' own table lists ≈ 204.9 GPa
-    Al 6061-T6    68.9       0.33   2700       ASM data sheet, aluminium 6061-T6
-    ============  =========  =====  =========  ===========================================
-
-    Raises
-    ------
-    ValueError
-        A value that is not a finite number in its valid range.
-    """
-
-    E: float
-    nu: float
-    rho: float
-    name: str = ""
-
-    def __post_init__(self):
-        object.__setattr__(self, "E", _positive("Young's modulus E", self.E, "> 0 (Pa)"))
-        object.__setattr__(self, "rho", _positive("density rho", self.rho, "> 0 (kg/m³)"))
-        try:
-            nu = float(self.nu)
-        except (TypeError, ValueError):
-            raise ValueError(f"Poisson's ratio nu must be a number in (-1, 0.5), got {self.nu!r}") from None
-        if isinstance(self.nu, bool) or not -1.0 < nu < 0.5:
-            raise ValueError(f"Poisson's ratio nu must be in (-1, 0.5) (open interval), got {self.nu!r}")
-        object.__setattr__(self, "nu", nu)
-
-    @classmethod
-    def preset(cls, name: str) -> Material:
-        """A preset by name, case and punctuation ignored.
-
-        Names: ``"Ti-6Al-4V"`` (also ``"titanium"``), ``"steel"``,
-        ``"Inconel 718"`` (also ``"IN718"``, ``"inconel"``),
-        ``"aluminium"`` (also ``"aluminum"``, ``"Al 6061-T6"``, ``"6061-T6"``).
-        """
-        key = re.sub(r"[^a-z0-9]", "", str(name).lower())
-        if key not in _PRESET_KEYS:
-            raise ValueError(f"unknown material preset {name!r} (presets: {', '.join(PRESETS)})")
-        return PRESETS[_PRESET_KEYS[key]]
-
-    def lame(self, plane: str | None = None) -> tuple[float, float]:
-        """Lamé constants ``(λ, μ)``; ``plane="stress"`` gives ``λ* = 2λμ/(λ + 2μ) = Eν/(1 - ν²)``.
-
-        ``plane=None`` (3-D) and ``plane="strain"`` give the 3-D constants.
-        """
-        lam, mu = lame_parameters(self.E, self.nu)
-        if plane == "stress":
-            lam = 2.0 * lam * mu / (lam + 2.0 * mu)
-        elif plane not in (None, "strain"):
-            raise ValueError(f"plane must be one of {PLANE_KINDS} or None, got {plane!r}")
-        return lam, mu
-
-
-#: Ti-6Al-4V (Grade 5), annealed: ASM data sheet.
-TI6AL4V = Material(113.8e9, 0.342, 4430.0, "Ti-6Al-4V")
-#: Carbon/structural steel, typical handbook value.
-STEEL = Material(200e9, 0.30, 7850.0, "steel")
-#: Inconel 718 (ASM/MatWeb; Special Metals lists ≈ 204.9 GPa).
-INCONEL718 = Material(200e9, 0.294, 8190.0, "Inconel 718")
-#: Aluminium 6061-T6: ASM data sheet.
-AL6061T6 = Material(68.9e9, 0.33, 2700.0, "Al 6061-T6")
-#: Alias of :data:`AL6061T6`.
-ALUMINIUM = AL6061T6
-
-#: Presets by display name.
-PRESETS = {m.name: m for m in (TI6AL4V, STEEL, INCONEL718, AL6061T6)}
-_PRESET_KEYS = {
-    "ti6al4v": "Ti-6Al-4V", "titanium": "Ti-6Al-4V", "tc4": "Ti-6Al-4V",
-    "steel": "steel",
-    "inconel718": "Inconel 718", "inconel": "Inconel 718", "in718": "Inconel 718",
-    "al6061t6": "Al 6061-T6", "6061t6": "Al 6061-T6", "aluminium": "Al 6061-T6",
-    "aluminum": "Al 6061-T6", "aluminium6061t6": "Al 6061-T6", "aluminum6061t6": "Al 6061-T6",
-}
-
-
-@dataclass(frozen=True, eq=False)
-class DofMap:
-    """Where each free degree of freedom of an :class:`FEModel` lives.
-
-    Attributes
-    ----------
-    node : (n,) int ndarray
-        Mesh node (index into ``mesh.points``) of a vertex dof; ``-1`` for a
-        dof that is not at a mesh node (edge dofs of quadratic elements).
-    direction : (n,) int ndarray
-        Displacement component: 0 = x, 1 = y, 2 = z.
-    coords : (n, 3) float ndarray
-        Location of the dof (``z = 0`` in 2-D).
-    fe_index : (n,) int ndarray
-        Index in the unclamped numbering (``dim * scalar dof + direction``).
-    n_total : int
-        Number of dofs before the clamped ones were removed.
-    """
-
-    node: np.ndarray
-    direction: np.ndarray
-    coords: np.ndarray
-    fe_index: np.ndarray
-    n_total: int
-
-    def __len__(self) -> int:
-        return self.node.size
-
-
-@dataclass(frozen=True, eq=False)
-class FEModel:
-    """A clamped linear-elastic finite-element model (free dofs only).
-
-    Attributes
-    ----------
-    K, M : scipy.sparse.csr_array
-        Stiffness and mass matrices on the free dofs (``M`` diagonal if ``mass == "lumped"``).
-    dofs : DofMap
-        Location, direction and mesh node of each free dof.
-    mesh : Mesh
-        The mesh the model was built from.
-    material : Material
-    order : int
-        Polynomial order of the elements (1 or 2).
-    mass : str
-        ``"consistent"`` or ``"lumped"`` (row sum for P1, HRZ for P2).
-    thickness : float or None
-        Out-of-plane thickness of a 2-D model (``None`` in 3-D).
-    plane : str or None
-        ``"stress"`` or ``"strain"`` for a 2-D model, ``None`` in 3-D.
-    clamped : ndarray
-        Mesh nodes whose displacements are fixed (sorted).
-    volume : float
-        Volume (3-D) or area (2-D) of the mesh.
-    rigid_modes : int
-        Rigid-body motions the clamp leaves free, summed over the
-        face-connected parts of the mesh (0 for a properly clamped model; 6
-        in 3-D, 3 in 2-D for an unclamped one-piece body).
-    """
-
-    K: sp.csr_array
-    M: sp.csr_array
-    dofs: DofMap
-    mesh: Mesh
-    material: Material
-    order: int
-    mass: str
-    thickness: float | None
-    plane: str | None
-    clamped: np.ndarray
-    volume: float
-    rigid_modes: int
-
-    @property
-    def dim(self) -> int:
-        """Spatial dimension (2 or 3)."""
-        return self.mesh.dim
-
-    @property
-    def n_dofs(self) -> int:
-        """Number of free degrees of freedom."""
-        return self.K.shape[0]
-
-    @property
-    def total_mass(self) -> float:
-        """``ρ · volume`` in 3-D, ``ρ · area · thickness`` in 2-D (kg)."""
-        return self.material.rho * self.volume * (self.thickness if self.thickness is not None else 1.0)
-
-    @cached_property
-    def _node_dof(self) -> np.ndarray:
-        table = np.full((self.mesh.points.shape[0], self.dim), -1, dtype=np.int64)
-        vertex = self.dofs.node >= 0
-        table[self.dofs.node[vertex], self.dofs.direction[vertex]] = np.flatnonzero(vertex)
-        return table
-
-    def dof_of(self, node, direction) -> int | np.ndarray:
-        """Free dof index of mesh ``node`` in ``direction`` (0/1/2 or ``"x"``/``"y"``/``"z"``).
-
-        ``node`` and ``direction`` may be arrays (broadcast together).
-
-        Raises
-        ------
-        ValueError
-            A node out of range, clamped, or not a vertex of the body cells; a bad direction.
-        """
-        n_nodes = self.mesh.points.shape[0]
-        nodes = np.asarray(node)
-        if nodes.dtype.kind not in "iu":
-            raise ValueError(f"node must be an integer mesh node index, got {node!r}")
-        if nodes.size and (nodes.min() < 0 or nodes.max() >= n_nodes):
-            bad = nodes[(nodes < 0) | (nodes >= n_nodes)].ravel()[0]
-            raise ValueError(f"node {bad} is out of range (mesh nodes 0..{n_nodes - 1})")
-        dirs = np.vectorize(lambda d: _direction(d, self.dim), otypes=[np.int64])(direction)
-        out = self._node_dof[nodes, dirs]
-        if np.any(out < 0):
-            bad = np.broadcast_to(nodes, out.shape)[out < 0].ravel()[0]
-            why = "is clamped" if np.isin(bad, self.clamped) else "is not a vertex of the body cells"
-            raise ValueError(f"node {bad} has no free dof: it {why}")
-        return int(out) if out.ndim == 0 else out
-
-    def __repr__(self) -> str:
-        extra = f", thickness={self.thickness:g}, plane {self.plane}" if self.dim == 2 else ""
-        return (
-            f"FEModel({self.dim}-D, P{self.order}, {self.n_dofs} free dofs, {self.mass} mass, "
-            f"{self.material.name or 'material'}{extra}, {self.clamped.size} clamped nodes)"
-        )
-
-
-def _direction(d, dim: int) -> int:
-    if isinstance(d, str) and d.lower() in _DIRECTIONS:
-        d = _DIRECTIONS[d.lower()]
-    if isinstance(d, (bool, np.bool_)) or not isinstance(d, (int, np.integer)) or not 0 <= d < dim:
-        valid = "0, 1, 2 or 'x', 'y', 'z'" if dim == 3 else "0, 1 or 'x', 'y'"
-        raise ValueError(f"direction must be {valid} in {dim}-D, got {d!r}")
-    return int(d)
 
 
 def assemble(
@@ -362,6 +125,22 @@ def assemble(
     ValueError
         Bad argument (the message names it and what is valid), a clamp that
         selects no node of the body, degenerate cells.
+
+    Examples
+    --------
+    A steel plate 100 × 20 × 2 mm in plane stress, clamped along ``x = 0`` (its ``root`` group):
+
+    >>> import numpy as np
+    >>> from skfem import MeshTri
+    >>> from bladecase.fe import Mesh
+    >>> t = MeshTri.init_tensor(np.linspace(0, 0.1, 11), np.linspace(0, 0.02, 3))
+    >>> points = np.c_[t.p.T, np.zeros(t.p.shape[1])]
+    >>> plate = Mesh(points, {"triangle": t.t.T}, dim=2, groups={"root": np.flatnonzero(points[:, 0] == 0)})
+    >>> model = assemble(plate, "steel", order=2, thickness=0.002)
+    >>> model
+    FEModel(2-D, P2, 200 free dofs, consistent mass, steel, thickness=0.002, plane stress, 3 clamped nodes)
+    >>> model.K.shape, round(model.total_mass, 6)  # ρ · area · thickness (kg)
+    ((200, 200), 0.0314)
     """
     if not isinstance(mesh, Mesh):
         raise ValueError(f"mesh must be a bladecase.Mesh, got {type(mesh).__name__}")
@@ -381,7 +160,7 @@ def assemble(
     if dim == 2:
         if thickness is None:
             raise ValueError("a 2-D model needs a thickness (> 0, same length unit as the mesh)")
-        thickness = _positive("thickness", thickness)
+        thickness = positive("thickness", thickness)
     elif thickness is not None:
         raise ValueError(f"thickness applies to 2-D models only; this mesh is 3-D (got thickness={thickness!r})")
 
@@ -390,23 +169,7 @@ def assemble(
         raise ValueError(f"mesh.points must be a finite (n, 3) array, got shape {points.shape}")
     clamped = _clamp_nodes(mesh, points, clamp)
 
-    cells = np.asarray(mesh.cells[mesh.body_type])[:, : dim + 1].astype(np.int64)
-    if cells.min() < 0 or cells.max() >= points.shape[0]:
-        raise ValueError(f"mesh cells refer to nodes outside 0..{points.shape[0] - 1}")
-    used, local = np.unique(cells, return_inverse=True)
-    local = local.reshape(cells.shape)
-    if dim == 2:
-        scale = np.abs(points[used, :2]).max()
-        if np.abs(points[used, 2]).max() > 1e-12 * max(scale, 1e-300):
-            raise ValueError("a 2-D mesh must lie in the xy-plane (z = 0)")
-    corners = points[cells, :dim]
-    cell_volume = np.abs(np.linalg.det(corners[:, 1:] - corners[:, :1])) / math.factorial(dim)
-    flat = cell_volume <= DEGENERATE_RTOL * cell_volume.max()
-    if flat.any():
-        i = int(np.flatnonzero(flat)[0])
-        raise ValueError(
-            f"mesh has {int(flat.sum())} degenerate cell(s) (zero volume), e.g. cell {i} with nodes {cells[i].tolist()}"
-        )
+    used, local = _body_cells(mesh, points, dim)
     p = points[used, :dim].T
     fe_mesh = (MeshTet if dim == 3 else MeshTri)(np.ascontiguousarray(p), np.ascontiguousarray(local.T))
     basis = CellBasis(fe_mesh, _ELEMENTS[dim, order]())
@@ -451,6 +214,31 @@ def assemble(
         clamped=used[vertex_clamped], volume=volume,
         rigid_modes=_free_motions(fe_mesh, vertex_clamped),
     )
+
+
+def _body_cells(mesh: Mesh, points: np.ndarray, dim: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(used, local)``: the mesh nodes of the body cells (sorted) and the cells' corners numbered among them.
+
+    Raises ``ValueError`` for cells referring to missing nodes, a 2-D mesh off
+    the xy-plane, degenerate (zero-volume) cells.
+    """
+    cells = np.asarray(mesh.cells[mesh.body_type])[:, : dim + 1].astype(np.int64)
+    if cells.min() < 0 or cells.max() >= points.shape[0]:
+        raise ValueError(f"mesh cells refer to nodes outside 0..{points.shape[0] - 1}")
+    used, local = np.unique(cells, return_inverse=True)
+    if dim == 2:
+        scale = np.abs(points[used, :2]).max()
+        if np.abs(points[used, 2]).max() > 1e-12 * max(scale, 1e-300):
+            raise ValueError("a 2-D mesh must lie in the xy-plane (z = 0)")
+    corners = points[cells, :dim]
+    cell_volume = np.abs(np.linalg.det(corners[:, 1:] - corners[:, :1])) / math.factorial(dim)
+    flat = cell_volume <= DEGENERATE_RTOL * cell_volume.max()
+    if flat.any():
+        i = int(np.flatnonzero(flat)[0])
+        raise ValueError(
+            f"mesh has {int(flat.sum())} degenerate cell(s) (zero volume), e.g. cell {i} with nodes {cells[i].tolist()}"
+        )
+    return used, local.reshape(cells.shape)
 
 
 def _describe(clamp) -> str:
@@ -601,140 +389,3 @@ def _scalar_mass(basis: CellBasis, mass: str, order: int):
         return np.asarray(Ms.sum(axis=1)).ravel()
     return Ms
 
-
-def natural_frequencies(model: FEModel, count: int, return_modes: bool = False):
-    """The ``count`` lowest natural frequencies (Hz) of a clamped model.
-
-    Shift-invert Lanczos (ARPACK ``eigsh``) about 0 with a sparse LDLᵀ of
-    ``K`` (SuperLU, symmetric mode, minimum-degree ordering on ``K``'s
-    pattern); no dense matrix is formed.
-
-    Parameters
-    ----------
-    model : FEModel
-    count : int
-        Number of frequencies, ``1 <= count < model.n_dofs``.
-    return_modes : bool
-        Also return the mode shapes.
-
-    Returns
-    -------
-    f : (count,) ndarray
-        Frequencies ``√λ / 2π`` in Hz, ascending.
-    phi : (n_dofs, count) ndarray
-        M-normalised mode shapes (``φᵀMφ = I``), only if ``return_modes``.
-
-    Raises
-    ------
-    ValueError
-        ``count`` out of range; a model with rigid-body modes (no clamp, or a
-        clamp that leaves a rotation free) or otherwise singular ``K``.
-    """
-    if not isinstance(model, FEModel):
-        raise ValueError(f"model must be an FEModel (from bladecase.assemble), got {type(model).__name__}")
-    n = model.n_dofs
-    if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or not 1 <= count < n:
-        raise ValueError(f"count must be an integer with 1 <= count < {n} (the number of free dofs), got {count!r}")
-    if model.rigid_modes:
-        if model.clamped.size == 0:
-            why = "the model is not clamped (no clamp?)"
-        else:
-            why = (f"the clamp ({model.clamped.size} node(s)) leaves {model.rigid_modes} rigid-body motion(s) free: "
-                   "no clamp on some part of the mesh, or clamped nodes on one point or one line")
-        raise ValueError(f"K is singular: {why}; clamp a face of every part")
-    K = sp.csc_array(model.K)
-    try:
-        lu = spla.splu(K, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
-    except RuntimeError as exc:
-        raise ValueError(f"K is singular ({exc}): no clamp? a part of the mesh not connected to the clamp?") from None
-    op = spla.LinearOperator(K.shape, matvec=lu.solve, dtype=float)
-    lam, phi = spla.eigsh(model.K, k=int(count), M=model.M, sigma=0.0, which="LM", OPinv=op)
-    order = np.argsort(lam)
-    lam, phi = lam[order], phi[:, order]
-    if not np.all(np.isfinite(lam)) or lam[0] <= 0:
-        raise ValueError(
-            f"K is not positive definite: eigenvalue {lam[0]:.3g} (a mechanism? degenerate cells?)"
-        )
-    f = np.sqrt(lam) / (2 * np.pi)
-    return (f, phi) if return_modes else f
-
-
-# ----------------------------------------------------------------------------- stage files
-
-#: Format tag of the ``.npz`` files written by :func:`save_model`.
-MODEL_FORMAT = "bladecase-femodel-1"
-
-
-def sparse_to_arrays(name: str, A) -> dict[str, np.ndarray]:
-    """A sparse matrix as CSR arrays ``name/data``, ``name/indices``, ``name/indptr``, ``name/shape``."""
-    A = sp.csr_array(A)
-    return {f"{name}/data": A.data, f"{name}/indices": A.indices, f"{name}/indptr": A.indptr,
-            f"{name}/shape": np.array(A.shape)}
-
-
-def sparse_from_arrays(data, name: str) -> sp.csr_array:
-    """Inverse of :func:`sparse_to_arrays`."""
-    return sp.csr_array((data[f"{name}/data"], data[f"{name}/indices"], data[f"{name}/indptr"]),
-                        shape=tuple(int(s) for s in data[f"{name}/shape"]))
-
-
-def model_to_arrays(model: FEModel, prefix: str = "") -> dict[str, np.ndarray]:
-    """Everything of an :class:`FEModel` as named arrays (see :func:`save_model`)."""
-    from .mesh import mesh_to_arrays
-
-    out = {f"{prefix}format": np.array(MODEL_FORMAT)}
-    out.update(sparse_to_arrays(f"{prefix}K", model.K))
-    out.update(sparse_to_arrays(f"{prefix}M", model.M))
-    d = model.dofs
-    out.update({f"{prefix}dofs/node": d.node, f"{prefix}dofs/direction": d.direction,
-                f"{prefix}dofs/coords": d.coords, f"{prefix}dofs/fe_index": d.fe_index,
-                f"{prefix}dofs/n_total": np.array(d.n_total)})
-    m = model.material
-    out.update({f"{prefix}material": np.array([m.E, m.nu, m.rho]), f"{prefix}material_name": np.array(m.name),
-                f"{prefix}order": np.array(model.order), f"{prefix}mass": np.array(model.mass),
-                f"{prefix}thickness": np.array(np.nan if model.thickness is None else model.thickness),
-                f"{prefix}plane": np.array(model.plane or ""), f"{prefix}clamped": model.clamped,
-                f"{prefix}volume": np.array(model.volume), f"{prefix}rigid_modes": np.array(model.rigid_modes)})
-    out.update(mesh_to_arrays(model.mesh, f"{prefix}mesh/"))
-    return out
-
-
-def model_from_arrays(data, prefix: str = "", source: str = "") -> FEModel:
-    """Inverse of :func:`model_to_arrays`; ``ValueError`` if ``data`` is not a saved model."""
-    from .mesh import mesh_from_arrays
-
-    key = f"{prefix}format"
-    if key not in data or str(data[key]) != MODEL_FORMAT:
-        raise ValueError(f"{source or 'data'} is not a bladecase FE model file (expected format {MODEL_FORMAT!r}; "
-                         "write one with 'bladecase assemble' or bladecase.fe.assembly.save_model)")
-    E, nu, rho = (float(x) for x in data[f"{prefix}material"])
-    thickness = float(data[f"{prefix}thickness"])
-    dofs = DofMap(node=np.asarray(data[f"{prefix}dofs/node"]), direction=np.asarray(data[f"{prefix}dofs/direction"]),
-                  coords=np.asarray(data[f"{prefix}dofs/coords"]), fe_index=np.asarray(data[f"{prefix}dofs/fe_index"]),
-                  n_total=int(data[f"{prefix}dofs/n_total"]))
-    return FEModel(
-        K=sparse_from_arrays(data, f"{prefix}K"), M=sparse_from_arrays(data, f"{prefix}M"), dofs=dofs,
-        mesh=mesh_from_arrays(data, f"{prefix}mesh/"),
-        material=Material(E, nu, rho, str(data[f"{prefix}material_name"])),
-        order=int(data[f"{prefix}order"]), mass=str(data[f"{prefix}mass"]),
-        thickness=None if math.isnan(thickness) else thickness, plane=str(data[f"{prefix}plane"]) or None,
-        clamped=np.asarray(data[f"{prefix}clamped"]), volume=float(data[f"{prefix}volume"]),
-        rigid_modes=int(data[f"{prefix}rigid_modes"]),
-    )
-
-
-def save_model(model: FEModel, path) -> None:
-    """Write an :class:`FEModel` (matrices, dof map, mesh, material) to a ``.npz`` file, atomically."""
-    from ..io import atomic_path
-
-    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
-        np.savez_compressed(fh, **model_to_arrays(model))
-
-
-def load_model(path) -> FEModel:
-    """Read an :class:`FEModel` written by :func:`save_model`."""
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            return model_from_arrays(data, source=str(path))
-    except (OSError, EOFError, KeyError) as exc:
-        raise ValueError(f"cannot read FE model file {str(path)!r}: {exc}") from None

@@ -14,26 +14,33 @@ Axes (units are the user's; SI recommended): the 3-D blade is radial along
 ``+z``); the plate is radial along ``+y`` (root edge at ``y = 0``, tip edge at
 ``y = span``).  At zero stagger a section's chord lies along ``+x``, from the
 leading edge at ``x = -c/2`` to the trailing edge at ``x = +c/2``.
+
+The NACA sections are in :mod:`~bladecase.fe.naca`, the gmsh/OpenCASCADE
+construction in :mod:`~bladecase.fe.cad`.
 """
 
 from __future__ import annotations
 
 import math
 import os
-import re
 import tempfile
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
+from ..checks import finite, integer, point, positive
 from ..io import atomic_path
+from .cad import build_blade, build_plate, gmsh_model, tip_field
 from .mesh import Mesh, load_mesh
+from .naca import SECTION_POINTS, naca_parameters, naca_section
 
-#: Points per side (suction, pressure) of a NACA section, cosine-spaced.
-SECTION_POINTS = 41
+__all__ = [
+    "CONTACT_RTOL", "SECTION_POINTS", "TIP_ZONE", "BladeGeometry", "PlateGeometry", "blade_mesh", "cad_volume",
+    "naca_parameters", "naca_section",
+]
 
 #: Tip refinement: the size grows from ``tip_size`` at the tip to ``size`` over
 #: this fraction of the span.
@@ -41,107 +48,6 @@ TIP_ZONE = 0.25
 
 #: Relative tolerance on the radial coordinate of a contact point (of ``span``).
 CONTACT_RTOL = 1e-9
-
-_NACA = re.compile(r"^[0-9]{4}$")
-
-
-def _positive(name: str, value, allow_none: bool = False) -> float | None:
-    if value is None and allow_none:
-        return None
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a positive number, got {value!r}") from None
-    if not math.isfinite(v) or v <= 0:
-        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
-    return v
-
-
-def _finite(name: str, value) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a finite number, got {value!r}") from None
-    if not math.isfinite(v):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
-    return v
-
-
-def _point(name: str, value, sizes: Sequence[int]) -> tuple[float, ...]:
-    try:
-        p = tuple(float(c) for c in value)
-    except (TypeError, ValueError):
-        counts = " or ".join(map(str, sizes))
-        raise ValueError(f"{name} must be a sequence of {counts} numbers, got {value!r}") from None
-    if len(p) not in sizes or not all(math.isfinite(c) for c in p):
-        raise ValueError(f"{name} must be {' or '.join(map(str, sizes))} finite coordinates, got {value!r}")
-    return p
-
-
-def naca_parameters(code: str) -> tuple[float, float, float]:
-    """``(m, p, t)`` of a NACA 4-digit code: max camber, its chordwise position, thickness (chord fractions).
-
-    ``"2412"`` gives ``(0.02, 0.4, 0.12)``.  ``ValueError`` unless ``code`` is
-    four digits with ``t > 0`` and, for a cambered section, ``0 < p``.
-    """
-    if not isinstance(code, str) or not _NACA.match(code):
-        raise ValueError(f"naca must be a 4-digit string such as '2412' or '0012', got {code!r}")
-    m, p, t = int(code[0]) / 100, int(code[1]) / 10, int(code[2:]) / 100
-    if t == 0:
-        raise ValueError(f"naca {code!r} has zero thickness (last two digits must be >= 01)")
-    if m > 0 and p == 0:
-        raise ValueError(
-            f"naca {code!r} is cambered (m = {m:g}) but puts the camber at p = 0 (second digit must be 1..9)"
-        )
-    return m, p, t
-
-
-def naca_section(code: str, chord: float, trailing_edge_thickness: float, n: int | None = None):
-    """Upper and lower surfaces of a NACA 4-digit section with a blunt trailing edge.
-
-    The half-thickness is the closed-trailing-edge NACA polynomial
-    (``a4 = -0.1036``) plus the linear ramp ``x·te/2``, so the trailing edge is
-    a straight segment of length ``te·chord`` normal to the camber line.
-
-    Parameters
-    ----------
-    code : str
-        NACA 4-digit code.
-    chord : float
-        Chord length.
-    trailing_edge_thickness : float
-        Trailing-edge thickness as a fraction of the chord (``0 < te < t``).
-    n : int or None
-        Points per surface (cosine spacing, dense at both edges); ``None``
-        for :data:`SECTION_POINTS`.
-
-    Returns
-    -------
-    upper, lower : (n, 2) ndarray
-        Points in the section frame, both from the leading edge
-        ``(-chord/2, 0)`` to the trailing edge (``x ≈ +chord/2``); the suction
-        (upper) side is towards ``+y`` for positive camber.
-    le_tangent : (2,) ndarray
-        Unit tangent at the leading edge, pointing from the upper to the lower surface.
-    """
-    m, p, t = naca_parameters(code)
-    te = trailing_edge_thickness
-    n = SECTION_POINTS if n is None else n
-    x = 0.5 * (1 - np.cos(np.linspace(0.0, np.pi, n)))
-    yt = 5 * t * (0.2969 * np.sqrt(x) - 0.1260 * x - 0.3516 * x**2 + 0.2843 * x**3 - 0.1036 * x**4) + 0.5 * te * x
-    if m > 0:
-        front = x < p
-        yc = np.where(front, m / p**2 * (2 * p * x - x**2), m / (1 - p) ** 2 * (1 - 2 * p + 2 * p * x - x**2))
-        dyc = np.where(front, 2 * m / p**2 * (p - x), 2 * m / (1 - p) ** 2 * (p - x))
-    else:
-        yc = dyc = np.zeros_like(x)
-    th = np.arctan(dyc)
-    upper = np.column_stack([x - yt * np.sin(th), yc + yt * np.cos(th)])
-    lower = np.column_stack([x + yt * np.sin(th), yc - yt * np.cos(th)])
-    upper[0] = lower[0] = 0.0  # the leading edge, exactly
-    shift = np.array([0.5, 0.0])
-    le_tangent = np.array([np.sin(th[0]), -np.cos(th[0])])
-    return (upper - shift) * chord, (lower - shift) * chord, le_tangent
 
 
 @dataclass(frozen=True)
@@ -196,30 +102,28 @@ class BladeGeometry:
     contact_point: tuple[float, float, float] | None = None
 
     def __post_init__(self) -> None:
-        _positive("span", self.span)
-        _positive("root_chord", self.root_chord)
-        _positive("tip_chord", self.tip_chord, allow_none=True)
-        _positive("thickness", self.thickness, allow_none=True)
+        positive("span", self.span)
+        positive("root_chord", self.root_chord)
+        positive("tip_chord", self.tip_chord, allow_none=True)
+        positive("thickness", self.thickness, allow_none=True)
         if (self.thickness is None) == (self.naca is None):
             raise ValueError(
                 "give exactly one of thickness (rectangular section) and naca (NACA 4-digit section), "
                 f"got thickness={self.thickness!r}, naca={self.naca!r}"
             )
         for name in ("twist_deg", "stagger_deg", "sweep", "lean"):
-            _finite(name, getattr(self, name))
-        n = self.n_sections
-        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
-            raise ValueError(f"n_sections must be an integer >= 2, got {n!r}")
+            finite(name, getattr(self, name))
+        integer("n_sections", self.n_sections, 2)
         if self.naca is not None:
             t = naca_parameters(self.naca)[2]
-            te = _positive("trailing_edge_thickness", self.trailing_edge_thickness)
+            te = positive("trailing_edge_thickness", self.trailing_edge_thickness)
             if te >= t:
                 raise ValueError(
                     f"trailing_edge_thickness = {te!r} must be smaller than the thickness ratio {t:g} "
                     f"of naca {self.naca!r}"
                 )
         if self.contact_point is not None:
-            x, y, z = _point("contact_point", self.contact_point, (3,))
+            x, y, z = point("contact_point", self.contact_point, (3,))
             if abs(z - self.span) > CONTACT_RTOL * self.span:
                 raise ValueError(
                     f"contact_point {self.contact_point!r} is not on the tip face z = span = {self.span!r}"
@@ -264,7 +168,7 @@ class BladeGeometry:
         y = sa * q[:, 0] + ca * q[:, 1] + self.lean * s
         return np.column_stack([x, y, np.full(len(q), z)])
 
-    def _le_tangent(self, z: float) -> np.ndarray:
+    def le_tangent(self, z: float) -> np.ndarray:
         """Unit tangent at the leading edge (suction → pressure side), global axes."""
         t = naca_section(self.naca, 1.0, self.trailing_edge_thickness, 3)[2]
         a = math.radians(self.angle_deg(z))
@@ -313,12 +217,12 @@ class PlateGeometry:
     contact_point: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
-        _positive("span", self.span)
-        _positive("chord", self.chord)
-        _positive("taper", self.taper)
-        _finite("sweep", self.sweep)
+        positive("span", self.span)
+        positive("chord", self.chord)
+        positive("taper", self.taper)
+        finite("sweep", self.sweep)
         if self.contact_point is not None:
-            p = _point("contact_point", self.contact_point, (2, 3))
+            p = point("contact_point", self.contact_point, (2, 3))
             x, y = p[:2]
             lo, hi = self.tip_edge()
             if abs(y - self.span) > CONTACT_RTOL * self.span or len(p) == 3 and p[2] != 0:
@@ -341,142 +245,14 @@ class PlateGeometry:
         return 0.1 * min(self.span, self.chord, self.taper * self.chord)
 
 
-# ----------------------------------------------------------------------------- gmsh session
-
-
-@contextmanager
-def _gmsh_model(name: str, options: dict[str, float]) -> Iterator[object]:
-    """A fresh gmsh model with ``options`` set; gmsh is left as it was found.
-
-    If gmsh is not initialised, it is initialised here (no config files, no
-    signal handler, silent) and finalised on exit; otherwise a new model is
-    added and removed, and the options are restored.
-    """
-    import gmsh
-
-    own = not gmsh.isInitialized()
-    if own:
-        gmsh.initialize(readConfigFiles=False, interruptible=False)
-        previous_model = None
-    else:
-        previous_model = gmsh.model.getCurrent()
-    saved: list[tuple[str, float]] = []
-    try:
-        options = {"General.Terminal": 0, "General.Verbosity": 2, **options}
-        for key, value in options.items():
-            saved.append((key, gmsh.option.getNumber(key)))
-            gmsh.option.setNumber(key, value)
-        gmsh.model.add(name)
-        try:
-            yield gmsh
-        finally:
-            gmsh.model.remove()
-    finally:
-        if own:
-            gmsh.finalize()
-        else:
-            for key, value in reversed(saved):
-                gmsh.option.setNumber(key, value)
-            gmsh.model.setCurrent(previous_model)
-
-
-def _build_blade(gmsh, g: BladeGeometry) -> tuple[int, list[int], list[int], int | None]:
-    """Loft the blade; return ``(volume, root faces, tip faces, contact point tag)``."""
-    occ = gmsh.model.occ
-    wires, curves = [], []
-    for k in range(g.n_sections):
-        z = g.span * k / (g.n_sections - 1)
-        parts = g.section(z)
-        first = None
-        tags = []
-        prev_end = None
-        for j, q in enumerate(parts):
-            start = prev_end if prev_end is not None else occ.addPoint(*q[0])
-            if first is None:
-                first = start
-            end = first if j == len(parts) - 1 else occ.addPoint(*q[-1])
-            if len(q) == 2:
-                tags.append(occ.addLine(start, end))
-            else:
-                inner = [occ.addPoint(*r) for r in q[1:-1]]
-                tangents = np.zeros((len(q), 3))
-                # G1 leading edge: the suction side ends, the pressure side starts there.
-                tangents[-1 if j == 0 else 0] = g._le_tangent(z)
-                tags.append(occ.addSpline([start, *inner, end], tangents=tangents.ravel().tolist()))
-            prev_end = end
-        curves += tags
-        wires.append(occ.addWire(tags))
-    out = occ.addThruSections(wires, makeSolid=True, makeRuled=False)
-    volumes = [t for d, t in out if d == 3]
-    if len(volumes) != 1:
-        raise RuntimeError(f"lofting {g!r} gave {len(volumes)} volumes instead of one")
-    occ.remove([(1, c) for c in curves], recursive=True)
-    contact = occ.addPoint(*g.contact_point[:2], g.span) if g.contact_point is not None else None
-    occ.synchronize()
-    root, tip = _caps(gmsh, volumes[0], 3, g.span, 2)
-    if contact is not None:
-        _check_inside_tip(gmsh, g, tip)
-        gmsh.model.mesh.embed(0, [contact], 2, tip[0])
-    return volumes[0], root, tip, contact
-
-
-def _caps(gmsh, body: int, dim: int, span: float, axis: int) -> tuple[list[int], list[int]]:
-    """Boundary entities of ``body`` lying in the planes ``x[axis] = 0`` and ``x[axis] = span``."""
-    root, tip = [], []
-    for _, t in gmsh.model.getBoundary([(dim, body)], oriented=False):
-        bb = gmsh.model.getBoundingBox(dim - 1, t)
-        lo, hi = bb[axis], bb[axis + 3]
-        if hi - lo < 1e-3 * span:  # gmsh pads bounding boxes (1e-7)
-            c = 0.5 * (lo + hi)
-            if abs(c) < 1e-3 * span:
-                root.append(t)
-            elif abs(c - span) < 1e-3 * span:
-                tip.append(t)
-    if not root or not tip:
-        raise RuntimeError(f"could not identify the root and tip of the blade (root {root}, tip {tip})")
-    return root, tip
-
-
-def _check_inside_tip(gmsh, g: BladeGeometry, tip: list[int]) -> None:
-    x, y = float(g.contact_point[0]), float(g.contact_point[1])
-    xyz = [x, y, g.span]
-    if len(tip) != 1 or not gmsh.model.isInside(2, tip[0], xyz):
-        raise ValueError(
-            f"contact_point {g.contact_point!r} is not inside the tip face (section at z = span = {g.span!r})"
-        )
-    edges = [t for _, t in gmsh.model.getBoundary([(2, tip[0])], oriented=False)]
-    dist = min(np.linalg.norm(np.array(gmsh.model.getClosestPoint(1, e, xyz)[0]) - xyz) for e in edges)
-    if dist <= 1e-9 * g.chord(g.span):
-        raise ValueError(f"contact_point {g.contact_point!r} lies on the boundary of the tip face; move it inside")
-
-
-def _build_plate(gmsh, g: PlateGeometry) -> tuple[int, list[int], list[int], int | None]:
-    """The trapezoid, counter-clockwise; a contact point inside the tip edge splits it in two."""
-    occ = gmsh.model.occ
-    lo, hi = g.tip_edge()
-    c = 0.5 * g.chord
-    xy = [(-c, 0.0), (c, 0.0), (hi, g.span)]
-    x = None if g.contact_point is None else float(g.contact_point[0])
-    if x is not None and lo < x < hi:
-        xy.append((x, g.span))
-    xy.append((lo, g.span))
-    points = [occ.addPoint(a, b, 0.0) for a, b in xy]
-    lines = [occ.addLine(points[i], points[(i + 1) % len(points)]) for i in range(len(points))]
-    surface = occ.addPlaneSurface([occ.addCurveLoop(lines)])
-    occ.synchronize()
-    root, tip = _caps(gmsh, surface, 2, g.span, 1)
-    contact = None if x is None else next(p for p, (a, b) in zip(points, xy) if b == g.span and a == x)
-    return surface, root, tip, contact
-
-
 # ----------------------------------------------------------------------------- meshing
 
 
 def _builder(geometry) -> tuple[int, object]:
     if isinstance(geometry, BladeGeometry):
-        return 3, _build_blade
+        return 3, build_blade
     if isinstance(geometry, PlateGeometry):
-        return 2, _build_plate
+        return 2, build_plate
     raise ValueError(f"geometry must be a BladeGeometry or a PlateGeometry, got {type(geometry).__name__}")
 
 
@@ -521,8 +297,8 @@ def blade_mesh(
         gmsh failed (its last error is quoted).
     """
     dim, build = _builder(geometry)
-    size = geometry.default_size() if size is None else _positive("size", size)
-    tip_size = _positive("tip_size", tip_size, allow_none=True)
+    size = geometry.default_size() if size is None else positive("size", size)
+    tip_size = positive("tip_size", tip_size, allow_none=True)
     if tip_size is not None and tip_size > size:
         raise ValueError(f"tip_size = {tip_size!r} must not exceed size = {size!r} (it refines the tip)")
     if isinstance(order, bool) or order not in (1, 2):
@@ -548,7 +324,7 @@ def blade_mesh(
     }
     target_cm = _scratch_path() if path is None else atomic_path(path)
     with target_cm as target:
-        with _gmsh_model("bladecase", options) as gmsh:
+        with gmsh_model("bladecase", options) as gmsh:
             try:
                 body, root, tip, contact = build(gmsh, geometry)
                 model = gmsh.model
@@ -558,7 +334,7 @@ def blade_mesh(
                 if contact is not None:
                     model.addPhysicalGroup(0, [contact], name="contact")
                 if tip_size is not None and tip_size < size:
-                    _tip_field(gmsh, dim, tip, tip_size, size, geometry.span)
+                    tip_field(gmsh, dim, tip, tip_size, size, TIP_ZONE * geometry.span)
                 model.mesh.generate(dim)
                 if order == 2:
                     model.mesh.setOrder(2)
@@ -585,20 +361,6 @@ def _scratch_path() -> Iterator[Path]:
         yield Path(tmpdir) / "blade.msh"
 
 
-def _tip_field(gmsh, dim: int, tip: list[int], tip_size: float, size: float, span: float) -> None:
-    """Background size: ``tip_size`` on the tip, growing linearly to ``size`` at ``TIP_ZONE · span``."""
-    field = gmsh.model.mesh.field
-    dist = field.add("Distance")
-    field.setNumbers(dist, "SurfacesList" if dim == 3 else "CurvesList", tip)
-    field.setNumber(dist, "Sampling", 100)
-    thr = field.add("Threshold")
-    field.setNumber(thr, "InField", dist)
-    field.setNumber(thr, "SizeMin", tip_size)
-    field.setNumber(thr, "SizeMax", size)
-    field.setNumber(thr, "DistMin", 0.0)
-    field.setNumber(thr, "DistMax", TIP_ZONE * span)
-    field.setAsBackgroundMesh(thr)
-
 
 def cad_volume(geometry: BladeGeometry | PlateGeometry) -> float:
     """Volume (3-D) or area (2-D) of the CAD model, by OpenCASCADE (``occ.getMass``).
@@ -610,6 +372,6 @@ def cad_volume(geometry: BladeGeometry | PlateGeometry) -> float:
     closer to the true volume than that (see ``docs/geometry.md``).
     """
     dim, build = _builder(geometry)
-    with _gmsh_model("bladecase-cad", {}) as gmsh:
+    with gmsh_model("bladecase-cad", {}) as gmsh:
         body = build(gmsh, geometry)[0]
         return float(gmsh.model.occ.getMass(dim, body))

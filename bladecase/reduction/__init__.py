@@ -3,22 +3,24 @@
 Data in: an :class:`~bladecase.fe.FEModel` and a :class:`Contact`. Data out: a :class:`ReducedModel`
 whose ``.system`` is the :class:`~bladecase.nsm.orbits.LinearSystem` the solver takes, and which expands
 reduced states back to the mesh.
+
+Modules: :mod:`~bladecase.reduction.contact` (:class:`Contact`), :mod:`~bladecase.reduction.symmetry`
+(mass factor, symmetry basis, per-dof defect), :mod:`~bladecase.reduction.lanczos` (the Lanczos chain),
+:mod:`~bladecase.reduction.model` (:class:`ReducedModel`), :mod:`~bladecase.reduction.registry`
+(:data:`METHODS`, :func:`register`, :func:`reduce`), :mod:`~bladecase.reduction.methods` (one module per
+method), :mod:`~bladecase.reduction.storage` (stage files).
 """
 
 from .contact import Contact, radial_normal
-from .lanczos import (
-    LanczosChain,
-    MassFactor,
-    PerDofDefect,
-    SymmetryBasis,
-    lanczos_chain,
-    mass_factor,
-    per_dof_defect,
-)
-from .methods import FULL_LIMIT, METHODS, ReducedModel, load_reduced, reduce, save_reduced
+from .lanczos import LanczosChain, chain_grounding, chain_jacobi, lanczos_chain
+from .methods import FULL_LIMIT
+from .model import ReducedModel, node_operator
+from .registry import METHODS, Registry, reduce, register
+from .storage import load_reduced, save_reduced
+from .symmetry import MassFactor, PerDofDefect, SymmetryBasis, mass_factor, per_dof_defect, per_dof_law
 
 __all__ = [
-    "FULL_LIMIT", "METHODS", "Contact", "LanczosChain", "MassFactor", "PerDofDefect", "ReducedModel",
-    "SymmetryBasis", "lanczos_chain", "load_reduced", "mass_factor", "per_dof_defect", "radial_normal",
-    "reduce", "save_reduced",
+    "FULL_LIMIT", "METHODS", "Contact", "LanczosChain", "MassFactor", "PerDofDefect", "ReducedModel", "Registry",
+    "SymmetryBasis", "chain_grounding", "chain_jacobi", "lanczos_chain", "load_reduced", "mass_factor",
+    "node_operator", "per_dof_defect", "per_dof_law", "radial_normal", "reduce", "register", "save_reduced",
 ]

@@ -1,7 +1,7 @@
 """The blade–casing contact of a finite-element model: one node, a normal, a gap.
 
 A :class:`Contact` says which mesh node touches the casing, along which unit
-normal ``ν`` and after which clearance ``d``.  On an :class:`~bladecase.fe.assembly.FEModel`
+normal ``ν`` and after which clearance ``d``.  On an :class:`~bladecase.fe.FEModel`
 it becomes the constraint vector ``w`` of theory §1 (``wᵀx = ν·u_node``, the
 normal components on that node's free dofs, zero elsewhere) and the
 :class:`~bladecase.nsm.system.LinearSystem` the solver and the reduction layer consume.
@@ -14,7 +14,7 @@ Picking the node:
   the leading-edge tip corner: :meth:`Contact.farthest`.
 
 Default normal (``normal=None``): the casing's radial direction.  The blades of
-:mod:`bladecase.geometry` are radial along the LAST axis — 3-D blades along
+:mod:`bladecase.fe.geometry` are radial along the LAST axis — 3-D blades along
 ``+z``, 2-D plates along ``+y`` — so the default normal is ``(0, 0, 1)`` in 3-D
 and ``(0, 1)`` in 2-D (:func:`radial_normal`).  Give the normal explicitly for a
 mesh oriented otherwise.
@@ -27,7 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..fe.assembly import FEModel, _positive
+from ..checks import positive
+from ..fe import FEModel
 from ..nsm import LinearSystem
 
 
@@ -59,7 +60,7 @@ def _unit(name: str, value, sizes: Sequence[int] = (2, 3)) -> tuple[float, ...]:
 def _gap(gap) -> float:
     if gap is None:
         raise ValueError("gap is required: the clearance d > 0 between the contact node at rest and the casing")
-    return _positive("gap", gap, noun="clearance")
+    return positive("gap", gap, noun="clearance")
 
 
 def _in_dim(name: str, vec: Sequence[float], dim: int) -> np.ndarray:
@@ -142,7 +143,24 @@ class Contact:
     def at(
         cls, model: FEModel, node: int, normal: Sequence[float] | None = None, gap: float | None = None
     ) -> Contact:
-        """The contact on mesh node ``node`` of ``model`` (checked), normal defaulted to the radial direction."""
+        """The contact on mesh node ``node`` of ``model`` (checked), normal defaulted to the radial direction.
+
+        >>> import numpy as np
+        >>> from bladecase.fe import Mesh, assemble
+        >>> square = Mesh(points=np.array([[0., 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]),
+        ...               cells={"triangle": np.array([[0, 1, 2], [0, 2, 3]])}, dim=2,
+        ...               groups={"root": np.array([0, 1])})
+        >>> model = assemble(square, "steel", order=1, thickness=0.01)
+        >>> contact = Contact.at(model, 2, gap=1e-4)
+        >>> contact
+        Contact(node=2, normal=(0.0, 1.0), gap=0.0001)
+        >>> contact.w(model).tolist()  # the free dofs: x and y of nodes 2 and 3
+        [0.0, 1.0, 0.0, 0.0]
+        >>> Contact.at(model, 0, gap=1e-4)
+        Traceback (most recent call last):
+            ...
+        ValueError: contact node 0 is clamped: pick a free node (e.g. a tip node)
+        """
         contact = cls(node, normal, gap)
         return contact._resolved(model)
 
