@@ -1,0 +1,223 @@
+"""Periodic orbits of the massless contact model with one contact phase per period, and their branches.
+
+A symmetric orbit (time-reversible system) has ``v = 0`` at the middle of its open phase and at the middle of its
+closed phase. From the mid-open state ``(Φ_o a, 0)``: open flight for ``α``, closing (``y = d``), closed flight for
+``β``, ``v = 0`` — so ``T = 2(α + β)`` and the contact lasts ``2β``. In closed-phase modal coordinates the closing
+state is ``p = P diag(cos ω_o α) a - q_eq``, ``p' = -P diag(ω_o sin ω_o α) a`` (``P = Φ_cᵀMΦ_o``), and
+``v = 0`` after ``β`` is the linear system ``L(α, β) a = -ω_c sin(ω_c β) q_eq`` with
+
+    L = -diag(ω_c sin ω_c β) P diag(cos ω_o α) - diag(cos ω_c β) P diag(ω_o sin ω_o α).
+
+The closing condition leaves ONE scalar equation ``r(α, β) = b_oᵀ diag(cos ω_o α) a - d = 0``: a curve in the
+``(α, β)`` plane — the nonsmooth mode — followed by pseudo-arclength continuation with the exact gradient of ``r``
+(derivatives of ``L`` in closed form), so folds in ``T`` are passed on the same branch. Admissibility
+(``y <= d`` over the open phase, ``λ >= 0`` over the closed one) is proved with certified bounds.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+
+from .massless import MasslessSystem
+from .signals import TrigSum, certified_max
+
+#: Relative tolerance (of the clearance) of the admissibility proofs.
+ADMISSIBILITY_RTOL = 1e-9
+
+
+@dataclass(frozen=True, eq=False)
+class SymmetricOrbit:
+    """A symmetric periodic orbit with one contact phase: open ``2α``, closed ``2β``, mid-open state ``(Φ_o a, 0)``."""
+
+    system: MasslessSystem
+    alpha: float
+    beta: float
+    a: np.ndarray
+
+    k = 1
+
+    @property
+    def T(self) -> float:
+        """Period."""
+        return 2.0 * (self.alpha + self.beta)
+
+    @property
+    def frequency(self) -> float:
+        return 1.0 / self.T
+
+    @property
+    def contact_time(self) -> float:
+        """Duration of the closed phase."""
+        return 2.0 * self.beta
+
+    @property
+    def x_mid_open(self) -> np.ndarray:
+        return self.system.open.phi @ self.a
+
+    @property
+    def energy(self) -> float:
+        return self.system.energy(self.x_mid_open, np.zeros(self.system.n))
+
+    def band_energy(self, modes: int) -> float:
+        """Energy held by the lowest ``modes`` open-phase modes (at mid-open, where ``v = 0`` and ``λ = 0``).
+
+        ``E = ½ Σ ω_j² a_j²`` over all modes is the total energy; the band-limited part is the measure that
+        converges under mesh refinement when the total does not (mesh-scale modes carry the rest).
+        """
+        if isinstance(modes, bool) or int(modes) < 1:
+            raise ValueError(f"modes must be an integer >= 1, got {modes!r}")
+        om, a = self.system.open.omega[: int(modes)], self.a[: int(modes)]
+        return float(0.5 * np.sum(om**2 * a**2))
+
+    def closing_state(self) -> tuple[np.ndarray, np.ndarray]:
+        """State when the contact closes (``t = α`` from mid-open)."""
+        return self.system.open.advance(self.x_mid_open, np.zeros(self.system.n), self.alpha)
+
+    def state(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """Interior ``(x, v)`` at times ``t`` (``t = 0``: closing), each ``(n, len(t))``."""
+        s = self.system
+        t = np.mod(np.atleast_1d(np.asarray(t, float)), self.T)
+        x1, v1 = self.closing_state()
+        x2, v2 = s.closed.advance(x1, v1, 2 * self.beta)
+        X, V = np.empty((s.n, t.size)), np.empty((s.n, t.size))
+        for j, tj in enumerate(t):
+            X[:, j], V[:, j] = s.closed.advance(x1, v1, tj) if tj < 2 * self.beta else \
+                s.open.advance(x2, v2, tj - 2 * self.beta)
+        return X, V
+
+    def proofs(self):
+        """Certified ``max(y - d)`` over the open phase and ``max(d - y)`` over the closed phase."""
+        s, d = self.system, self.system.gap
+        tol = ADMISSIBILITY_RTOL * d
+        y = s.open.contact(self.x_mid_open, np.zeros(s.n))
+        open_ = certified_max(TrigSum(y.alpha, y.beta, y.omega, y.const - d), self.alpha, tol)
+        x1, v1 = self.closing_state()
+        xm, vm = s.closed.advance(x1, v1, self.beta)
+        y = s.closed.contact(xm, vm)
+        closed = certified_max(TrigSum(-y.alpha, -y.beta, y.omega, d - y.const), self.beta, tol)
+        return open_, closed
+
+    @property
+    def admissible(self) -> bool:
+        """``y <= d`` throughout the open phase and ``λ >= 0`` throughout the closed phase (proved)."""
+        o, c = self.proofs()
+        return bool(o.certified and c.certified)
+
+
+def closing_residual(system: MasslessSystem, alpha: float, beta: float, gradient: bool = False):
+    """``(a, r)`` or ``(a, r, ∇r)``: mid-open amplitudes and the closing residual ``r(α, β)`` (exact gradient)."""
+    o, c, P = system.open, system.closed, system.transfer
+    co, so = np.cos(o.omega * alpha), np.sin(o.omega * alpha)
+    cc, sc = np.cos(c.omega * beta), np.sin(c.omega * beta)
+    q_eq = c.phi.T @ (system.M @ c.x_eq)
+    L = -(sc * c.omega)[:, None] * (P * co) - cc[:, None] * (P * (o.omega * so))
+    lu = sla.lu_factor(L, check_finite=False)
+    a = sla.lu_solve(lu, -(c.omega * sc) * q_eq)
+    r = float(o.b @ (co * a)) - system.gap
+    if not gradient:
+        return a, r
+    L_a = (sc * c.omega)[:, None] * (P * (o.omega * so)) - cc[:, None] * (P * (o.omega**2 * co))
+    L_b = -(cc * c.omega**2)[:, None] * (P * co) + (c.omega * sc)[:, None] * (P * (o.omega * so))
+    a_a = sla.lu_solve(lu, -L_a @ a)
+    a_b = sla.lu_solve(lu, -(c.omega**2 * cc) * q_eq - L_b @ a)
+    return a, r, np.array([float(o.b @ (-o.omega * so * a + co * a_a)), float(o.b @ (co * a_b))])
+
+
+def orbit_at_period(system: MasslessSystem, T: float, beta0: float, maxiter: int = 60) -> SymmetricOrbit | None:
+    """The symmetric one-phase orbit of period ``T`` reached by Newton from contact half-time ``beta0``."""
+    b = float(beta0)
+    for _ in range(maxiter):
+        _, r, g = closing_residual(system, T / 2 - b, b, True)
+        step = r / (g[1] - g[0])
+        b -= step
+        if not 0 < b < T / 2:
+            return None
+        if abs(step) <= 1e-14 * T:
+            a, _ = closing_residual(system, T / 2 - b, b)
+            return SymmetricOrbit(system, T / 2 - b, b, a)
+    return None
+
+
+def _correct(system: MasslessSystem, z: np.ndarray) -> tuple[np.ndarray, bool, int]:
+    """Newton on ``r = 0`` with steps along ``∇r`` (orthogonal to the tangent)."""
+    for it in range(10):
+        _, r, g = closing_residual(system, *z, True)
+        dz = -r * g / (g @ g)
+        z = z + dz
+        if np.hypot(*dz) <= 1e-11 * (1 + np.hypot(*z)):
+            return z, abs(r) <= 1e-8 * system.gap, it
+    return z, False, 10
+
+
+def follow_from_grazing(system: MasslessSystem, T_min: float, mode: int = 0, ds: float = 1e-3,
+                        ds_max: float = 0.02, max_points: int = 2000) -> list[SymmetricOrbit]:
+    """The branch grown from the linear open-phase mode ``mode`` at grazing, followed while ``T >= T_min``.
+
+    Pseudo-arclength in ``(α, β)``: tangent ``⊥ ∇r`` oriented by the previous one (so turning points in ``T``
+    are passed on the same branch), step accepted only if the corrected point is within twice the step and
+    ahead; adaptive step between ``1e-10`` and ``ds_max``.
+    """
+    w = system.open.omega[mode]
+    z = np.array([np.pi / w, 1e-6 / w])
+    for _ in range(50):  # first point: r(α, β₀) = 0 in α near half the linear period
+        _, r, g = closing_residual(system, *z, True)
+        z[0] -= r / g[0]
+        if abs(r / g[0]) <= 1e-14 * z[0]:
+            break
+    out: list[SymmetricOrbit] = []
+    tangent, h = None, ds
+    while len(out) < max_points:
+        a, _, g = closing_residual(system, *z, True)
+        out.append(SymmetricOrbit(system, z[0], z[1], a))
+        t = np.array([-g[1], g[0]]) / np.hypot(*g)
+        t = t if (t[1] > 0 if tangent is None else t @ tangent > 0) else -t
+        tangent = t
+        while True:
+            zp, ok, it = _correct(system, z + h * tangent)
+            if ok and np.hypot(*(zp - z)) < 2 * h and (zp - z) @ tangent > 0:
+                h = min(h * (1.5 if it <= 3 else 1.0), ds_max)
+                break
+            h /= 2
+            if h < 1e-10:
+                return out
+        z = zp
+        if 2 * (z[0] + z[1]) < T_min or min(z) <= 0:
+            return out
+    return out
+
+
+def orbits_at_period(system: MasslessSystem, T: float, samples: int | None = None) -> list[SymmetricOrbit]:
+    """Every symmetric one-phase orbit of period ``T`` found from sign changes of ``r`` on a grid of contact
+    half-times ``β ∈ (0, T/2)`` (``samples`` points, default ``20 n``), each refined by Brent's method.
+
+    Sign changes across a pole of ``r`` (``L`` singular) are discarded. Co-existing orbits are the rule for
+    fine models: their number grows with the number of dofs (internal resonances with the discrete spectrum).
+    """
+    from scipy.optimize import brentq
+
+    if not (np.isfinite(T) and T > 0):
+        raise ValueError(f"T must be finite and > 0, got {T!r}")
+    count = int(samples) if samples is not None else 20 * system.n
+    if count < 3:
+        raise ValueError(f"samples must be >= 3, got {samples!r}")
+    betas = np.linspace(0.0, T / 2, count + 2)[1:-1]
+    r = np.array([closing_residual(system, T / 2 - b, b)[1] for b in betas])
+    out = []
+    for i in np.flatnonzero(np.sign(r[1:]) != np.sign(r[:-1])):
+        b = brentq(lambda x: closing_residual(system, T / 2 - x, x)[1], betas[i], betas[i + 1], xtol=1e-15)
+        a, res = closing_residual(system, T / 2 - b, b)
+        if abs(res) <= 1e-8 * system.gap:
+            out.append(SymmetricOrbit(system, T / 2 - b, b, a))
+    return out
+
+
+def smoothest(orbits: list[SymmetricOrbit], modes: int = 10) -> SymmetricOrbit | None:
+    """The orbit with the least energy outside the lowest ``modes`` open-phase modes (``None`` for no orbit).
+
+    Among co-existing orbits at one period, the one a continuum would recognise: its band-limited energy
+    converges under mesh refinement (``docs/massless.md``).
+    """
+    return min(orbits, key=lambda o: o.energy - o.band_energy(modes), default=None)
