@@ -24,6 +24,7 @@ import time
 import numpy as np
 
 import bladecase
+from bladecase.nsm import Arc, Branch
 
 FAMILY_RANGE = (3.0, 14.5)  # periods where the 2-ipp families are followed
 
@@ -41,17 +42,17 @@ def five_T2(system: bladecase.LinearSystem | None = None) -> float:
 
 
 @functools.cache
-def _families(system: bladecase.LinearSystem) -> tuple[bladecase.Family, ...]:
+def _families(system: bladecase.LinearSystem) -> tuple[Branch, ...]:
     return tuple(bladecase.nonsmooth_mode(system, 2, FAMILY_RANGE, scan=24))
 
 
-def two_ipp_families(system: bladecase.LinearSystem | None = None) -> list[bladecase.Family]:
+def two_ipp_families(system: bladecase.LinearSystem | None = None) -> list[Branch]:
     """Every 2-ipp family of ``system`` with periods in ``FAMILY_RANGE``
     (``nonsmooth_mode(system, 2, FAMILY_RANGE, scan=24)``, computed once per system instance)."""
     return list(_families(two_dof() if system is None else system))
 
 
-def paper_arc(system: bladecase.LinearSystem | None = None) -> tuple[bladecase.Family, bladecase.Arc]:
+def paper_arc(system: bladecase.LinearSystem | None = None) -> tuple[Branch, Arc]:
     """The 2-ipp family and admissible arc of the paper's Figs. 2–4: the arc whose
     upper end is closest to ``5T₂``."""
     system = two_dof() if system is None else system
@@ -61,14 +62,14 @@ def paper_arc(system: bladecase.LinearSystem | None = None) -> tuple[bladecase.F
     return min(pairs, key=lambda fa: abs(fa[1].T_hi - five_T2(system)))
 
 
-def paper_mode(system: bladecase.LinearSystem | None = None) -> bladecase.Family:
-    """The paper's nonsmooth mode from ① to ②, as a :class:`bladecase.Family` holding
+def paper_mode(system: bladecase.LinearSystem | None = None) -> Branch:
+    """The paper's nonsmooth mode from ① to ②, as a :class:`bladecase.nsm.Branch` holding
     only the orbits of :func:`paper_arc`, sorted by ``T`` (one arc, ``arcs[0]``), so that
     ``manifold()`` samples that arc alone, not other arcs of the same family.
 
     The continuation's points stop short of the arc's upper end ``T_hi`` (refined by
     bisection to ``5T₂``); the orbit at ``T_hi`` itself, ②, is re-solved there with
-    ``Family.orbit_at`` (the crossing next to the arc's last point) and appended.
+    ``Branch.orbit_at`` (the crossing next to the arc's last point) and appended.
     """
     system = two_dof() if system is None else system
     family, arc = paper_arc(system)
@@ -78,8 +79,8 @@ def paper_mode(system: bladecase.LinearSystem | None = None) -> bladecase.Family
     if ends:
         phase = last.impact_times / last.T
         orbits.append(min(ends, key=lambda o: np.abs(o.impact_times / o.T - phase).max()))
-    whole = bladecase.Arc(0, len(orbits) - 1, arc.T_lo, arc.T_hi, arc.refined_lo, arc.refined_hi)
-    return bladecase.Family(system=system, k=family.k, orbits=orbits, arcs=[whole])
+    whole = Arc(0, len(orbits) - 1, arc.T_lo, arc.T_hi, arc.refined_lo, arc.refined_hi)
+    return Branch(system=system, k=family.k, orbits=orbits, arcs=[whole])
 
 
 def run(main, doc: str) -> None:

@@ -53,7 +53,7 @@ ZOOM_T1 = (5.25, 7.05)
 def numerator(system: bladecase.LinearSystem, t1, T) -> np.ndarray:
     """Pole-free numerator ``N(t₁, T) = s(t₁)·Π_j sin(ω_j T/2)`` (broadcasts ``t1`` and ``T``).
 
-    Equals ``bladecase.nsm.orbits._Modal.of(system, T).g_s(t1)[1] * prod(sin(ω T/2))``
+    Equals ``bladecase.nsm.ModalKernel.of(system, T).g_s(t1)[1] * prod(sin(ω T/2))``
     wherever ``T`` is not resonant, and stays finite (and continuous) across
     the resonant periods.
     """
@@ -84,7 +84,7 @@ def resonant_periods(system: bladecase.LinearSystem, T_range=T_RANGE) -> list[tu
 def admissible_arcs(families) -> list[dict]:
     """The admissible stretches of the families, as curves in the (t₁, T) plane.
 
-    Each item: ``family`` (index), ``arc`` (:class:`bladecase.Arc`), ``T``
+    Each item: ``family`` (index), ``arc`` (:class:`bladecase.nsm.Arc`), ``T``
     and ``t1`` (arrays along the arc, in continuation order), ``T_lo``, ``T_hi``.
     """
     out = []

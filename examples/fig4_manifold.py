@@ -5,7 +5,7 @@ m=1/2, gap=1)``).  The nonsmooth mode is the 2-ipp family whose admissible
 arc runs from ① (T ≈ 13.33) to ② (T → 5T₂ ≈ 13.73) — the red curve of Fig. 2
 and the trajectories of Fig. 3.  Its orbits sweep a two-dimensional invariant
 manifold ``(T, t) ↦ (x, v)`` of the four-dimensional state space, sampled with
-``Family.manifold(n_orbits, n_times)`` and projected onto ``(x₁, x₂, ẋ₂)``
+``Branch.manifold(n_orbits, n_times)`` and projected onto ``(x₁, x₂, ẋ₂)``
 (the orbits of ``_paper.paper_mode``, from ① to the arc's end at 5T₂).
 
 The manifold is smooth along each flight and torn along the impacts: at
@@ -33,6 +33,7 @@ from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection  # noq
 
 import bladecase  # noqa: E402
 from bladecase.io import save_figure  # noqa: E402
+from bladecase.nsm import Arc, Branch  # noqa: E402
 
 _HERE = str(pathlib.Path(__file__).resolve().parent)
 if _HERE not in sys.path:  # for examples/_paper.py, also when the script is loaded by path (tests)
@@ -40,23 +41,19 @@ if _HERE not in sys.path:  # for examples/_paper.py, also when the script is loa
 import _paper as paper  # noqa: E402
 
 
-def evenly_spaced(mode: bladecase.Family, n: int, n_probe: int = 64) -> bladecase.Family:
-    """``n`` orbits of ``mode`` evenly spaced in state space, as a new :class:`bladecase.Family`.
+def evenly_spaced(mode: Branch, n: int) -> Branch:
+    """``n`` orbits of ``mode`` evenly spaced in state space, as a new :class:`bladecase.nsm.Branch`.
 
     The continuation takes small steps in ``T`` near ② (the orbits grow fast
-    there), so sampling by index (what ``manifold()`` does) would crowd that
-    end.  Here the orbits are picked evenly in the cumulative RMS distance
-    between consecutive orbits (states sampled at ``n_probe`` phases); the
-    returned family holds exactly those orbits, so ``manifold(n, ·)`` samples
-    all of them.
+    there), so sampling by index (what ``manifold()`` does by default) would
+    crowd that end.  Here the orbits are picked evenly in the cumulative RMS
+    distance between consecutive orbits (``mode.sample(n, spacing="state")``);
+    the returned branch holds exactly those orbits, so ``manifold(n, ·)``
+    samples all of them.
     """
-    theta = np.arange(n_probe) / n_probe
-    states = np.array([np.concatenate(o.state(theta * o.T)).ravel() for o in mode.orbits])
-    s = np.concatenate([[0.0], np.cumsum(np.sqrt(np.mean(np.diff(states, axis=0) ** 2, axis=1)))])
-    pick = np.unique([int(np.argmin(np.abs(s - target))) for target in np.linspace(0.0, s[-1], n)])
-    orbits = [mode.orbits[i] for i in pick]
-    arc = bladecase.Arc(0, len(orbits) - 1, mode.arcs[0].T_lo, mode.arcs[0].T_hi)
-    return bladecase.Family(system=mode.system, k=mode.k, orbits=orbits, arcs=[arc])
+    orbits = mode.sample(n, spacing="state")
+    arc = Arc(0, len(orbits) - 1, mode.arcs[0].T_lo, mode.arcs[0].T_hi)
+    return Branch(system=mode.system, k=mode.k, orbits=orbits, arcs=[arc])
 
 
 def impact_jumps(orbit: bladecase.PeriodicOrbit) -> np.ndarray:

@@ -36,7 +36,7 @@ import numpy as np
 import pytest
 
 import bladecase as bc
-from bladecase.nsm.orbits import _Modal
+from bladecase.nsm import ModalKernel
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 NAMES = ["fig2_impact_time_map", "fig3_trajectories", "fig4_manifold", "frequency_energy"]
@@ -132,7 +132,7 @@ def test_fig2_numerator_is_pole_free_s(ex, sys2):
     rng = np.random.default_rng(0)
     for T in (1.7, 4.2, 9.3, 13.5):
         t1 = rng.uniform(0, T, 7)
-        s = _Modal.of(sys2, T).g_s(t1)[1]
+        s = ModalKernel.of(sys2, T).g_s(t1)[1]
         assert np.allclose(f2.numerator(sys2, t1, T), s * np.prod(np.sin(omega * T / 2)), rtol=1e-12, atol=1e-14)
     # finite at a resonant period, and the diagonal t1 = T/2 is always a root
     T2 = 2 * np.pi / omega[1]
@@ -159,7 +159,7 @@ def test_fig2_paper_arc(ex, paper, sys2):
     assert arc["t1"][i] == pytest.approx(arc["T"][i] / 2, rel=1e-3)
     # the arc lies on the zero set: s(t1) = 0 along it
     for T, t1 in zip(arc["T"][::20], arc["t1"][::20]):
-        assert abs(_Modal.of(sys2, T).g_s(t1)[1]) < 1e-8
+        assert abs(ModalKernel.of(sys2, T).g_s(t1)[1]) < 1e-8
 
 
 # --- Fig. 3 -----------------------------------------------------------------

@@ -685,13 +685,13 @@ def test_paper_red_arc(two_dof, fam2):
     omega, b = contact_spectrum(two_dof)
     T_branch = brentq(lambda T: np.sum(b**2 * omega / np.sin(omega * T / 2)), 13.0, 13.6, xtol=1e-14)
     assert a.T_lo == pytest.approx(T_branch, rel=1e-5)
-    first = f.orbits[a.start]
+    # the arc's two end points, ① first (the curve folds beyond ②, so ① is the end with the smaller period)
+    first, last = sorted((f.orbits[a.start], f.orbits[a.stop]), key=lambda o: o.T)
     assert abs(first.impact_times[0] / first.T - 0.5) <= 1e-3
     one = bc.orbit_1ipp(two_dof, T_branch / 2)
     assert one.admissible
     np.testing.assert_allclose(first.impulses, np.repeat(one.impulses, 2), rtol=1e-2)
     # ②: grazing the linear mode: the impulses vanish as T -> 5T₂
-    last = f.orbits[a.stop]
     assert last.impulses.max() <= 0.2 * first.impulses.min()
     assert all(o.repeats == 1 for o in f.orbits[a.start: a.stop + 1])
 
@@ -795,3 +795,117 @@ def test_impact_matrices_bad_times(two_dof, times):
 def test_impact_matrices_resonant(two_dof):
     with pytest.raises(ValueError, match="resonant"):
         bc.impact_matrices(two_dof, [1.0, 2 * T2_2DOF])
+
+
+# ---------------------------------------------------------------------------
+# 8. One branch type, serialised in one place; the continuation driver is generic
+# ---------------------------------------------------------------------------
+
+
+def _strip_new_keys(doc):
+    """A family document as ``Family.to_dict`` wrote it before the branch types were merged."""
+    keep = {"T", "frequency", "ipp", "impact_times", "impulses", "energy", "admissible", "max_violation", "repeats"}
+    return {"ipp": doc["ipp"], "arcs": doc["arcs"], "orbits": [{k: o[k] for k in keep} for o in doc["orbits"]]}
+
+
+def test_branch_dict_round_trip_2ipp(two_dof, fam2):
+    import json
+
+    from bladecase.nsm import Branch
+
+    red = next(f for f in fam2 if any(abs(a.T_hi - 5 * T2_2DOF) < 1e-3 for a in f.arcs))
+    doc = json.loads(json.dumps(red.to_dict()))
+    back = Branch.from_dict(two_dof, doc)
+    assert back.source == "curve" and back.k == 2 and back.periods is None
+    assert back.to_dict() == doc
+    assert back.table() == red.table() and "2-ipp family" in back.table() and "admissible arc" in back.table()
+    np.testing.assert_array_equal(back.impact_times, red.impact_times)
+    T = 0.5 * (red.arcs[-1].T_lo + red.arcs[-1].T_hi)
+    for a, b in zip(back.orbit_at(T), red.orbit_at(T)):
+        np.testing.assert_array_equal(a.impact_times, b.impact_times)
+    # the modes.json written by `bladecase demo` before the merge: {"system_dofs", "gap", "families": [...]}
+    modes = {"system_dofs": 2, "gap": 1.0, "families": [_strip_new_keys(f.to_dict()) for f in fam2]}
+    loaded = [Branch.from_dict(two_dof, f) for f in json.loads(json.dumps(modes))["families"]]
+    for f, g in zip(fam2, loaded):
+        assert [a.to_dict() for a in g.arcs] == [a.to_dict() for a in f.arcs]
+        np.testing.assert_array_equal(g.energy, f.energy)
+        np.testing.assert_array_equal(g.admissible, f.admissible)
+        assert all(np.isnan(o.max_violation_time) for o in g.orbits)
+
+
+def test_kipp_curve_jacobian_is_exact(two_dof, five_dof):
+    """The continuation's Jacobian (eliminated impulses, derivatives in the times and in T) and the
+    fixed-T Newton Jacobian against central differences (second order: the error falls 100x per 10x step)."""
+    from bladecase.nsm import KippCurve, ModalKernel, kipp_jacobian, kipp_residual
+
+    def fd(fun, x, h):
+        return np.column_stack([(fun(x + h * e) - fun(x - h * e)) / (2 * h) for e in np.eye(x.size)])
+
+    rng = np.random.default_rng(3)
+    for system, k, T in [(two_dof, 2, 9.1), (two_dof, 3, 6.3), (five_dof, 3, 7.2), (five_dof, 4, 7.7)]:
+        curve = KippCurve(system, k, T, 1.0)
+        times = np.sort(rng.uniform(0.05, 0.95, k - 1))
+        z = np.append(times, 1.0 + rng.uniform(-0.05, 0.05))
+        J = curve.jacobian(z)
+
+        errs = [np.abs(fd(curve.residual, z, h) - J).max() / np.abs(J).max() for h in (1e-3, 1e-4)]
+        assert errs[1] <= 2e-2 * errs[0] + 1e-9, (k, errs)
+        md = ModalKernel.of(system, T)
+        t_all, lam = np.append(times * T, T), rng.uniform(0.5, 1.5, k)
+
+        def res(u, md=md, k=k, T=T, d=system.gap):
+            return kipp_residual(md, np.append(u[: k - 1], T), u[k - 1:], d)
+
+        u = np.concatenate([t_all[:-1], lam])
+        Jn = kipp_jacobian(md, t_all, lam)
+        errs = [np.abs(fd(res, u, h) - Jn).max() / np.abs(Jn).max() for h in (1e-3, 1e-4)]
+        assert errs[1] <= 2e-2 * errs[0] + 1e-9, (k, errs)
+
+
+def test_generic_driver_follows_another_residual():
+    """The continuation driver takes any residual with its exact Jacobian: here the closing condition of
+    the massless contact model (one equation in the open and closed half-durations (α, β), theory §8) of
+    the bilinear oscillator (mass on k₁ = 1, massless contact point on k₂ = 3, gap 1), whose periodic
+    orbits obey a closed-form period–energy relation."""
+    from bladecase.nsm import Curve, trace
+    from bladecase.nsm.massless import condense
+    from bladecase.nsm.massless_orbits import SymmetricOrbit, closing_residual, orbit_at_period
+
+    s = condense(np.diag([1.0, 0.0]), np.array([[4.0, -3.0], [-3.0, 3.0]]), np.array([0.0, 1.0]), gap=1.0)
+
+    def period(E, k1=1.0, k2=3.0, d=1.0):  # open flight to x = d, closed flight about x_eq and back
+        w1, w2, x_eq = np.sqrt(k1), np.sqrt(k1 + k2), k2 * d / (k1 + k2)
+        A1 = np.sqrt(2 * E / k1)
+        A2 = np.hypot(d - x_eq, w1 * np.sqrt(A1**2 - d**2) / w2)
+        return 2 * (np.arccos(-d / A1) / w1 + np.arccos((d - x_eq) / A2) / w2)
+
+    curve = Curve(residual=lambda z: np.array([closing_residual(s, *z)[1]]),
+                  jacobian=lambda z: closing_residual(s, *z, True)[2][None, :], tol=1e-10)
+    start = orbit_at_period(s, 5.5, beta0=0.3)
+    pts, i0 = trace(curve, np.array([start.alpha, start.beta]), ds=0.02, max_points=60,
+                    stop=lambda z: not 4.8 <= 2 * z.sum() <= 2 * np.pi * (1 - 1e-6) or min(z) <= 0)
+    Ts = np.array([2 * z.sum() for z in pts])
+    assert len(pts) > 30 and 0 < i0 < len(pts) - 1 and Ts.min() < 4.9 and Ts.max() > 6.0
+    for z in pts[1:-1]:
+        o = SymmetricOrbit(s, z[0], z[1], closing_residual(s, *z)[0])
+        assert o.T == pytest.approx(period(o.energy), rel=1e-9)
+
+
+def test_sample_spacings(fam2):
+    red = next(f for f in fam2 if any(abs(a.T_hi - 5 * T2_2DOF) < 1e-3 for a in f.arcs))
+    arc = next(a for a in red.arcs if abs(a.T_hi - 5 * T2_2DOF) < 1e-3)
+    T_mid = 0.5 * (arc.T_lo + arc.T_hi)
+    by_index = red.sample(5, at=T_mid)
+    assert all(o in red.orbits[arc.start: arc.stop + 1] and o.admissible for o in by_index)
+    by_state = red.sample(5, at=T_mid, spacing="state")
+    assert 2 <= len(by_state) <= 5 and all(o in red.orbits[arc.start: arc.stop + 1] for o in by_state)
+    by_period = red.sample(5, at=T_mid, spacing="period")
+    assert len(by_period) == 5 and all(o.admissible for o in by_period)
+    pad = 1e-6 * (arc.T_hi - arc.T_lo)
+    np.testing.assert_allclose([o.T for o in by_period], np.linspace(arc.T_lo + pad, arc.T_hi - pad, 5), rtol=1e-15)
+    T, theta, x, v = red.manifold(5, 8, at=T_mid, spacing="period")
+    assert x.shape == (2, 5, 8) and np.all(T == [o.T for o in by_period])
+    with pytest.raises(ValueError, match="spacing"):
+        red.sample(5, spacing="random")
+    with pytest.raises(ValueError, match="count"):
+        red.sample(0)

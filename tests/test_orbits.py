@@ -305,3 +305,41 @@ def test_certification_vs_brute_force_many_modes(chain10, chain10_backbone, rand
         ends = [e for iv in bb.intervals[:6] for e in (iv.T_lo, iv.T_hi) if iv.refined_lo and iv.refined_hi]
         periods = np.r_[[e * (1 + r) for e in ends for r in (-1e-6, 1e-6)], np.linspace(1.0, 4.5, 12)]
         assert _certification_agrees_with_brute_force(s, periods, points=100_001) > 20
+
+
+# ---------------------------------------------------------------------------
+# Orbits are light records: they pickle without the system and re-bind to it
+# ---------------------------------------------------------------------------
+
+
+def test_orbit_pickles_small_without_the_system():
+    import pickle
+
+    big = bc.chain(500, k=1.0, m=1.0 / 500, gap=1.0)
+    T = 0.97 * 2 * np.pi / big.spectrum.omega[0]
+    o = bc.orbit_1ipp(big, T)
+    o.state(0.0)  # caches the modal kernel (500 x 500 modes): it must not be shipped either
+    data = pickle.dumps(o)
+    assert len(data) < 10_000, len(data)
+    back = pickle.loads(data)
+    assert back.system is None
+    for name in ("T", "energy", "admissible", "max_violation", "max_violation_time", "repeats", "stable"):
+        assert getattr(back, name) == getattr(o, name), name
+    np.testing.assert_array_equal(back.impact_times, o.impact_times)
+    np.testing.assert_array_equal(back.impulses, o.impulses)
+    with pytest.raises(ValueError, match="not bound to a system"):
+        back.state(0.0)
+    bound = back.bind(big)
+    t = np.linspace(0, T, 7)
+    for a, b in zip(bound.state(t), o.state(t)):
+        np.testing.assert_array_equal(a, b)
+    with pytest.raises(ValueError, match="LinearSystem"):
+        back.bind("not a system")
+
+
+def test_orbit_dict_round_trip(two_dof):
+    o = bc.orbit_1ipp(two_dof, 4.5)
+    back = bc.PeriodicOrbit.from_dict(two_dof, o.to_dict())
+    assert back.to_dict() == o.to_dict()
+    assert back.stable is None and back.multipliers is None
+    np.testing.assert_array_equal(back.state(1.0)[0], o.state(1.0)[0])

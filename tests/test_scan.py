@@ -212,3 +212,54 @@ def test_chain10_intervals_are_admissible_throughout(chain10, chain10_backbone):
     # e.g. the reported [4.1291, 4.4646] contains 4·2π/ω₉ = 4.15859 and 3·2π/ω₈ = 4.41062;
     # T = 4.1626 in it has Λ = -1.96 and max_violation = 12 d
     assert _interval_problems(chain10, chain10_backbone, dense=201) == []
+
+
+# ---------------------------------------------------------------------------
+# One branch type: the backbone is a Branch (source "scan"), serialised in one place
+# ---------------------------------------------------------------------------
+
+
+def test_backbone_is_a_branch_with_scan_source(two_dof_backbone):
+    from bladecase.nsm import Branch
+
+    bb = two_dof_backbone
+    assert isinstance(bb, Branch) and bc.Backbone is Branch and bc.Family is Branch and bc.Interval is bc.Arc
+    assert bb.source == "scan" and bb.k == bb.ipp == 1
+    assert bb.intervals is bb.arcs
+    np.testing.assert_array_equal(bb.T, bb.periods)
+    for a in bb.arcs:  # arcs carry the scan indices of their admissible points
+        assert bb.admissible[a.start: a.stop + 1].all()
+        assert a.T_lo <= bb.periods[a.start] and bb.periods[a.stop] <= a.T_hi
+
+
+def test_backbone_dict_round_trip(two_dof):
+    P = 2 * np.pi / two_dof.spectrum.omega
+    bb = bc.backbone(two_dof, [P[1], 4.0, 4.5, 5.0, 2 * P[1], 6.0, 7.0])
+    d = bb.to_dict()
+    back = bc.Backbone.from_dict(two_dof, json.loads(json.dumps(d)))
+    assert back.source == "scan" and back.orbits[0] is None and back.orbits[4] is None
+    assert back.to_dict() == d
+    assert back.table() == bb.table()
+    # a document written before the merge: intervals only (no arcs), orbits without the new keys
+    old = {key: d[key] for key in ("ipp", "system", "linear_frequencies", "linear_periods", "intervals")}
+    old["orbits"] = [{k: v for k, v in o.items() if k not in ("max_violation_time", "stable", "multipliers")}
+                     for o in d["orbits"]]
+    legacy = bc.Backbone.from_dict(two_dof, old)
+    assert [(a.start, a.stop, a.T_lo, a.T_hi) for a in legacy.arcs] == [(a.start, a.stop, a.T_lo, a.T_hi)
+                                                                     for a in bb.arcs]
+    np.testing.assert_array_equal(legacy.energy, bb.energy)
+    with pytest.raises(ValueError, match="system of 2 dofs, this one has 3"):
+        bc.Backbone.from_dict(bc.chain(3, gap=1.0), d)
+    with pytest.raises(ValueError, match="not a branch document"):
+        bc.Backbone.from_dict(two_dof, {"ipp": 1})
+
+
+def test_branch_pickles_without_the_system(two_dof_backbone):
+    import pickle
+
+    back = pickle.loads(pickle.dumps(two_dof_backbone))
+    assert back.system is None and all(o is None or o.system is None for o in back.orbits)
+    with pytest.raises(ValueError, match="not bound"):
+        _ = back.linear_frequencies
+    bound = back.bind(two_dof_backbone.system)
+    assert bound.to_dict() == two_dof_backbone.to_dict()

@@ -315,3 +315,49 @@ def test_no_impact_below_the_obstacle(two_dof):
 def test_simulate_errors(two_dof, x0, v0, t_end, e, match):
     with pytest.raises(ValueError, match=match):
         bc.simulate(two_dof, x0, v0, t_end, restitution=e)
+
+
+# ---------------------------------------------------------------------------
+# The simulator is made of swappable pieces: a flight propagator and an impact law
+# ---------------------------------------------------------------------------
+
+
+def test_event_loop_with_explicit_pieces_is_simulate(random_sys):
+    from bladecase.nsm import ModalFlight, NewtonImpact, integrate
+
+    x0, v0 = _generic_state(random_sys, seed=5)
+    ref = bc.simulate(random_sys, x0, v0, 40.0, restitution=0.8)
+    tr = integrate(ModalFlight(random_sys), NewtonImpact(0.8), x0, v0, 40.0)
+    assert tr.impact_times.size > 5
+    for name in ("impact_times", "impulses", "x", "v", "x_end", "v_end"):
+        np.testing.assert_array_equal(getattr(tr, name), getattr(ref, name), err_msg=name)
+    t = np.linspace(0, 40.0, 333)
+    np.testing.assert_array_equal(tr.state(t)[0], ref.state(t)[0])
+
+
+def test_event_loop_uses_the_pieces_it_is_given(two_dof):
+    """A propagator and an impact law of one's own plug into the loop: here the modal flight with a
+    counter on the contact-signal requests, and a perfectly plastic-like law that keeps a tenth of the
+    normal velocity (the loop only asks for ``apply``)."""
+    from bladecase.nsm import ModalFlight, integrate
+
+    class CountingFlight(ModalFlight):
+        calls = 0
+
+        def contact_signal(self, q, p, t0=0.0):
+            CountingFlight.calls += 1
+            return super().contact_signal(q, p, t0)
+
+    class TenthRebound:
+        def apply(self, flight, q, p):
+            direction, mobility = flight.normal_direction
+            lam = 1.1 * flight.normal_velocity(q, p) / mobility
+            return p - lam * direction, lam
+
+    o = bc.orbit_1ipp(two_dof, 4.5)
+    x0, v0 = o.state(o.T / 2)
+    tr = integrate(CountingFlight(two_dof), TenthRebound(), x0[:, 0], v0[:, 0], 3 * o.T)
+    assert tr.impact_times.size >= 1 and CountingFlight.calls >= tr.impact_times.size
+    ref = bc.simulate(two_dof, x0[:, 0], v0[:, 0], 3 * o.T, restitution=0.1)
+    np.testing.assert_allclose(tr.impact_times, ref.impact_times, rtol=1e-13)
+    np.testing.assert_allclose(tr.impulses, ref.impulses, rtol=1e-12)

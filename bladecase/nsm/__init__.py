@@ -1,17 +1,57 @@
 """Stage 3 — the nonsmooth-mode solver: systems, orbits, branches, simulation.
 
 Data in: a :class:`LinearSystem` (from a chain, a reduced model or a full FE model — the solver never
-knows which). Data out: orbits and branches (nonsmooth modes) and simulated trajectories.
+knows which). Data out: periodic orbits, branches (nonsmooth modes) and simulated trajectories.
+
+The pipeline inside, one module per step:
+
+- :mod:`~bladecase.nsm.system` — :class:`LinearSystem`, its contact :class:`Spectrum`, :func:`chain`;
+- :mod:`~bladecase.nsm.modal` — :class:`ModalKernel` (periodic impulse response at a period) and the k-ipp
+  equations: :func:`impact_matrices`, :func:`kipp_residual`, :func:`kipp_jacobian`, :func:`newton_times`,
+  :func:`solve_times`;
+- :mod:`~bladecase.nsm.signals` — certified bounds and first roots of trigonometric sums;
+- :mod:`~bladecase.nsm.orbits` — :class:`PeriodicOrbit` (a small record; pickles without its system),
+  :func:`make_orbit` (certified admissibility), :func:`orbit_1ipp`;
+- :mod:`~bladecase.nsm.kipp` — every k-ipp orbit at one period: :func:`orbits_kipp`;
+- :mod:`~bladecase.nsm.continuation` — pseudo-arclength following of ``R(z) = 0`` for any residual with an
+  exact Jacobian (:class:`Curve`, :func:`trace`, :func:`bisect`);
+- :mod:`~bladecase.nsm.families` — the k-ipp residual as such a curve (:class:`KippCurve`);
+- :mod:`~bladecase.nsm.branches` — :class:`Branch` and :class:`Arc`, the one result type of
+  :func:`nonsmooth_mode` (continuation, any k) and :func:`backbone` (:mod:`~bladecase.nsm.scan`, 1-ipp scan);
+  ``Family``, ``Backbone``, ``Interval`` are their former names;
+- :mod:`~bladecase.nsm.flight` and :mod:`~bladecase.nsm.simulation` — the event-driven simulator:
+  a flight propagator (:class:`ModalFlight`), an impact law (:class:`NewtonImpact`), the event loop
+  (:func:`integrate`) and :func:`simulate`;
+- :mod:`~bladecase.nsm.massless`, :mod:`~bladecase.nsm.massless_orbits`, :mod:`~bladecase.nsm.bar` — the
+  massless contact model (theory §8).
 """
 
-from .branches import Arc, Family, nonsmooth_mode
-from .orbits import PeriodicOrbit, impact_matrices, make_orbit, orbit_1ipp, orbits_kipp
-from .scan import Backbone, Interval, backbone
-from .simulation import Trajectory, simulate
+from .bar import bar, bar_continuum_energy
+from .branches import Arc, Backbone, Branch, Family, Interval, nonsmooth_mode
+from .continuation import Curve, bisect, trace
+from .families import KippCurve
+from .flight import FlightPropagator, ImpactLaw, ModalFlight, NewtonImpact
+from .kipp import canonical_rotation, orbits_kipp
+from .massless import MasslessSystem, condense, simulate_massless
+from .modal import (
+    ModalKernel,
+    check_period,
+    impact_matrices,
+    kipp_jacobian,
+    kipp_residual,
+    newton_times,
+    solve_times,
+)
+from .orbits import PeriodicOrbit, make_orbit, orbit_1ipp
+from .scan import backbone
+from .simulation import Trajectory, integrate, simulate
 from .system import LinearSystem, Spectrum, chain
 
 __all__ = [
-    "Arc", "Backbone", "Family", "Interval", "LinearSystem", "PeriodicOrbit", "Spectrum", "Trajectory",
-    "backbone", "chain", "impact_matrices", "make_orbit", "nonsmooth_mode", "orbit_1ipp", "orbits_kipp",
-    "simulate",
+    "Arc", "Backbone", "Branch", "Curve", "Family", "FlightPropagator", "ImpactLaw", "Interval", "KippCurve",
+    "LinearSystem", "MasslessSystem", "ModalFlight", "ModalKernel", "NewtonImpact", "PeriodicOrbit", "Spectrum",
+    "Trajectory", "backbone", "bar", "bar_continuum_energy", "bisect", "canonical_rotation", "chain",
+    "check_period", "condense", "impact_matrices", "integrate", "kipp_jacobian", "kipp_residual", "make_orbit",
+    "newton_times", "nonsmooth_mode", "orbit_1ipp", "orbits_kipp", "simulate", "simulate_massless",
+    "solve_times", "trace",
 ]

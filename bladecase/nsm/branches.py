@@ -1,12 +1,12 @@
-"""Nonsmooth modes: families of k-ipp periodic orbits followed in the period.
+"""Branches of periodic orbits — the nonsmooth modes — and how they are found.
 
-A k-ipp orbit is a zero of ``R(t₁…t_{k-1}, T, Λ) = [ΠΛ ; ΣΛ - d·1]``: ``2k``
-equations in ``2k`` unknowns, one of them redundant (``ΛᵀΠΛ ≡ 0``), so the
-solutions form curves — the nonsmooth modes (theory §4).  They are followed
-by pseudo-arclength continuation (tangent from the SVD of the Jacobian,
-Gauss–Newton corrector on ``R = 0`` plus the arclength condition), so turning
-points in ``T`` do not stop them.  Starting points come from
-:func:`bladecase.orbits_kipp` on a scan of periods.
+One type, :class:`Branch`, holds a sequence of k-ipp orbits with its admissible :class:`Arc` s, whether it came
+from a scan of periods (:func:`bladecase.nsm.scan.backbone`, 1 impact per period: one orbit per requested
+period, ``None`` at resonant ones) or from continuation along the solution curve (:func:`nonsmooth_mode`, any
+``k``; the curve is followed through turning points in ``T`` by :mod:`bladecase.nsm.continuation`).
+``Family``, ``Backbone`` and ``Interval`` are the former names of :class:`Branch` and :class:`Arc`.
+
+Serialisation lives here only: :meth:`Branch.to_dict` and :meth:`Branch.from_dict`.
 """
 
 from __future__ import annotations
@@ -15,37 +15,29 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .orbits import (
-    REPEAT_RTOL,
-    PeriodicOrbit,
-    _matrices,
-    _Modal,
-    _solve_times,
-    canonical_rotation,
-    check_period,
-    make_orbit,
-    orbits_kipp,
-)
+from ..progress import progress_bar
+from .families import ARC_RTOL, MERGE_RTOL, follow_family, passes
+from .kipp import check_k, orbits_kipp
+from .modal import ModalKernel, check_period, solve_times
+from .orbits import PeriodicOrbit, make_orbit
 from .system import LinearSystem
 
-#: Relative precision in ``T`` of the refined ends of admissible arcs.
-ARC_RTOL = 1e-9
+__all__ = ["ARC_RTOL", "MERGE_RTOL", "Arc", "Backbone", "Branch", "Family", "Interval", "nonsmooth_mode"]
 
-#: A family is not followed past two impacts closer than ``MERGE_RTOL·T``
-#: (it then tends to an orbit with fewer impacts).
-MERGE_RTOL = 1e-4
+SPACINGS = ("index", "state", "period")
 
 
 @dataclass(frozen=True)
 class Arc:
-    """An admissible arc of a family: points ``start..stop`` (inclusive) and its
+    """An admissible arc of a branch: points ``start..stop`` (inclusive) and its
     period range ``[T_lo, T_hi]``.
 
     ``refined_lo``/``refined_hi`` say whether that end is where admissibility
-    is lost (refined by bisection along the curve); otherwise the arc ends
-    where the family itself ends (period range, resonance, impacts merging,
-    branch point with a repeated orbit).  Along a curve with a turning point
-    ``T`` is not monotone: ``T_lo``/``T_hi`` are the extreme periods of the arc.
+    is lost (refined by bisection, along the curve or in ``T``); otherwise the
+    arc ends where the branch itself ends (period range or scan end, resonance,
+    impacts merging, branch point with a repeated orbit).  Along a curve with a
+    turning point ``T`` is not monotone: ``T_lo``/``T_hi`` are the extreme
+    periods of the arc.
     """
 
     start: int
@@ -59,291 +51,341 @@ class Arc:
         return {"start": int(self.start), "stop": int(self.stop), "T_lo": float(self.T_lo),
                 "T_hi": float(self.T_hi), "refined_lo": bool(self.refined_lo), "refined_hi": bool(self.refined_hi)}
 
+    @classmethod
+    def from_dict(cls, data: dict) -> Arc:
+        return cls(int(data["start"]), int(data["stop"]), float(data["T_lo"]), float(data["T_hi"]),
+                   bool(data["refined_lo"]), bool(data["refined_hi"]))
+
 
 @dataclass(frozen=True, eq=False)
-class Family:
-    """A nonsmooth mode: a one-parameter family of k-ipp periodic orbits.
+class Branch:
+    """A branch of k-ipp periodic orbits (a nonsmooth mode, or a 1-ipp backbone scan).
 
     Attributes
     ----------
+    system : LinearSystem or None
+        ``None`` once unpickled (:meth:`bind` re-attaches one).
     k : int
-        Impacts per period.
-    orbits : list of PeriodicOrbit
-        The orbits along the curve, in continuation order (``T`` need not be
-        monotone: turning points are followed).
+        Impacts per period (also :attr:`ipp`).
+    orbits : list of PeriodicOrbit (or None)
+        The points: in continuation order along a curve (``T`` need not be
+        monotone), or one per scanned period (``None`` where it is resonant).
     arcs : list of Arc
-        Maximal admissible stretches, with ends refined by bisection along the
-        curve.
+        Maximal admissible stretches (also :attr:`intervals`).
+    periods : ndarray or None
+        The scanned periods (a scan); ``None`` for a curve (the orbits' periods).
+    source : str
+        ``"scan"`` (periods given) or ``"curve"``.
     """
 
-    system: LinearSystem = field(repr=False)
+    system: LinearSystem | None = field(repr=False)
     k: int
     orbits: list = field(repr=False)
     arcs: list
+    periods: np.ndarray | None = field(default=None, repr=False)
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "k", check_k(self.k))
+        object.__setattr__(self, "orbits", list(self.orbits))
+        object.__setattr__(self, "arcs", list(self.arcs))
+        if self.periods is not None:
+            P = np.asarray(self.periods, dtype=float).reshape(-1)
+            if P.size != len(self.orbits):
+                raise ValueError(f"periods has {P.size} entries for {len(self.orbits)} orbits")
+            object.__setattr__(self, "periods", P)
+        elif any(o is None for o in self.orbits):
+            raise ValueError("a branch with missing orbits (None) needs the periods of its points")
+        source = self.source or ("scan" if self.periods is not None else "curve")
+        if source not in ("scan", "curve"):
+            raise ValueError(f"source must be 'scan' or 'curve', got {self.source!r}")
+        object.__setattr__(self, "source", source)
+
+    # -- columns ---------------------------------------------------------------------------------
+
+    def _column(self, get, default=np.nan) -> np.ndarray:
+        return np.array([default if o is None else get(o) for o in self.orbits])
+
+    @property
+    def ipp(self) -> int:
+        """Impacts per period (``k``)."""
+        return self.k
 
     @property
     def T(self) -> np.ndarray:
-        return np.array([o.T for o in self.orbits])
+        """``(N,)`` period of every point."""
+        return self.periods if self.periods is not None else np.array([o.T for o in self.orbits], dtype=float)
 
     @property
     def frequencies(self) -> np.ndarray:
+        """``1 / T`` of every point."""
         return 1.0 / self.T
 
     @property
     def energy(self) -> np.ndarray:
-        return np.array([o.energy for o in self.orbits])
+        return self._column(lambda o: o.energy)
 
     @property
     def admissible(self) -> np.ndarray:
-        return np.array([o.admissible for o in self.orbits], dtype=bool)
+        return self._column(lambda o: o.admissible, False).astype(bool)
+
+    @property
+    def max_violation(self) -> np.ndarray:
+        return self._column(lambda o: o.max_violation)
 
     @property
     def impact_times(self) -> np.ndarray:
-        """``(N, k)`` impact times."""
-        return np.array([o.impact_times for o in self.orbits])
+        """``(N, k)`` impact times (NaN rows where no orbit)."""
+        return np.array([np.full(self.k, np.nan) if o is None else o.impact_times for o in self.orbits])
 
     @property
     def impulses(self) -> np.ndarray:
-        return np.array([o.impulses for o in self.orbits])
+        """``(N, k)`` impulses (NaN rows where no orbit)."""
+        return np.array([np.full(self.k, np.nan) if o is None else o.impulses for o in self.orbits])
 
     @property
-    def ipp(self) -> int:
-        return self.k
+    def stable(self) -> np.ndarray:
+        """Per-point Floquet stability (object array: ``True``/``False``, ``None`` where not computed)."""
+        return np.array([None if o is None else o.stable for o in self.orbits], dtype=object)
 
     @property
-    def intervals(self) -> list:
-        """Admissible arcs as :class:`bladecase.Interval` (for plots shared with backbones)."""
-        from .scan import Interval
-
-        return [Interval(a.T_lo, a.T_hi, a.refined_lo, a.refined_hi) for a in self.arcs]
+    def intervals(self) -> list[Arc]:
+        """The admissible arcs (former name, from the backbone scans)."""
+        return self.arcs
 
     @property
     def linear_frequencies(self) -> np.ndarray:
-        sp = self.system.spectrum
+        """``ω_j / 2π`` of the modes that see the contact."""
+        sp = self._bound().spectrum
         return sp.frequencies[sp.active]
 
+    # -- binding and pickling ----------------------------------------------------------------------
+
+    def _bound(self) -> LinearSystem:
+        if self.system is None:
+            raise ValueError("this Branch is not bound to a system (it was unpickled): call branch.bind(system)")
+        return self.system
+
+    def __getstate__(self) -> dict:
+        return {"k": self.k, "orbits": self.orbits, "arcs": self.arcs, "periods": self.periods,
+                "source": self.source, "system": None}
+
+    def __setstate__(self, state: dict) -> None:
+        for name, value in state.items():
+            object.__setattr__(self, name, value)
+
+    def bind(self, system: LinearSystem) -> Branch:
+        """This branch (and its orbits) attached to ``system``."""
+        orbits = [None if o is None else o.bind(system) for o in self.orbits]
+        return Branch(system, self.k, orbits, self.arcs, self.periods, self.source)
+
+    def compact(self) -> Branch:
+        """The same orbits without the missing (resonant) points, as a curve; arcs re-indexed."""
+        keep = [i for i, o in enumerate(self.orbits) if o is not None]
+        new = {old: n for n, old in enumerate(keep)}
+        arcs = [Arc(new[a.start], new[a.stop], a.T_lo, a.T_hi, a.refined_lo, a.refined_hi) for a in self.arcs]
+        return Branch(self.system, self.k, [self.orbits[i] for i in keep], arcs)
+
+    # -- orbits anywhere on the branch ---------------------------------------------------------------
+
     def orbit_at(self, T: float) -> list[PeriodicOrbit]:
-        """The family's orbits of period ``T`` (one per crossing of ``T`` by the curve),
-        each re-solved exactly from the interpolated neighbours."""
+        """The branch's orbits of period ``T`` (one per crossing of ``T`` by the curve),
+        each re-solved exactly from the interpolated neighbours.
+
+        >>> from bladecase.nsm import chain, nonsmooth_mode
+        >>> families = nonsmooth_mode(chain(2, k=1.0, m=0.5, gap=1.0), 2, (13.2, 13.75), scan=2)
+        >>> (mode,) = [f for f in families if f.arcs]
+        >>> [(o.T, round(float(o.impact_times[0]), 6), o.admissible) for o in mode.orbit_at(13.5)]
+        [(13.5, 6.082917, True)]
+        """
+        system = self._bound()
         out = []
         Ts = self.T
-        d = self.system.gap
-        T = check_period(self.system, T)
+        T = check_period(system, T)
         for i in range(len(Ts) - 1):
+            a_orb, b_orb = self.orbits[i], self.orbits[i + 1]
             lo, hi = sorted((Ts[i], Ts[i + 1]))
-            if not lo <= T <= hi or hi == lo:
+            if a_orb is None or b_orb is None or not lo <= T <= hi or hi == lo:
                 continue
             a = (T - Ts[i]) / (Ts[i + 1] - Ts[i])
-            guess = (1 - a) * self.orbits[i].impact_times / Ts[i] + a * self.orbits[i + 1].impact_times / Ts[i + 1]
-            sol = _solve_times(_Modal.of(self.system, T), guess * T, d)
+            guess = (1 - a) * a_orb.impact_times / Ts[i] + a * b_orb.impact_times / Ts[i + 1]
+            sol = solve_times(ModalKernel.of(system, T), guess * T, system.gap)
             if sol is not None:
-                out.append(make_orbit(self.system, T, *sol))
+                out.append(make_orbit(system, T, *sol))
         return out
 
-    def manifold(self, n_orbits: int = 40, n_times: int = 200, admissible_only: bool = True):
-        """Sample the family's 2-D invariant manifold ``(T, t) ↦ (x, v)``.
+    def _arc_through(self, at: float | None) -> Arc | None:
+        """The arc whose period range holds ``at``, else the widest arc (``None`` if there is none)."""
+        arcs = [a for a in self.arcs if at is not None and a.T_lo <= at <= a.T_hi]
+        arcs = arcs or sorted(self.arcs, key=lambda a: a.T_lo - a.T_hi)[:1]
+        return arcs[0] if arcs else None
 
-        Picks ``n_orbits`` orbits evenly along the curve (by index, over the
-        admissible arcs when ``admissible_only``) and ``n_times`` instants
-        ``t = θT``, ``θ ∈ [0, 1)``, on each.
+    def sample(self, count: int, *, at: float | None = None, spacing: str = "index",
+               admissible_only: bool = True) -> list[PeriodicOrbit]:
+        """``count`` orbits spread over the branch (or over the admissible arc through period ``at``).
+
+        ``spacing``: ``"index"`` — evenly by index among the computed orbits; ``"state"`` — evenly in the
+        cumulative RMS distance between consecutive orbits' states (64 phases each), so fast-changing
+        stretches are not crowded; ``"period"`` — re-solved (:meth:`orbit_at`) at evenly spaced periods
+        over the arc through ``at`` (the widest arc when ``at`` is None or in no arc), keeping at each
+        period the admissible orbit closest in impact phases to the previous one.  The first two pick
+        admissible orbits only when ``admissible_only``; fewer orbits come back where fewer exist.
+        """
+        if spacing not in SPACINGS:
+            raise ValueError(f"spacing must be one of {SPACINGS}, got {spacing!r}")
+        if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
+            raise ValueError(f"count must be an integer >= 1, got {count!r}")
+        if spacing == "period":
+            return self._sample_periods(count, at)
+        idx = np.array([i for i, o in enumerate(self.orbits) if o is not None], dtype=int)
+        if at is not None:
+            arc = self._arc_through(at)
+            idx = idx[(idx >= arc.start) & (idx <= arc.stop)] if arc is not None else idx[:0]
+        if admissible_only:
+            idx = idx[self.admissible[idx]]
+            if idx.size == 0:
+                raise ValueError("the branch has no admissible orbit (use admissible_only=False)")
+        if spacing == "index":
+            pick = idx[np.unique(np.linspace(0, idx.size - 1, count).round().astype(int))]
+        else:
+            theta = np.arange(64) / 64
+            states = np.array([np.concatenate(self.orbits[i].state(theta * self.orbits[i].T)).ravel() for i in idx])
+            dist = np.concatenate([[0.0], np.cumsum(np.sqrt(np.mean(np.diff(states, axis=0) ** 2, axis=1)))])
+            pick = idx[np.unique([int(np.argmin(np.abs(dist - s))) for s in np.linspace(0.0, dist[-1], count)])]
+        return [self.orbits[i] for i in pick]
+
+    def _sample_periods(self, count: int, at: float | None) -> list[PeriodicOrbit]:
+        arc = self._arc_through(at)
+        if arc is None:
+            return []
+        pad = 1e-6 * (arc.T_hi - arc.T_lo)
+        out: list[PeriodicOrbit] = []
+        for Tj in np.linspace(arc.T_lo + pad, arc.T_hi - pad, count):
+            try:
+                cands = [o for o in self.orbit_at(Tj) if o.admissible]
+            except ValueError:  # a resonant period
+                continue
+            if not cands:
+                continue
+            if out:
+                ref = out[-1].impact_times / out[-1].T
+                cands.sort(key=lambda o: np.abs(o.impact_times / o.T - ref).max())
+            out.append(cands[0])
+        return out
+
+    def manifold(self, n_orbits: int = 40, n_times: int = 200, admissible_only: bool = True, *,
+                 at: float | None = None, spacing: str = "index"):
+        """Sample the branch's 2-D invariant manifold ``(T, t) ↦ (x, v)``.
+
+        ``n_orbits`` orbits picked by :meth:`sample` (default: evenly by index over the admissible
+        arcs when ``admissible_only``) and ``n_times`` instants ``t = θT``, ``θ ∈ [0, 1)``, on each.
 
         Returns
         -------
-        T : (n_orbits,) periods;  theta : (n_times,) phases;
-        x, v : (n, n_orbits, n_times) positions and velocities.
+        T : (m,) periods (``m <= n_orbits``);  theta : (n_times,) phases;
+        x, v : (n, m, n_times) positions and velocities.
         """
-        idx = np.arange(len(self.orbits))
-        if admissible_only:
-            idx = idx[self.admissible]
-            if idx.size == 0:
-                raise ValueError("the family has no admissible orbit (use admissible_only=False)")
-        pick = idx[np.unique(np.linspace(0, idx.size - 1, n_orbits).round().astype(int))]
+        orbits = self.sample(n_orbits, at=at, spacing=spacing, admissible_only=admissible_only)
+        if not orbits:
+            raise ValueError("no orbit to sample on the branch")
         theta = np.arange(n_times) / n_times
-        xs, vs = [], []
-        for i in pick:
-            o = self.orbits[i]
-            x, v = o.state(theta * o.T)
-            xs.append(x)
-            vs.append(v)
-        return self.T[pick], theta, np.stack(xs, axis=1), np.stack(vs, axis=1)
+        states = [o.state(theta * o.T) for o in orbits]
+        return (np.array([o.T for o in orbits]), theta, np.stack([s[0] for s in states], axis=1),
+                np.stack([s[1] for s in states], axis=1))
+
+    # -- plain data ----------------------------------------------------------------------------------
 
     def to_dict(self) -> dict:
-        return {
-            "ipp": self.k,
-            "arcs": [a.to_dict() for a in self.arcs],
-            "orbits": [o.to_dict() for o in self.orbits],
-        }
+        """Plain data (JSON-ready); :meth:`from_dict` reads it back.
 
-    def table(self) -> str:
-        lines = [f"{self.k}-ipp family, {len(self.orbits)} orbits, T in [{self.T.min():.8g}, {self.T.max():.8g}]"]
-        for a in self.arcs:
-            lines.append(f"  admissible arc: T in [{a.T_lo:.10g}, {a.T_hi:.10g}]  (points {a.start}..{a.stop})")
-        if not self.arcs:
-            lines.append("  no admissible arc")
+        Keys: ``ipp``, ``source``, ``orbits`` (records; ``{"T", "frequency", "resonant": true}`` at a
+        resonant scan period), ``arcs`` (with point indices), ``intervals`` (their period ranges), and,
+        when bound, ``system`` (``n``, ``gap``), ``linear_frequencies``, ``linear_periods``.
+        """
+        out: dict = {"ipp": self.k, "source": self.source}
+        if self.system is not None:
+            lf = self.linear_frequencies
+            out.update(system={"n": self.system.n, "gap": self.system.gap}, linear_frequencies=lf.tolist(),
+                       linear_periods=(1.0 / lf).tolist())
+        out["orbits"] = [{"T": float(T), "frequency": float(1 / T), "resonant": True} if o is None else o.to_dict()
+                         for T, o in zip(self.T, self.orbits)]
+        out["arcs"] = [a.to_dict() for a in self.arcs]
+        out["intervals"] = [{"T_lo": a.T_lo, "T_hi": a.T_hi, "refined_lo": a.refined_lo, "refined_hi": a.refined_hi}
+                            for a in self.arcs]
+        return out
+
+    @classmethod
+    def from_dict(cls, system: LinearSystem | None, data: dict) -> Branch:
+        """A branch back from :meth:`to_dict` (orbits as stored: not re-solved, not re-certified).
+
+        Also reads the documents written before the branch types were merged: a family's
+        (``ipp``, ``arcs``, ``orbits``) and a backbone's (``intervals`` without point indices).
+        """
+        try:
+            k = check_k(int(data["ipp"]))
+            n = (data.get("system") or {}).get("n")
+            if system is not None and n is not None and int(n) != system.n:
+                raise ValueError(f"the branch was computed on a system of {n} dofs, this one has {system.n}")
+            orbits, periods = [], []
+            for rec in data["orbits"]:
+                orbit = None if rec.get("resonant") else PeriodicOrbit.from_dict(system, rec)
+                orbits.append(orbit)
+                periods.append(float(rec["T"]))
+            if "arcs" in data:
+                arcs = [Arc.from_dict(a) for a in data["arcs"]]
+            else:
+                arcs = [_interval_arc(iv, periods, orbits) for iv in data["intervals"]]
+            source = data.get("source") or ("curve" if "arcs" in data else "scan")
+        except (KeyError, TypeError, AttributeError) as exc:
+            raise ValueError(f"not a branch document (as written by Branch.to_dict): missing or bad {exc}") from None
+        return cls(system, k, orbits, arcs, periods if source == "scan" else None, source)
+
+    def table(self, points: bool | None = None) -> str:
+        """Human-readable summary: a header line, one row per point (``points``; default: for scans),
+        then the admissible arcs."""
+        k, T = self.k, self.T
+        lines = [f"{k}-ipp family, {len(self.orbits)} orbits ({self.source}), T in [{T.min():.8g}, {T.max():.8g}]"]
+        if points if points is not None else self.source == "scan":
+            lines.append(f"{'T':>14} {'1/T':>12} {'energy':>12} {'impact times':>36} {'impulses':>30} admissible")
+            for Tp, o in zip(T, self.orbits):
+                if o is None:
+                    lines.append(f"{Tp:14.8g} {1 / Tp:12.6g} {'resonant':>12}")
+                    continue
+                times = " ".join(f"{t:.6g}" for t in o.impact_times)
+                imp = " ".join(f"{x:.5g}" for x in o.impulses)
+                lines.append(f"{Tp:14.8g} {1 / Tp:12.6g} {o.energy:12.6g} {times:>36} {imp:>30} "
+                             f"{'yes' if o.admissible else 'no'}")
+        lines.append("")
+        if self.arcs:
+            lines.append(f"admissible intervals of T ({k} impact(s) per period):")
+            for a in self.arcs:
+                lines.append(f"  admissible arc: T in [{a.T_lo:.12g}, {a.T_hi:.12g}]   "
+                             f"1/T in [{1 / a.T_hi:.8g}, {1 / a.T_lo:.8g}]   (points {a.start}..{a.stop})")
+        else:
+            lines.append(f"no admissible arc: no admissible {k}-ipp orbit in the {self.source}")
         return "\n".join(lines)
 
+    def plot(self, ax=None, **kwargs):
+        """Frequency–energy plot (see :func:`bladecase.post.plots.frequency_energy`)."""
+        from ..post.plots import frequency_energy
 
-# ---------------------------------------------------------------------------
-
-
-class _Curve:
-    """The k-ipp equations with the impulses eliminated, in the scaled
-    unknowns ``z = (t₁/T₀ … t_{k-1}/T₀, T/T₀)``.
-
-    ``Λ = d Σ⁻¹ 1`` satisfies the position conditions; the residual is the
-    impact-law condition ``Π n`` with the direction ``n = Σ⁻¹1 / |Σ⁻¹1|``,
-    scaled by ``wᵀM⁻¹w / 2`` (``k`` equations, one redundant since
-    ``nᵀΠn ≡ 0``).  For k = 2 this is the paper's Eq. 15, ``s(t₁) = 0``, and
-    the curve lives in the ``(t₁, T)`` plane of its Fig. 2.
-    """
-
-    def __init__(self, system: LinearSystem, k: int, T0: float, lam0: float):
-        self.system, self.k, self.T0, self.lam0 = system, k, T0, lam0
-        self.d = system.gap
-        b = system.spectrum.contact_modes[1]
-        self.scale = float(b @ b) / 2
-
-    def times(self, z) -> tuple[float, np.ndarray]:
-        T = z[-1] * self.T0
-        return T, np.append(z[:-1] * self.T0, T)
-
-    def split(self, z):
-        """``(T, times, Λ)`` at ``z``."""
-        T, times = self.times(z)
-        _, Sigma = _matrices(_Modal.of(self.system, T), times)
-        lam = self.d * np.linalg.solve(Sigma, np.ones(self.k))
-        return T, times, lam
-
-    def join(self, times, lam=None):
-        return times / self.T0
-
-    def residual(self, z):
-        T, times = self.times(z)
-        Pi, Sigma = _matrices(_Modal.of(self.system, T), times)
-        try:
-            n = np.linalg.solve(Sigma, np.ones(self.k))
-        except np.linalg.LinAlgError:
-            return np.full(self.k, np.nan)
-        return Pi @ (n / np.linalg.norm(n)) / self.scale
-
-    def jacobian(self, z, h=1e-7):
-        n = z.size
-        J = np.empty((self.k, n))
-        for j in range(n):
-            e = np.zeros(n)
-            e[j] = h
-            J[:, j] = (self.residual(z + e) - self.residual(z - e)) / (2 * h)
-        return J
-
-    def tangent(self, z, previous=None, J=None):
-        """Unit null vector of the Jacobian, oriented along ``previous``."""
-        _, _, vt = np.linalg.svd(self.jacobian(z) if J is None else J)
-        t = vt[-1]
-        if previous is not None and t @ previous < 0:
-            t = -t
-        return t
-
-    def valid(self, z) -> bool:
-        """Ordered impacts, no two closer than ``MERGE_RTOL·T``, finite impulses,
-        and not within ``MERGE_RTOL`` of a repeated orbit (period ``T/j``)."""
-        T, times = self.times(z)
-        gaps = np.diff(np.concatenate([[0.0], times]))
-        if not (np.all(np.isfinite(z)) and T > 0 and gaps.min() > MERGE_RTOL * T):
-            return False
-        try:
-            T, times, lam = self.split(z)
-        except np.linalg.LinAlgError:
-            return False
-        if not np.all(np.isfinite(lam)) or np.abs(lam).max() > 1e8 * self.lam0:
-            return False
-        return _distance_to_repetition(times, lam, T) > MERGE_RTOL
-
-    def correct(self, zp, tangent, J=None, tol=1e-10, maxiter=10):
-        """Newton on ``[R(z) ; tangent·(z - zp)] = 0``; with ``J`` given, the chord
-        method (that Jacobian kept for every iteration)."""
-        z = zp.copy()
-        for it in range(maxiter):
-            r = np.append(self.residual(z), tangent @ (z - zp))
-            if not np.all(np.isfinite(r)):
-                return None, it
-            A = np.vstack([self.jacobian(z) if J is None else J, tangent])
-            dz, *_ = np.linalg.lstsq(A, -r, rcond=None)
-            z = z + dz
-            if np.abs(dz).max() < 1e-11:
-                res = np.abs(self.residual(z)).max()
-                return (z if res < tol else None), it + 1
-        return None, maxiter
+        return frequency_energy([self], ax=ax, **kwargs)
 
 
-def _repetition_offsets(times, T) -> list[np.ndarray]:
-    """For each ``j > 1`` dividing ``k``: the offsets of the impact pattern from
-    one repeating every ``T/j`` (all zero at a repeated orbit)."""
-    k = times.size
-    return [np.mod(np.roll(times, -(k // j)) - times, T) - T / j for j in range(2, k + 1) if k % j == 0]
+def _interval_arc(iv: dict, periods: list[float], orbits: list) -> Arc:
+    """An arc from a period interval of an old backbone document: the admissible points inside it."""
+    idx = [i for i, (T, o) in enumerate(zip(periods, orbits))
+           if o is not None and o.admissible and iv["T_lo"] <= T <= iv["T_hi"]]
+    if not idx:
+        raise ValueError(f"interval [{iv['T_lo']}, {iv['T_hi']}] holds no admissible orbit of the document")
+    return Arc(idx[0], idx[-1], float(iv["T_lo"]), float(iv["T_hi"]), bool(iv["refined_lo"]), bool(iv["refined_hi"]))
 
 
-def _crosses_repetition(curve: _Curve, z_a, z_b) -> bool:
-    """Does the segment ``z_a → z_b`` cross a repeated orbit (all offsets flip sign)?"""
-    for da, db in zip(_repetition_offsets(*curve.times(z_a)[::-1]), _repetition_offsets(*curve.times(z_b)[::-1])):
-        if np.all(np.sign(da) * np.sign(db) < 0):
-            return True
-    return False
-
-
-def _distance_to_repetition(times, lam, T) -> float:
-    """How far (relative) the impact pattern is from repeating every ``T/j``, ``j | k``."""
-    k = times.size
-    scale = max(np.abs(lam).max(), np.finfo(float).tiny)
-    best = np.inf
-    for j in range(2, k + 1):
-        if k % j:
-            continue
-        shift = k // j
-        dt = np.mod(np.roll(times, -shift) - times, T)
-        dist = max(np.abs(dt - T / j).max() / T, np.abs(np.roll(lam, -shift) - lam).max() / scale)
-        best = min(best, dist)
-    return best
-
-
-def _follow(curve: _Curve, z0, direction, T_range, ds, ds_min, ds_max, max_points):
-    """Points of the curve from ``z0`` along ``direction`` until it leaves
-    ``T_range``, two impacts merge, it reaches a repeated orbit (a branch
-    point with the family of period-``T/j`` orbits), the impulses blow up
-    (resonance), the curve closes on itself, or the corrector fails at the
-    smallest step."""
-    pts = []
-    J = curve.jacobian(z0)
-    z, tan = z0, curve.tangent(z0, direction, J)
-    travelled = 0.0
-    for _ in range(max_points):
-        step = ds
-        while True:
-            zp = z + step * tan
-            zc, iters = curve.correct(zp, tan, J)
-            if zc is None:  # chord method failed: full Newton (fresh Jacobian every iteration)
-                zc, iters = curve.correct(zp, tan)
-            # The corrector moves across the curve; a large move means it jumped
-            # to another branch: take a smaller step instead.
-            # Crossing a repeated (period T/j) orbit is a branch point: the family
-            # ends there; smaller steps bring its last point close to it.
-            if (zc is not None and curve.valid(zc) and np.linalg.norm(zc - zp) < 0.3 * step
-                    and not _crosses_repetition(curve, z, zc)):
-                break
-            step /= 2
-            if step < ds_min:
-                return pts
-        travelled += np.linalg.norm(zc - z)
-        J = curve.jacobian(zc)
-        tan = curve.tangent(zc, tan, J)
-        z = zc
-        pts.append(z)
-        if travelled > 4 * ds_max and np.linalg.norm(z - z0) < step:
-            return pts  # closed curve
-        ds = min(ds_max, step * (1.5 if iters <= 6 else 0.7 if iters >= 9 else 1.0))
-        T = z[curve.k - 1] * curve.T0
-        if not T_range[0] <= T <= T_range[1]:
-            return pts
-    return pts
+#: Former names: the continuation family and the 1-ipp scan are one type now.
+Family = Branch
+Backbone = Branch
+#: Former name of the admissible stretch of a 1-ipp scan: the same type as :class:`Arc`.
+Interval = Arc
 
 
 def nonsmooth_mode(
@@ -356,7 +398,7 @@ def nonsmooth_mode(
     refine: bool = True,
     progress: bool = False,
     resolution: int | None = None,
-) -> list[Family]:
+) -> list[Branch]:
     """Follow every k-ipp family (nonsmooth mode) found in ``T_range``.
 
     Parameters
@@ -372,8 +414,8 @@ def nonsmooth_mode(
         Orbits that are repetitions of shorter-period orbits (``repeats >
         1``) are not followed: they are not new modes.
     step : float
-        Initial arclength step in scaled unknowns (times / ``T``, impulses /
-        their scale); it adapts between ``step/1000`` and ``2·step``.
+        Initial arclength step in scaled unknowns (times / ``T``); it adapts
+        between ``step/1000`` and ``2·step``.
     max_points : int
         Cap on points per direction of each family.
     refine : bool
@@ -387,196 +429,44 @@ def nonsmooth_mode(
 
     Returns
     -------
-    list of Family
+    list of Branch
         Each family's orbits in curve order (all within ``T_range``), certified,
-        with admissible arcs.
-        A family crossing a later scan period is not started again there.
+        with admissible arcs.  A family crossing a later scan period is not
+        started again there.  k = 1: the one 1-ipp branch (a scan of
+        ``max(scan, 200)`` periods, resonant points left out).
+
+    Examples
+    --------
+    The paper's 2-dof chain: the 2-ipp mode ending at ``5T₂ = 13.7293`` (seed Fig. 2).
+
+    >>> from bladecase.nsm import chain
+    >>> families = nonsmooth_mode(chain(2, k=1.0, m=0.5, gap=1.0), 2, (13.2, 13.75), scan=2)
+    >>> len(families), [(round(a.T_lo, 3), round(a.T_hi, 4), a.refined_hi) for f in families for a in f.arcs]
+    (4, [(13.329, 13.7293, True)])
     """
-    if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
-        raise ValueError(f"k (impacts per period) must be an integer >= 1, got {k!r}")
+    k = check_k(k)
     T_lo, T_hi = (float(x) for x in T_range)
     if not (np.isfinite(T_lo) and np.isfinite(T_hi)) or not 0 < T_lo < T_hi:
         raise ValueError(f"T_range must be (T_min, T_max) with 0 < T_min < T_max, got {T_range!r}")
     if k == 1:
-        return _one_ipp_families(system, (T_lo, T_hi), scan, refine)
-    periods = np.linspace(T_lo, T_hi, scan)
-    it = periods
-    if progress:
-        from tqdm.auto import tqdm
+        from .scan import backbone
 
-        it = tqdm(periods, desc=f"{k}-ipp starts", unit="T", leave=False)
+        return [backbone(system, np.linspace(T_lo, T_hi, max(scan, 200))).compact()]
     starts = []
-    for T in it:
+    for T in progress_bar(np.linspace(T_lo, T_hi, scan), f"{k}-ipp starts", enabled=progress, unit="T"):
         try:
             sols = orbits_kipp(system, T, k, resolution=resolution)
         except ValueError:
             continue
         starts.extend((T, o) for o in sols if o.repeats == 1)
-    families: list[Family] = []
+    families: list[Branch] = []
     covered = [False] * len(starts)
-    for n, (T, o) in enumerate(starts):
+    for n, (_, o) in enumerate(starts):
         if covered[n]:
             continue
-        lam0 = max(np.abs(o.impulses).max(), system.gap)
-        curve = _Curve(system, k, T, lam0)
-        z0 = curve.join(o.impact_times)
-        t0 = curve.tangent(z0)
-        fwd = _follow(curve, z0, t0, (T_lo, T_hi), step, step / 1000, 2 * step, max_points)
-        bwd = _follow(curve, z0, -t0, (T_lo, T_hi), step, step / 1000, 2 * step, max_points)
-        zs = bwd[::-1] + [z0] + fwd
-        orbits = []
-        for z in zs:
-            if not T_lo <= z[k - 1] * curve.T0 <= T_hi:
-                continue  # the step that left the period range: not part of the family
-            try:
-                orbits.append(_polished_orbit(curve, z))
-            except (ValueError, np.linalg.LinAlgError):
-                continue
+        fam = follow_family(system, k, o, (T_lo, T_hi), step, max_points, refine)
         for m in range(n + 1, len(starts)):
-            if not covered[m] and _passes(curve, zs, starts[m]):
+            if not covered[m] and passes(fam.problem, fam.points, starts[m]):
                 covered[m] = True
-        arcs = _arcs(curve, [curve.join(o.impact_times) for o in orbits], orbits, refine)
-        families.append(Family(system=system, k=k, orbits=orbits, arcs=arcs))
+        families.append(Branch(system=system, k=k, orbits=fam.orbits, arcs=[Arc(*a) for a in fam.arcs]))
     return families
-
-
-def _polished_orbit(curve: _Curve, z) -> PeriodicOrbit:
-    """The orbit at curve point ``z``, its impact times re-solved at fixed ``T``
-    to machine precision (Newton on ``(t, Λ)``).  Admissibility is certified;
-    for a non-admissible orbit ``max_violation`` is the largest sampled
-    violation (not polished)."""
-    T, times, lam = curve.split(z)
-    sol = _solve_times(_Modal.of(curve.system, T), times, curve.d)
-    if sol is not None and np.abs(sol[0] - times).max() < 1e-6 * T:
-        times, lam = sol
-    return make_orbit(curve.system, T, times, lam, polish=False)
-
-
-#: A start orbit is only re-solved from a crossing segment of a followed curve
-#: when the interpolated impact times lie within ``PASS_GATE·T`` of its own
-#: (under every re-anchoring); farther crossings are other orbits of that period.
-PASS_GATE = 0.05
-
-
-def _phase_distance(times: np.ndarray, reference: np.ndarray, T: float) -> float:
-    """``min`` over re-anchorings of ``times`` (shift by each ``t_r``) of the largest
-    distance to ``reference`` (both sets of ``k`` impact times in ``(0, T]``)."""
-    shifted = np.mod(times[None, :] - times[:, None], T)  # row r: re-anchored at impact r
-    shifted[shifted == 0] = T
-    shifted.sort(axis=1)
-    return float(np.abs(shifted - np.sort(reference)[None, :]).max(axis=1).min())
-
-
-def _passes(curve: _Curve, zs, start) -> bool:
-    """Does the polyline ``zs`` cross the start orbit (same period, same impacts)?"""
-    T_s, o = start
-    k = curve.k
-    Ts = np.array([z[k - 1] for z in zs]) * curve.T0
-    lo, hi = np.minimum(Ts[:-1], Ts[1:]), np.maximum(Ts[:-1], Ts[1:])
-    segments = np.flatnonzero((lo <= T_s) & (T_s <= hi) & (hi > lo))
-    if segments.size == 0:
-        return False
-    md = _Modal.of(curve.system, T_s)
-    for i in segments:
-        a = (T_s - Ts[i]) / (Ts[i + 1] - Ts[i])
-        ta, tb = curve.times(zs[i])[1], curve.times(zs[i + 1])[1]
-        guess = ((1 - a) * ta / Ts[i] + a * tb / Ts[i + 1]) * T_s
-        if _phase_distance(guess, o.impact_times, T_s) > PASS_GATE * T_s:
-            continue  # the interpolated impacts are far from the start's: no need to solve
-        sol = _solve_times(md, guess, curve.d)
-        if sol is None:
-            continue
-        times, _ = canonical_rotation(sol[0], sol[1], T_s)
-        if np.abs(times - o.impact_times).max() <= 1e3 * REPEAT_RTOL * T_s:
-            return True
-    return False
-
-
-def _arcs(curve: _Curve, zs, orbits, refine: bool) -> list[Arc]:
-    adm = np.array([o.admissible for o in orbits], dtype=bool)
-    arcs = []
-    i = 0
-    while i < adm.size:
-        if not adm[i]:
-            i += 1
-            continue
-        j = i
-        while j + 1 < adm.size and adm[j + 1]:
-            j += 1
-        ref_a, ref_b = refine and i > 0, refine and j + 1 < adm.size
-        T_a, T_b = orbits[i].T, orbits[j].T
-        if ref_a:
-            T_a, ref_a = _bisect_curve(curve, zs[i], zs[i - 1])
-        if ref_b:
-            T_b, ref_b = _bisect_curve(curve, zs[j], zs[j + 1])
-        Ts = [o.T for o in orbits[i:j + 1]] + [T_a, T_b]
-        lo, hi = min(Ts), max(Ts)
-        arcs.append(Arc(i, j, float(lo), float(hi), refined_lo=bool((lo == T_a and ref_a) or (lo == T_b and ref_b)),
-                        refined_hi=bool((hi == T_a and ref_a) or (hi == T_b and ref_b))))
-        i = j + 1
-    return arcs
-
-
-def _bisect_curve(curve: _Curve, z_in, z_out, maxiter: int = 80) -> tuple[float, bool]:
-    """Period where admissibility is lost between curve points ``z_in``
-    (admissible) and ``z_out``: bisection along the curve.
-
-    The midpoint is solved at fixed ``T = (T_in + T_out)/2`` by Newton from
-    the interpolated impact times (robust near resonances, where the
-    eliminated-impulse residual is stiff), else by the arclength corrector
-    orthogonal to the chord (turning points); a midpoint that leaves the
-    bracket is rejected.  Returns the admissible end and whether the bracket
-    was narrowed to ``ARC_RTOL``.
-    """
-    k = curve.k
-    for _ in range(maxiter):
-        T_in, T_out = z_in[k - 1] * curve.T0, z_out[k - 1] * curve.T0
-        if abs(T_out - T_in) <= ARC_RTOL * abs(T_in):
-            return float(T_in), True
-        zm = None
-        Tm = 0.5 * (T_in + T_out)
-        if T_in != T_out:
-            try:
-                md = _Modal.of(curve.system, check_period(curve.system, Tm))
-                guess = 0.5 * (curve.times(z_in)[1] / T_in + curve.times(z_out)[1] / T_out) * Tm
-                sol = _solve_times(md, guess, curve.d)
-            except ValueError:
-                sol = None
-            if sol is not None:
-                zm = curve.join(sol[0])
-        if zm is None:
-            chord = (z_out - z_in) / np.linalg.norm(z_out - z_in)
-            zm, _ = curve.correct(0.5 * (z_in + z_out), chord)
-        if zm is None:
-            break
-        # stay on this stretch of the curve: between the two ends, near the chord
-        span = z_out - z_in
-        a = float((zm - z_in) @ span / (span @ span))
-        if not 0 < a < 1 or np.linalg.norm(zm - z_in - a * span) > np.linalg.norm(span):
-            break
-        Tm, times, lam = curve.split(zm)
-        try:
-            ok = make_orbit(curve.system, Tm, times, lam, polish=False).admissible
-        except ValueError:
-            ok = False
-        if ok:
-            z_in = zm
-        else:
-            z_out = zm
-    return float(z_in[k - 1] * curve.T0), False
-
-
-def _one_ipp_families(system, T_range, scan, refine) -> list[Family]:
-    """k = 1: the family is the 1-ipp backbone (one family; its admissible arcs never span a resonance)."""
-    from .scan import backbone
-
-    bb = backbone(system, np.linspace(T_range[0], T_range[1], max(scan, 200)))
-    orbits = [o for o in bb.orbits if o is not None]
-    adm = np.array([o.admissible for o in orbits], dtype=bool)
-    arcs = []
-    for iv in bb.intervals:
-        idx = [n for n, o in enumerate(orbits) if iv.T_lo <= o.T <= iv.T_hi]
-        if idx:
-            arcs.append(Arc(idx[0], idx[-1], iv.T_lo, iv.T_hi, iv.refined_lo, iv.refined_hi))
-    del adm
-    return [Family(system=system, k=1, orbits=orbits, arcs=arcs)]

@@ -1,87 +1,49 @@
-"""Periodic orbits with impacts: the core of the nonsmooth-mode solver.
+"""Periodic orbits with impacts: the record, its construction and certification, and the 1-ipp orbit.
 
-Formulation (theory §3–4).  For a non-resonant period ``T``, the ``T``-periodic
-response to the unit impulse train ``-w Σ_k δ(t - kT)`` is ``x = -G(t)`` with
+An orbit with impacts at ``0 < t₁ < … < t_k = T`` and impulses ``Λ_i`` is ``x(t) = -Σ_i Λ_i G((t - t_i) mod T)``
+(theory §3–4; ``G`` in :mod:`bladecase.nsm.modal`).  One impact per period (k = 1) gives ``Λ = -d / g(0)``,
+``g = wᵀG``.  Orbits with k >= 2 impacts are found by :func:`bladecase.nsm.kipp.orbits_kipp`.
 
-    G(t)  = Σ_j φ_j b_j cos(ω_j (t - T/2)) / (2 ω_j sin(ω_j T/2)),   t ∈ [0, T)
-
-and an orbit with impacts at ``0 < t₁ < … < t_k = T`` and impulses ``Λ_i`` is
-``x(t) = -Σ_i Λ_i G((t - t_i) mod T)``.  One impact per period (k = 1) gives
-``Λ = -d / g(0)``, ``g = wᵀG``.  Everything is evaluated in the modal
-coordinates of the modes that see the contact (``b_j ≠ 0``).
+A :class:`PeriodicOrbit` is a small record (period, impact times, impulses, energy, certified admissibility)
+bound to its system; it pickles without the system (:meth:`PeriodicOrbit.bind` re-attaches one).
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
 
+from .modal import RESONANCE_RTOL, ModalKernel, check_period, impact_matrices
 from .signals import TrigSum, certified_max
 from .system import LinearSystem
 
-#: ``T`` is resonant when ``|ω_j T - 2πm| <= RESONANCE_RTOL · ω_j T`` for an
-#: integer ``m >= 1`` and a mode with ``b_j ≠ 0``: within the accuracy of the
-#: computed ``ω_j`` (the response amplitude there exceeds ``~1e11 d``).
-RESONANCE_RTOL = 1e-12
+__all__ = [
+    "ADMISSIBILITY_RTOL", "REPEAT_RTOL", "RESONANCE_RTOL", "PeriodicOrbit", "check_period", "impact_matrices",
+    "make_orbit", "orbit_1ipp", "repetitions",
+]
+
+
+def __getattr__(name: str):
+    # ``orbits_kipp`` lived here before the k-ipp search moved to :mod:`bladecase.nsm.kipp` (which imports
+    # this module): still importable from here, resolved on first use.
+    if name in ("orbits_kipp", "canonical_rotation"):
+        from . import kipp
+
+        return getattr(kipp, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 #: An orbit is admissible when its impulses are >= 0 and
 #: ``wᵀx(t) - d <= ADMISSIBILITY_RTOL · d`` is PROVED for every ``t`` of the
-#: period (see :mod:`bladecase.trigsum`); the tolerance is raised to
+#: period (see :mod:`bladecase.nsm.signals`); the tolerance is raised to
 #: ``10⁴ ε Σ|coefficients|`` when round-off in evaluating ``wᵀx`` is larger.
 ADMISSIBILITY_RTOL = 1e-9
 
-
-def check_period(system: LinearSystem, T: float) -> float:
-    """Return ``T`` as a float; raise ``ValueError`` if it is invalid or resonant."""
-    try:
-        T = float(T)
-    except (TypeError, ValueError):
-        raise ValueError(f"period T must be a number, got {T!r}") from None
-    if not np.isfinite(T) or T <= 0:
-        raise ValueError(f"period T must be finite and > 0, got {T!r}")
-    sp = system.spectrum
-    omega = sp.omega[sp.active]
-    r = omega * T / (2 * np.pi)
-    m = np.rint(r)
-    bad = np.flatnonzero((m >= 1) & (np.abs(r - m) <= RESONANCE_RTOL * r))
-    if bad.size:
-        j = int(np.flatnonzero(sp.active)[bad[0]])
-        mm = int(m[bad[0]])
-        raise ValueError(
-            f"period T = {T!r} is resonant: ω_{j + 1} T = 2π·{mm} (mode {j + 1}, ω = {sp.omega[j]:.10g}, "
-            f"linear period {2 * np.pi / sp.omega[j]:.10g}); nonsmooth orbits need ω_j T ∉ 2πℤ "
-            f"(relative tolerance {RESONANCE_RTOL:g})"
-        )
-    return T
-
-
-@dataclass(frozen=True)
-class _Modal:
-    """Active-mode data of a system at period ``T``."""
-
-    omega: np.ndarray
-    b: np.ndarray
-    phi: np.ndarray
-    sin_half: np.ndarray  # sin(ω T / 2)
-    T: float
-
-    @classmethod
-    def of(cls, system: LinearSystem, T: float) -> _Modal:
-        omega, b, phi = system.spectrum.contact_modes
-        return cls(omega=omega, b=b, phi=phi, sin_half=np.sin(omega * T / 2), T=T)
-
-    def g_s(self, u) -> tuple[np.ndarray, np.ndarray]:
-        """``g(u) = wᵀG(u)`` and ``s(u) = wᵀG'(u)`` for ``u`` in ``[0, T]`` (any shape)."""
-        ph = np.multiply.outer(np.asarray(u, dtype=float) - self.T / 2, self.omega)
-        c = self.b**2 / (2 * self.sin_half)
-        return np.cos(ph) @ (c / self.omega), -(np.sin(ph) @ c)
-
-    def ds(self, u) -> np.ndarray:
-        """``s'(u) = wᵀG''(u)`` for ``u`` in ``(0, T)``."""
-        ph = np.multiply.outer(np.asarray(u, dtype=float) - self.T / 2, self.omega)
-        return -(np.cos(ph) @ (self.b**2 * self.omega / (2 * self.sin_half)))
+#: Relative tolerance (of ``T`` for times, of ``max|Λ|`` for impulses) of the
+#: repeated-orbit test.
+REPEAT_RTOL = 1e-7
 
 
 @dataclass(frozen=True, eq=False)
@@ -90,7 +52,8 @@ class PeriodicOrbit:
 
     Attributes
     ----------
-    system : LinearSystem
+    system : LinearSystem or None
+        The system it is an orbit of; ``None`` once unpickled (:meth:`bind` re-attaches one).
     T : float
         Period.
     impact_times : (k,) ndarray
@@ -111,9 +74,13 @@ class PeriodicOrbit:
         ``j > 1`` when the orbit is an orbit of period ``T/j`` counted ``j``
         times (its impacts and impulses are invariant under a shift by
         ``T/j``): not a new nonsmooth mode.  ``1`` otherwise.
+    stable : bool or None
+        Floquet stability; ``None`` when not computed.
+    multipliers : ndarray or None
+        Floquet multipliers; ``None`` when not computed.
     """
 
-    system: LinearSystem = field(repr=False)
+    system: LinearSystem | None = field(repr=False)
     T: float
     impact_times: np.ndarray
     impulses: np.ndarray
@@ -122,6 +89,8 @@ class PeriodicOrbit:
     max_violation: float
     max_violation_time: float = field(repr=False)
     repeats: int = 1
+    stable: bool | None = field(default=None, repr=False)
+    multipliers: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def k(self) -> int:
@@ -133,9 +102,42 @@ class PeriodicOrbit:
         """``1 / T``."""
         return 1.0 / self.T
 
+    # -- pickling without the system -------------------------------------------------------------
+
+    def __getstate__(self) -> dict:
+        state = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        state["system"] = None  # the record only: the system's matrices are not shipped
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        for f in dataclasses.fields(self):
+            object.__setattr__(self, f.name, state.get(f.name, f.default))
+
+    def bind(self, system: LinearSystem) -> PeriodicOrbit:
+        """This orbit attached to ``system`` (a copy; the record is unchanged).
+
+        >>> import pickle
+        >>> from bladecase.nsm import chain, orbit_1ipp
+        >>> s = chain(2, k=1.0, m=0.5, gap=1.0)
+        >>> o = pickle.loads(pickle.dumps(orbit_1ipp(s, 4.5)))
+        >>> o.system is None, float(o.bind(s).contact(0.0)[0])
+        (True, 1.0)
+        """
+        if not isinstance(system, LinearSystem):
+            raise ValueError(f"bind needs a LinearSystem, got {type(system).__name__}")
+        return dataclasses.replace(self, system=system)
+
+    def _bound(self) -> LinearSystem:
+        if self.system is None:
+            raise ValueError("this PeriodicOrbit is not bound to a system (it was unpickled or loaded): "
+                             "call orbit.bind(system) first")
+        return self.system
+
     @cached_property
-    def _modal(self) -> _Modal:
-        return _Modal.of(self.system, self.T)
+    def _modal(self) -> ModalKernel:
+        return ModalKernel.of(self._bound(), self.T)
+
+    # -- the motion ------------------------------------------------------------------------------
 
     def modal_state(self, t) -> tuple[np.ndarray, np.ndarray]:
         """Active-mode coordinates ``(q, q̇)``, each of shape ``(m_active, len(t))``."""
@@ -172,10 +174,12 @@ class PeriodicOrbit:
 
     def segment(self, i: int) -> TrigSum:
         """``wᵀx(t_{i-1} + τ) - d`` on flight ``i`` (``t₀ = 0``) as a trigonometric sum in ``τ``."""
-        return _segment_sum(self._modal, self.T, self.impact_times, self.impulses, i, self.system.gap)
+        return _segment_sum(self._modal, self.T, self.impact_times, self.impulses, i, self._bound().gap)
+
+    # -- plain data ------------------------------------------------------------------------------
 
     def to_dict(self) -> dict:
-        """Plain-data summary (JSON-ready)."""
+        """Plain-data record (JSON-ready); :meth:`from_dict` reads it back."""
         return {
             "T": self.T,
             "frequency": self.frequency,
@@ -185,11 +189,27 @@ class PeriodicOrbit:
             "energy": self.energy,
             "admissible": bool(self.admissible),
             "max_violation": self.max_violation,
+            "max_violation_time": self.max_violation_time,
             "repeats": self.repeats,
+            "stable": self.stable,
+            "multipliers": None if self.multipliers is None else [[z.real, z.imag] for z in self.multipliers],
         }
 
+    @classmethod
+    def from_dict(cls, system: LinearSystem | None, data: dict) -> PeriodicOrbit:
+        """The orbit back from :meth:`to_dict` (as stored: not re-solved, not re-certified)."""
+        mult = data.get("multipliers")
+        return cls(
+            system=system, T=float(data["T"]), impact_times=np.asarray(data["impact_times"], dtype=float),
+            impulses=np.asarray(data["impulses"], dtype=float), energy=float(data["energy"]),
+            admissible=bool(data["admissible"]), max_violation=float(data["max_violation"]),
+            max_violation_time=float(data.get("max_violation_time", np.nan)), repeats=int(data.get("repeats", 1)),
+            stable=None if data.get("stable") is None else bool(data["stable"]),
+            multipliers=None if mult is None else np.array([complex(a, b) for a, b in mult]),
+        )
 
-def _segment_sum(md: _Modal, T: float, times: np.ndarray, impulses: np.ndarray, i: int, d: float) -> TrigSum:
+
+def _segment_sum(md: ModalKernel, T: float, times: np.ndarray, impulses: np.ndarray, i: int, d: float) -> TrigSum:
     start = 0.0 if i == 0 else times[i - 1]
     theta = np.mod(start - times, T) - T / 2  # phase of each impulse at the segment start
     ph = np.multiply.outer(md.omega, theta)
@@ -204,7 +224,7 @@ def make_orbit(
     T: float,
     impact_times,
     impulses,
-    _md: _Modal | None = None,
+    _md: ModalKernel | None = None,
     polish: bool = True,
     probe: float | None = None,
     certify: bool = True,
@@ -221,14 +241,9 @@ def make_orbit(
     """
     times = np.asarray(impact_times, dtype=float)
     lam = np.asarray(impulses, dtype=float)
-    md = _md if _md is not None else _Modal.of(system, T)
+    md = _md if _md is not None else ModalKernel.of(system, T)
     d = system.gap
-    # Energy from the post-impact modal state at t = 0.
-    theta = np.mod(-times, T) - T / 2
-    ph = np.multiply.outer(md.omega, theta)
-    scale = md.b / (2 * md.sin_half)
-    q = -(scale / md.omega) * (np.cos(ph) @ lam)
-    qd = scale * (np.sin(ph) @ lam)
+    q, qd = md.start_state(times, lam)  # energy from the post-impact modal state at t = 0
     energy = 0.5 * float(qd @ qd + (md.omega * q) @ (md.omega * q))
     # Admissibility, flight by flight.
     starts = np.concatenate([[0.0], times[:-1]])
@@ -263,15 +278,6 @@ def make_orbit(
     )
 
 
-#: Relative tolerance (of ``T`` for times, of ``max|Λ|`` for impulses) of the
-#: repeated-orbit test.
-REPEAT_RTOL = 1e-7
-
-#: Two impacts closer than ``DISTINCT_RTOL·T`` are one: such a "solution" is
-#: not a k-ipp orbit and is discarded.
-DISTINCT_RTOL = 1e-7
-
-
 def repetitions(times: np.ndarray, impulses: np.ndarray, T: float) -> int:
     """Largest ``j`` dividing ``k`` such that the impact pattern repeats every ``T/j``."""
     k = times.size
@@ -304,281 +310,21 @@ def orbit_1ipp(system: LinearSystem, T: float, **options) -> PeriodicOrbit:
         ``b_j ≠ 0``), or ``g(0) = 0`` (no impulse brings the orbit to the obstacle).
 
     ``options`` are passed to :func:`make_orbit` (``polish``, ``probe``, ``certify``).
+
+    Examples
+    --------
+    >>> from bladecase.nsm import chain
+    >>> o = orbit_1ipp(chain(2, k=1.0, m=0.5, gap=1.0), 4.5)
+    >>> o.k, o.admissible, round(float(o.impulses[0]), 6), round(o.energy, 6)
+    (1, True, 2.486244, 1.833362)
+    >>> x, v = o.state(0.0)       # post-impact state, at the obstacle
+    >>> round(float(x[1, 0]), 12)
+    1.0
     """
     T = check_period(system, T)
-    md = _Modal.of(system, T)
+    md = ModalKernel.of(system, T)
     g0 = float(np.sum(md.b**2 * np.cos(md.omega * T / 2) / (2 * md.omega * md.sin_half)))
     if g0 == 0.0 or not np.isfinite(g0):
         raise ValueError(f"no 1-ipp orbit at T = {T!r}: the impulse response does not reach the obstacle (g(0) = {g0})")
     lam = -system.gap / g0
     return make_orbit(system, T, [T], [lam], md, **options)
-
-
-# ---------------------------------------------------------------------------
-# k impacts per period
-# ---------------------------------------------------------------------------
-
-
-def _check_times(impact_times) -> np.ndarray:
-    times = np.asarray(impact_times, dtype=float).reshape(-1)
-    if times.size == 0 or not np.all(np.isfinite(times)):
-        raise ValueError("impact_times must be a non-empty sequence of finite times")
-    if times[0] <= 0 or np.any(np.diff(times) <= 0):
-        raise ValueError(f"impact_times must satisfy 0 < t1 < ... < tk = T, got {times.tolist()}")
-    return times
-
-
-def _matrices(md: _Modal, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    D = np.mod(times[:, None] - times[None, :], md.T)
-    g, s = md.g_s(D)
-    np.fill_diagonal(s, 0.0)
-    return s, -g
-
-
-def impact_matrices(system: LinearSystem, impact_times) -> tuple[np.ndarray, np.ndarray]:
-    """The paper's matrices ``(Π, Σ)`` for impacts at ``0 < t₁ < … < t_k = T``.
-
-    ``Π_ij = s((t_i - t_j) mod T)`` (``Π_ii = 0``; skew-symmetric) and
-    ``Σ_ij = -g((t_i - t_j) mod T)`` (symmetric), with ``g = wᵀG`` and
-    ``s = wᵀG'`` (theory §3–4).  A ``k``-ipp orbit has impulses ``Λ`` with
-    ``ΠΛ = 0`` (elastic impact law at every impact) and ``ΣΛ = d·1`` (at the
-    obstacle at every impact).
-    """
-    times = _check_times(impact_times)
-    T = check_period(system, times[-1])
-    return _matrices(_Modal.of(system, T), times)
-
-
-def kipp_residual(md: _Modal, times: np.ndarray, impulses: np.ndarray, d: float) -> np.ndarray:
-    """``[ΠΛ ; ΣΛ - d·1]`` (length ``2k``; ``ΛᵀΠΛ ≡ 0`` makes one component redundant)."""
-    Pi, Sigma = _matrices(md, times)
-    return np.concatenate([Pi @ impulses, Sigma @ impulses - d])
-
-
-def _impulses(md: _Modal, times: np.ndarray, d: float) -> np.ndarray | None:
-    """``Λ`` from ``ΣΛ = d·1`` (least squares), or ``None`` if ``Σ`` is singular."""
-    _, Sigma = _matrices(md, times)
-    lam, *_ = np.linalg.lstsq(Sigma, np.full(times.size, d), rcond=1e-12)
-    return lam if np.all(np.isfinite(lam)) else None
-
-
-def newton_times(md: _Modal, times: np.ndarray, lam: np.ndarray, d: float, maxiter: int = 12):
-    """Gauss–Newton on ``[ΠΛ ; ΣΛ - d] = 0`` in ``(t₁…t_{k-1}, Λ)`` at fixed ``T``,
-    with the analytic Jacobian; ``None`` unless it converges to round-off."""
-    k, T = times.size, md.T
-    times, lam = times.astype(float).copy(), lam.astype(float).copy()
-    prev = np.inf
-    for _ in range(maxiter):
-        D = np.mod(times[:, None] - times[None, :], T)
-        g, s = md.g_s(D)
-        np.fill_diagonal(s, 0.0)
-        r = np.concatenate([s @ lam, -g @ lam - d])
-        dsD = md.ds(D)
-        np.fill_diagonal(dsD, 0.0)
-        # d/dt_l of Σ_j X(D_ij) Λ_j, with dD_ij/dt_l = δ_il - δ_jl:
-        #   row i: δ_il Σ_j X'(D_ij)Λ_j - X'(D_il)Λ_l
-        A_pi = np.diag(dsD @ lam) - dsD * lam[None, :]
-        A_sg = -(np.diag(s @ lam) - s * lam[None, :])
-        J = np.block([[A_pi[:, : k - 1], s], [A_sg[:, : k - 1], -g]])
-        step, *_ = np.linalg.lstsq(J, -r, rcond=None)
-        times[: k - 1] += step[: k - 1]
-        lam += step[k - 1:]
-        size = np.abs(step[: k - 1]).max(initial=0.0) / T + np.abs(step[k - 1:]).max() / max(np.abs(lam).max(), d)
-        if not np.all(np.isfinite(step)) or size > 10 * prev:
-            return None
-        if size < 1e-14:
-            break
-        prev = size
-    if times[0] <= DISTINCT_RTOL * T or np.any(np.diff(times) <= DISTINCT_RTOL * T):
-        return None  # impacts merged: not a k-ipp orbit
-    r = kipp_residual(md, times, lam, d)
-    scale = float(md.b @ md.b) / 2 * np.abs(lam).max()
-    if np.abs(r[:k]).max() > 1e-9 * max(scale, d) or np.abs(r[k:]).max() > 1e-9 * d:
-        return None
-    return times, lam
-
-
-def _solve_times(md: _Modal, times0: np.ndarray, d: float) -> tuple[np.ndarray, np.ndarray] | None:
-    """Solve for ``(t₁…t_{k-1}, Λ)`` at fixed ``T`` from impact times ``times0``:
-    Newton with the analytic Jacobian, else Levenberg–Marquardt (wider basin)."""
-    from scipy.optimize import least_squares
-
-    T, k = md.T, times0.size
-    lam0 = _impulses(md, times0, d)
-    if lam0 is None:
-        return None
-    sol = newton_times(md, times0, lam0, d)
-    if sol is not None:
-        return sol
-    lscale = max(np.abs(lam0).max(), d)
-
-    def fun(u):
-        times = np.append(u[: k - 1], T)
-        return kipp_residual(md, times, u[k - 1:] * lscale, d) / d
-
-    res = least_squares(fun, np.concatenate([times0[:-1], lam0 / lscale]), method="lm", xtol=1e-15, ftol=1e-15,
-                        gtol=1e-15, max_nfev=200 * k)
-    times = np.append(res.x[: k - 1], T)
-    lam = res.x[k - 1:] * lscale
-    if not np.all(np.isfinite(res.x)) or np.abs(res.fun).max() > 1e-9:
-        return None
-    if times[0] <= DISTINCT_RTOL * T or np.any(np.diff(times) <= DISTINCT_RTOL * T):
-        return None
-    return times, lam
-
-
-def orbits_kipp(system: LinearSystem, T: float, k: int, resolution: int | None = None) -> list[PeriodicOrbit]:
-    """Every periodic orbit of period ``T`` with ``k`` impacts per period.
-
-    Solves ``Π(t)Λ = 0``, ``Σ(t)Λ = d·1`` for ``0 < t₁ < … < t_k = T``
-    (theory §4).  k = 1: :func:`orbit_1ipp`.  k = 2: the condition is the
-    scalar ``s(t₁) = 0`` (the paper's Eq. 15, ``Pf(Π) = Π₁₂``); all its sign
-    changes on ``(0, T)`` are found with certified root exclusion
-    (:func:`bladecase.nsm.signals.all_roots`), then ``Λ = Σ⁻¹ d·1``.  k >= 3
-    (``Pf(Π) = 0`` and a two-dimensional null space for even k, the null
-    vector of ``Π`` for odd k): Newton on ``(t₁…t_{k-1}, Λ)`` started from
-    every cell of a grid on the ordered times, ``resolution`` points per time
-    (default: 4 per period of the highest contact mode, between 16 and 48),
-    from the equally spaced and repeated lower-order patterns, and
-    Levenberg–Marquardt from the most promising cells; solutions closer than
-    ``1e-7 T`` are merged.  For k >= 3 completeness is up to that resolution.
-    Solutions that differ only by which impact is placed at ``t = 0`` (a time
-    shift) are the same orbit and are returned once
-    (:func:`canonical_rotation`).
-
-    Each solution is a :class:`PeriodicOrbit` with certified admissibility;
-    orbits with a negative impulse are never admissible.  Solutions that are
-    an orbit of period ``T/j`` counted ``j`` times (e.g. k = 2 with
-    ``t₁ = T/2``, a 1-ipp orbit of period ``T/2``) have ``repeats = j``.
-
-    Returns
-    -------
-    list of PeriodicOrbit, sorted by ``t₁``.
-    """
-    if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
-        raise ValueError(f"k (impacts per period) must be an integer >= 1, got {k!r}")
-    if k == 1:
-        return [orbit_1ipp(system, T)]
-    T = check_period(system, T)
-    md = _Modal.of(system, T)
-    d = system.gap
-    solutions: list[tuple[np.ndarray, np.ndarray]] = []
-    if k == 2:
-        for t1 in _k2_roots(md):
-            times = np.array([t1, T])
-            lam = _impulses(md, times, d)
-            if lam is not None:
-                solutions.append((times, lam))
-    else:
-        solutions = _multistart(md, k, d, resolution)
-    unique: list[tuple[np.ndarray, np.ndarray]] = []
-    for times, lam in solutions:
-        times, lam = canonical_rotation(times, lam, T)
-        if not any(np.abs(times - t).max() <= REPEAT_RTOL * T for t, _ in unique):
-            unique.append((times, lam))
-    orbits = [make_orbit(system, T, times, lam, md) for times, lam in unique]
-    return sorted(orbits, key=lambda o: tuple(o.impact_times))
-
-
-def canonical_rotation(times: np.ndarray, impulses: np.ndarray, T: float) -> tuple[np.ndarray, np.ndarray]:
-    """The same orbit re-anchored at the impact that makes ``(t₁, …, t_k)`` smallest
-    lexicographically (times closer than ``REPEAT_RTOL·T`` count as equal, so
-    that round-off cannot pick different representatives of one orbit).
-    Re-anchoring at impact ``r`` (a time shift by ``t_r``) gives the same
-    physical orbit; this picks one representative."""
-    tol = REPEAT_RTOL * T
-    best = None
-    for r in range(times.size):
-        shifted = np.mod(times - times[r], T)
-        shifted[(shifted <= tol) | (shifted >= T - tol)] = T
-        order = np.argsort(shifted)
-        cand = (shifted[order], impulses[order])
-        if best is None:
-            best = cand
-            continue
-        diff = cand[0] - best[0]
-        first = np.flatnonzero(np.abs(diff) > tol)
-        if first.size and diff[first[0]] < 0:
-            best = cand
-    best[0][-1] = T
-    return best
-
-
-def _multistart(md: _Modal, k: int, d: float, resolution: int | None) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Solutions for k >= 3: Levenberg–Marquardt from the equally spaced
-    pattern, from every repeated lower-order solution (period ``T/j``,
-    ``j | k``) and from the grid cells of ordered impact times whose screening
-    residual is a local minimum (non-strict) or among the lowest 5 %; Newton
-    from every grid cell."""
-    from itertools import combinations
-
-    T = md.T
-    if resolution is None:
-        resolution = int(np.clip(np.ceil(4 * T * md.omega.max() / (2 * np.pi)), 16, 48))
-    grid = T * (np.arange(1, resolution) / resolution)
-    idx = np.array(list(combinations(range(grid.size), k - 1)))
-    starts = np.column_stack([grid[idx], np.full(len(idx), T)])
-    # Screening residual: ||Π n|| / ||n|| with n = Σ⁻¹1 (scale-free).
-    S = float(md.b @ md.b) / 2
-    score = np.full(len(starts), np.inf)
-    for i, times in enumerate(starts):
-        Pi, Sigma = _matrices(md, times)
-        try:
-            n = np.linalg.solve(Sigma, np.ones(k))
-        except np.linalg.LinAlgError:
-            continue
-        score[i] = np.linalg.norm(Pi @ n) / (np.linalg.norm(n) * S)
-    pos = {tuple(row): i for i, row in enumerate(idx)}
-    finite = np.isfinite(score)
-    low = set(np.flatnonzero(finite & (score <= np.quantile(score[finite], 0.05)))) if finite.any() else set()
-    candidates = []
-    for i, row in enumerate(idx):
-        if not finite[i]:
-            continue
-        best = i in low
-        if not best:
-            best = True
-            for delta in np.ndindex(*(3,) * (k - 1)):
-                j = pos.get(tuple(row + np.array(delta) - 1))
-                if j is not None and j != i and score[j] < score[i]:
-                    best = False
-                    break
-        if best:
-            candidates.append(starts[i])
-    # Patterns that always solve or nearly solve: equally spaced impacts, and
-    # repetitions of the solutions with k/j impacts at period T/j.
-    seeds = [T * np.arange(1, k + 1) / k]
-    for j in range(2, k):
-        if k % j == 0:
-            sub = _Modal(omega=md.omega, b=md.b, phi=md.phi, sin_half=np.sin(md.omega * T / (2 * j)), T=T / j)
-            base = [np.array([T / j])] if k // j == 1 else (
-                [t for t, _ in _multistart(sub, k // j, d, resolution)] if k // j >= 3 else
-                [np.array([t1, T / j]) for t1 in _k2_roots(sub)])
-            for t in base:
-                seeds.append(np.concatenate([t + m * T / j for m in range(j)]))
-    found: list[tuple[np.ndarray, np.ndarray]] = []
-
-    def keep(sol):
-        if sol is not None and not any(np.abs(sol[0] - t).max() <= REPEAT_RTOL * T for t, _ in found):
-            found.append(sol)
-
-    # Newton (analytic Jacobian, cheap) from every cell: the screening score is
-    # a poor guide to Newton's basins; Levenberg–Marquardt (wider basin,
-    # costlier) from the seeds and the promising cells.
-    for times0 in seeds + candidates:
-        keep(_solve_times(md, np.asarray(times0, dtype=float), d))
-    for times0 in starts:
-        lam0 = _impulses(md, times0, d)
-        if lam0 is not None:
-            keep(newton_times(md, times0, lam0, d))
-    return found
-
-
-def _k2_roots(md: _Modal) -> np.ndarray:
-    """Every ``t₁`` in ``(0, T)`` with ``s(t₁) = 0`` (the k = 2 condition)."""
-    from .signals import all_roots
-
-    T = md.T
-    c = md.b**2 / 2
-    s_sum = TrigSum(alpha=c, beta=-c * np.cos(md.omega * T / 2) / md.sin_half, omega=md.omega)
-    return np.array([t for t in all_roots(s_sum, 0.0, T) if 0 < t < T])

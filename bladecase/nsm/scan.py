@@ -1,127 +1,26 @@
-"""Backbones: orbits over a range of periods and their admissible intervals.
+"""Backbones: 1-ipp orbits over a scan of periods and their admissible intervals.
 
-:func:`backbone` evaluates the k-ipp orbit at every period of a scan, keeps
+:func:`backbone` evaluates the 1-ipp orbit at every period of a scan, keeps
 the frequency–energy data, and refines the maximal admissible intervals of
-``T`` by bisection on the admissibility predicate.
+``T`` by bisection on the admissibility predicate.  The result is a
+:class:`~bladecase.nsm.branches.Branch` with ``source = "scan"``.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..progress import progress_bar
+from .branches import Arc, Backbone, Branch, Interval
 from .orbits import PeriodicOrbit, orbit_1ipp
 from .system import LinearSystem
 
+__all__ = ["BISECTION_RTOL", "Backbone", "Interval", "backbone"]  # Backbone, Interval: former names
+
 #: Relative precision in ``T`` of the refined ends of admissible intervals.
 BISECTION_RTOL = 1e-9
-
-
-@dataclass(frozen=True)
-class Interval:
-    """A maximal admissible interval ``[T_lo, T_hi]`` of the period.
-
-    ``refined_lo``/``refined_hi`` tell whether the end was refined by
-    bisection (False when the interval reaches the end of the scan, where
-    admissibility beyond the scan is unknown).
-    """
-
-    T_lo: float
-    T_hi: float
-    refined_lo: bool
-    refined_hi: bool
-
-    def to_dict(self) -> dict:
-        return {"T_lo": self.T_lo, "T_hi": self.T_hi, "refined_lo": self.refined_lo, "refined_hi": self.refined_hi}
-
-
-@dataclass(frozen=True, eq=False)
-class Backbone:
-    """Orbits of one family type (``ipp`` impacts per period) over a period scan.
-
-    Attributes
-    ----------
-    periods : (N,) ndarray
-        Scanned periods.
-    orbits : list of PeriodicOrbit or None
-        ``None`` where the period is resonant (or no orbit exists).
-    intervals : list of Interval
-        Maximal admissible intervals, ends refined to ``BISECTION_RTOL``.
-    linear_frequencies : (m,) ndarray
-        ``ω_j / 2π`` of the modes that see the contact.
-    """
-
-    system: LinearSystem = field(repr=False)
-    ipp: int
-    periods: np.ndarray
-    orbits: list = field(repr=False)
-    intervals: list
-    linear_frequencies: np.ndarray = field(repr=False)
-
-    def _column(self, get, default=np.nan) -> np.ndarray:
-        return np.array([default if o is None else get(o) for o in self.orbits])
-
-    @property
-    def frequencies(self) -> np.ndarray:
-        """``1 / T`` for every scanned period."""
-        return 1.0 / self.periods
-
-    @property
-    def energy(self) -> np.ndarray:
-        return self._column(lambda o: o.energy)
-
-    @property
-    def admissible(self) -> np.ndarray:
-        return self._column(lambda o: o.admissible, False).astype(bool)
-
-    @property
-    def max_violation(self) -> np.ndarray:
-        return self._column(lambda o: o.max_violation)
-
-    @property
-    def impulses(self) -> np.ndarray:
-        """``(N, ipp)`` impulses (NaN rows where no orbit)."""
-        return np.array([np.full(self.ipp, np.nan) if o is None else o.impulses for o in self.orbits])
-
-    def table(self) -> str:
-        """Human-readable table of the scan followed by the admissible intervals."""
-        lines = [f"{'T':>14} {'1/T':>12} {'energy':>12} {'impulses':>24} admissible"]
-        for T, o in zip(self.periods, self.orbits):
-            if o is None:
-                lines.append(f"{T:14.8g} {1 / T:12.6g} {'resonant':>12}")
-                continue
-            imp = " ".join(f"{x:.5g}" for x in o.impulses)
-            lines.append(f"{T:14.8g} {1 / T:12.6g} {o.energy:12.6g} {imp:>24} {'yes' if o.admissible else 'no'}")
-        lines.append("")
-        if self.intervals:
-            lines.append(f"admissible intervals of T ({self.ipp} impact(s) per period):")
-            for iv in self.intervals:
-                lines.append(f"  [{iv.T_lo:.12g}, {iv.T_hi:.12g}]   1/T in [{1 / iv.T_hi:.8g}, {1 / iv.T_lo:.8g}]")
-        else:
-            lines.append(f"no admissible {self.ipp}-ipp orbit in the scanned range")
-        return "\n".join(lines)
-
-    def to_dict(self) -> dict:
-        """Plain data (JSON-ready): system summary, scan, intervals."""
-        return {
-            "ipp": self.ipp,
-            "system": {"n": self.system.n, "gap": self.system.gap},
-            "linear_frequencies": self.linear_frequencies.tolist(),
-            "linear_periods": (1.0 / self.linear_frequencies).tolist(),
-            "orbits": [
-                {"T": float(T), "frequency": float(1 / T), "resonant": True} if o is None else o.to_dict()
-                for T, o in zip(self.periods, self.orbits)
-            ],
-            "intervals": [iv.to_dict() for iv in self.intervals],
-        }
-
-    def plot(self, ax=None, **kwargs):
-        """Frequency–energy plot (see :func:`bladecase.post.plots.frequency_energy`)."""
-        from ..post.plots import frequency_energy
-
-        return frequency_energy([self], ax=ax, **kwargs)
 
 
 def _solver(ipp: int) -> Callable[[LinearSystem, float], PeriodicOrbit]:
@@ -193,7 +92,7 @@ def backbone(
     periods: Sequence[float] | np.ndarray,
     ipp: int = 1,
     progress: bool = False,
-) -> Backbone:
+) -> Branch:
     """Orbits with ``ipp`` impacts per period at each of ``periods``.
 
     Parameters
@@ -205,13 +104,15 @@ def backbone(
     ipp : int
         Impacts per period.
     progress : bool
-        Show a progress bar (tqdm) on standard error.
+        Show a progress bar on standard error (:func:`bladecase.progress.progress_bar`).
 
     Returns
     -------
-    Backbone
-        Orbits, frequency–energy data and the maximal admissible intervals of
-        ``T``, whose ends are refined by bisection to ``BISECTION_RTOL``.
+    Branch
+        ``source = "scan"``: one orbit per period (``None`` where resonant),
+        frequency–energy data and the maximal admissible intervals of ``T``
+        (:attr:`~Branch.arcs`, also :attr:`~Branch.intervals`), whose ends are
+        refined by bisection to ``BISECTION_RTOL``.
         An interval never contains a resonant period ``2πm/ω_j`` of a mode
         that sees the contact (the impulse changes sign there): two
         admissible scan points with a resonance between them give two
@@ -219,6 +120,13 @@ def backbone(
         to a resonance converges to the excluded resonant period).
         Admissible stretches between two resonances that fall between the
         same two scan points are not found: scan finer.
+
+    Examples
+    --------
+    >>> from bladecase.nsm import chain
+    >>> bb = backbone(chain(2, k=1.0, m=0.5, gap=1.0), np.linspace(1.0, 12.0, 111))
+    >>> [(round(iv.T_lo, 6), round(iv.T_hi, 6)) for iv in bb.intervals]
+    [(2.504874, 2.745853), (3.745895, 5.491705), (5.650149, 7.188736)]
     """
     solve = _solver(ipp)
     P = np.asarray(periods, dtype=float).reshape(-1)
@@ -227,12 +135,7 @@ def backbone(
     if not np.all(np.isfinite(P)) or np.any(P <= 0):
         raise ValueError(f"periods must be finite and > 0, got e.g. {P[~(np.isfinite(P) & (P > 0))][0]!r}")
     P = np.unique(P)
-    it = P
-    if progress:
-        from tqdm.auto import tqdm
-
-        it = tqdm(P, desc=f"{ipp}-ipp orbits", unit="T", leave=False)
-    orbits = [_try(solve, system, T) for T in it]
+    orbits = [_try(solve, system, T) for T in progress_bar(P, f"{ipp}-ipp orbits", enabled=progress, unit="T")]
     adm = np.array([o is not None and o.admissible for o in orbits])
     omega = system.spectrum.contact_modes[0]
     # Nearest resonances 2πm/ω_j strictly inside each gap between scan points:
@@ -257,11 +160,7 @@ def backbone(
             out = first_res[j]
             hi = _bisect(solve, system, P[j], P[j + 1] if out is None else out,
                          _phase(orbits[j + 1]) if out is None else None)
-        intervals.append(Interval(float(P[i] if lo is None else lo), float(P[j] if hi is None else hi),
-                                  lo is not None, hi is not None))
+        intervals.append(Arc(i, j, float(P[i] if lo is None else lo), float(P[j] if hi is None else hi),
+                             lo is not None, hi is not None))
         i = j + 1
-    sp = system.spectrum
-    return Backbone(
-        system=system, ipp=ipp, periods=P, orbits=orbits, intervals=intervals,
-        linear_frequencies=sp.frequencies[sp.active],
-    )
+    return Branch(system=system, k=ipp, orbits=orbits, arcs=intervals, periods=P)

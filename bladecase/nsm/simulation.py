@@ -1,13 +1,13 @@
 """Event-driven simulation: the independent truth for every periodic orbit.
 
-Free flight is integrated exactly in modal coordinates (each mode is a
-rotation in its phase plane).  The next impact is the FIRST root of
-``wᵀx(t) - d`` after the current time, found by
-:func:`bladecase.nsm.signals.first_upcrossing`, which proves every skipped
-interval free of contact (no grazing contact missed) and refines the root to
-machine precision.  The impact law is Moreau's (theory §1), valid for any SPD
-``M``: ``v⁺ = v⁻ - (1+e) M⁻¹w (wᵀv⁻)/(wᵀM⁻¹w)``; in modal coordinates
-``q̇⁺ = q̇⁻ - (1+e) b (bᵀq̇⁻)/(bᵀb)``.
+The loop (:func:`integrate`) takes two swappable pieces (:mod:`bladecase.nsm.flight`): a flight propagator
+(today the exact undamped modal flight, :class:`~bladecase.nsm.flight.ModalFlight`) and an impact law (today
+Moreau's form of Newton's law, :class:`~bladecase.nsm.flight.NewtonImpact`).  The next impact is the FIRST
+root of the propagator's contact signal ``wᵀx(t) - d`` after the current time, found by
+:func:`bladecase.nsm.signals.first_upcrossing`, which proves every skipped interval free of contact (no grazing
+contact missed) from the signal's certified curvature bound, and refines the root to machine precision.
+:func:`simulate` is the usual entry point: modal flight and Newton's law with restitution ``e``, for any SPD
+``M`` (theory §1): ``v⁺ = v⁻ - (1+e) M⁻¹w (wᵀv⁻)/(wᵀM⁻¹w)``.
 """
 
 from __future__ import annotations
@@ -17,12 +17,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .signals import TrigSum, first_upcrossing
+from .flight import CONTACT_RTOL, FlightPropagator, ImpactLaw, ModalFlight, NewtonImpact
+from .signals import first_upcrossing
 from .system import LinearSystem
 
-#: Relative tolerance (of ``gap``) within which a state counts as "at the obstacle"
-#: (raised to the round-off of ``wᵀx`` for large amplitudes).
-CONTACT_RTOL = 1e-12
+__all__ = ["CONTACT_RTOL", "Trajectory", "integrate", "simulate"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -44,6 +43,8 @@ class Trajectory:
     complete : bool
         False when the run stopped early (``max_impacts`` reached, or an
         accumulation of impacts — chattering — with ``restitution < 1``).
+    flight : FlightPropagator
+        The propagator of the run (its coordinates are those of the stored states).
     """
 
     system: LinearSystem = field(repr=False)
@@ -55,6 +56,7 @@ class Trajectory:
     x_end: np.ndarray = field(repr=False)
     v_end: np.ndarray = field(repr=False)
     complete: bool
+    flight: FlightPropagator = field(repr=False)
     _t0: float = field(repr=False)
     _q0: np.ndarray = field(repr=False)
     _p0: np.ndarray = field(repr=False)
@@ -67,40 +69,105 @@ class Trajectory:
         Post-impact values at impact instants.
         """
         t = np.atleast_1d(np.asarray(t, dtype=float))
-        sp = self.system.spectrum
         starts = np.concatenate([[self._t0], self.impact_times])
         q0 = np.column_stack([self._q0, self._q]) if self._q.size else self._q0[:, None]
         p0 = np.column_stack([self._p0, self._p]) if self._p.size else self._p0[:, None]
         idx = np.searchsorted(starts, t, side="right") - 1
         if np.any(idx < 0) or np.any(t > self.t_end * (1 + 1e-14) + 1e-300):
             raise ValueError(f"times must lie in [{self._t0}, {self.t_end}]")
-        tau = t - starts[idx]
-        ph = sp.omega[:, None] * tau[None, :]
-        c, s = np.cos(ph), np.sin(ph)
-        q = q0[:, idx] * c + p0[:, idx] / sp.omega[:, None] * s
-        p = -q0[:, idx] * sp.omega[:, None] * s + p0[:, idx] * c
-        return sp.phi @ q, sp.phi @ p
+        q, p = self.flight.advance(q0[:, idx], p0[:, idx], t - starts[idx], starts[idx])
+        return self.flight.decode(q, p)
 
     def energy(self) -> np.ndarray:
         """Energy after each impact (``½vᵀMv + ½xᵀKx``), shape ``(k,)``."""
-        om = self.system.spectrum.omega[:, None]
-        return 0.5 * np.sum(self._p**2 + (om * self._q) ** 2, axis=0)
+        return self.flight.energy(self._q, self._p)
 
 
-def _contact_tol(b: np.ndarray, q: np.ndarray, d: float) -> float:
-    """Distance to the obstacle below which a state counts as at the obstacle:
-    ``CONTACT_RTOL·d``, or the round-off of ``wᵀx = bᵀq`` when larger."""
-    return max(CONTACT_RTOL * d, 64 * np.finfo(float).eps * float(np.abs(b) @ np.abs(q)))
+def _check_state(n: int, x0, v0) -> tuple[np.ndarray, np.ndarray]:
+    x0 = np.asarray(x0, dtype=float).reshape(-1)
+    v0 = np.asarray(v0, dtype=float).reshape(-1)
+    for name, a in (("x0", x0), ("v0", v0)):
+        if a.shape != (n,):
+            raise ValueError(f"{name} has {a.size} entries, expected {n}")
+        if not np.all(np.isfinite(a)):
+            raise ValueError(f"{name} contains non-finite values")
+    return x0, v0
 
 
-def _modal(system: LinearSystem, x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    phi = system.spectrum.phi
-    return phi.T @ (system.M @ x), phi.T @ (system.M @ v)
+def _next_impact(flight: FlightPropagator, q, p, t: float, t_end: float) -> float | None:
+    """Flight time to the next contact (``0``: impact now), or ``None`` if there is none before ``t_end``."""
+    f = flight.contact_signal(q, p, t)
+    f0 = flight.gap_value(q)
+    vn = flight.normal_velocity(q, p)
+    if f0 < -flight.contact_tol(q):
+        return first_upcrossing(f, 0.0, t_end - t)
+    if vn > 0:
+        return 0.0  # at the obstacle and moving into it: impact now
+    # Leaving the obstacle: f(τ) <= f0 + vn τ + B₂τ²/2 < 0 just after.
+    B2 = f.curvature_bound
+    start = min(f.step, abs(vn) / B2) if B2 > 0 else f.step
+    if vn == 0.0 or float(f(start)[0]) >= 0:
+        start = min(f.step, 1e-9 / float(f.omega.max()))
+        if float(f(start)[0]) >= 0:
+            raise RuntimeError(f"grazing contact at t = {t!r} with zero normal velocity: the "
+                               "motion would slide along the obstacle (not an impact motion)")
+    return first_upcrossing(f, start, t_end - t) if start < t_end - t else None
 
 
-def _flight(omega, q, p, tau):
-    c, s = np.cos(omega * tau), np.sin(omega * tau)
-    return q * c + p / omega * s, -q * omega * s + p * c
+def integrate(flight: FlightPropagator, impact: ImpactLaw, x0, v0, t_end: float,
+              max_impacts: int = 1_000_000, _stacklevel: int = 2) -> Trajectory:
+    """The event loop: fly with ``flight`` to the first contact, apply ``impact``, repeat until ``t_end``.
+
+    ``(x0, v0)`` at ``t = 0`` must satisfy ``wᵀx0 <= d`` (up to the propagator's contact tolerance).
+    Stops early (``complete = False``, with a ``RuntimeWarning``) after ``max_impacts`` impacts or when
+    impacts accumulate (more than 50 flights shorter than ``1e-12`` of the time in a row).
+    """
+    system = flight.system
+    x0, v0 = _check_state(system.n, x0, v0)
+    t_end = float(t_end)
+    if not np.isfinite(t_end) or t_end <= 0:
+        raise ValueError(f"t_end must be finite and > 0, got {t_end!r}")
+    d = system.gap
+    q0, p0 = flight.encode(x0, v0)
+    tol0 = flight.contact_tol(q0)
+    if system.w @ x0 - d > tol0:
+        raise ValueError(f"initial state violates the constraint: wᵀx0 - d = {system.w @ x0 - d:.6g} > 0 "
+                         f"(tolerance {tol0:.3g})")
+    q, p = q0, p0
+    times, lams, qs, ps = [], [], [], []
+    t = 0.0
+    complete = True
+    tiny_flights = 0
+    while True:
+        tau = _next_impact(flight, q, p, t, t_end)
+        if tau is None:
+            q, p = flight.advance(q, p, t_end - t, t)
+            t = t_end
+            break
+        q, p = flight.advance(q, p, tau, t)
+        t += tau
+        if flight.normal_velocity(q, p) <= 0:
+            continue  # grazing touch: no impulse
+        p, lam = impact.apply(flight, q, p)
+        times.append(t)
+        lams.append(lam)
+        qs.append(q.copy())
+        ps.append(p.copy())
+        tiny_flights = tiny_flights + 1 if tau < 1e-12 * max(t, 1.0) else 0
+        if len(times) >= max_impacts or tiny_flights > 50:
+            complete = False
+            why = "max_impacts reached" if len(times) >= max_impacts else "impacts accumulate (chattering)"
+            warnings.warn(f"simulate stopped at t = {t:.6g} after {len(times)} impacts: {why}", RuntimeWarning,
+                          stacklevel=_stacklevel)
+            break
+    m = q0.size
+    Q = np.array(qs).T if qs else np.zeros((m, 0))
+    P = np.array(ps).T if ps else np.zeros((m, 0))
+    X, V = flight.decode(Q, P)
+    x_end, v_end = flight.decode(q, p)
+    return Trajectory(system=system, impact_times=np.array(times), impulses=np.array(lams), x=X, v=V, t_end=t,
+                      x_end=x_end, v_end=v_end, complete=complete, flight=flight, _t0=0.0, _q0=q0, _p0=p0,
+                      _q=Q, _p=P)
 
 
 def simulate(
@@ -112,6 +179,9 @@ def simulate(
     max_impacts: int = 1_000_000,
 ) -> Trajectory:
     """Integrate the impacting system from ``(x0, v0)`` at ``t = 0`` to ``t_end``.
+
+    Exact undamped modal flight (:class:`~bladecase.nsm.flight.ModalFlight`) and Newton's impact law in
+    Moreau's form (:class:`~bladecase.nsm.flight.NewtonImpact`); :func:`integrate` takes other pieces.
 
     Parameters
     ----------
@@ -130,96 +200,23 @@ def simulate(
     -------
     Trajectory
         Impact times, impulses, post-impact states, final state.
+
+    Examples
+    --------
+    A 1-ipp orbit, started from its post-impact state, comes back after one period:
+
+    >>> from bladecase.nsm import chain, orbit_1ipp
+    >>> s = chain(2, k=1.0, m=0.5, gap=1.0)
+    >>> o = orbit_1ipp(s, 4.5)
+    >>> x0, v0 = o.state(0.0)
+    >>> tr = simulate(s, x0[:, 0], v0[:, 0], 1.5 * o.T)
+    >>> tr.impact_times.round(9).tolist(), bool(np.allclose(tr.x[:, 0], x0[:, 0], atol=1e-9))
+    ([4.5], True)
     """
     n = system.n
-    x0 = np.asarray(x0, dtype=float).reshape(-1)
-    v0 = np.asarray(v0, dtype=float).reshape(-1)
-    for name, a in (("x0", x0), ("v0", v0)):
-        if a.shape != (n,):
-            raise ValueError(f"{name} has {a.size} entries, expected {n}")
-        if not np.all(np.isfinite(a)):
-            raise ValueError(f"{name} contains non-finite values")
+    x0, v0 = _check_state(n, x0, v0)
     t_end = float(t_end)
     if not np.isfinite(t_end) or t_end <= 0:
         raise ValueError(f"t_end must be finite and > 0, got {t_end!r}")
-    e = float(restitution)
-    if not 0 < e <= 1:
-        raise ValueError(f"restitution must be in (0, 1], got {restitution!r}")
-    d = system.gap
-    w = system.w
-    sp = system.spectrum
-    tol0 = _contact_tol(sp.b, _modal(system, x0, v0)[0], d)
-    if w @ x0 - d > tol0:
-        raise ValueError(f"initial state violates the constraint: wᵀx0 - d = {w @ x0 - d:.6g} > 0 "
-                         f"(tolerance {tol0:.3g})")
-
-    sp = system.spectrum
-    omega, b = sp.omega, sp.b
-    bb = float(b @ b)
-    q, p = _modal(system, x0, v0)
-    times, lams, qs, ps = [], [], [], []
-    t = 0.0
-    complete = True
-    tiny_flights = 0
-    while True:
-        f = TrigSum(alpha=b * q, beta=b * p / omega, omega=omega, const=-d)
-        f0 = float(b @ q) - d
-        vn = float(b @ p)
-        start = 0.0
-        if f0 >= -_contact_tol(b, q, d):
-            if vn > 0:
-                tau = 0.0  # at the obstacle and moving into it: impact now
-            else:
-                # Leaving the obstacle: f(τ) <= f0 + vn τ + B₂τ²/2 < 0 just after.
-                B2 = f.curvature_bound
-                start = min(f.step, abs(vn) / B2) if B2 > 0 else f.step
-                if vn == 0.0 or float(f(start)[0]) >= 0:
-                    start = min(f.step, 1e-9 / float(omega.max()))
-                    if float(f(start)[0]) >= 0:
-                        raise RuntimeError(f"grazing contact at t = {t!r} with zero normal velocity: the "
-                                           "motion would slide along the obstacle (not an impact motion)")
-                tau = first_upcrossing(f, start, t_end - t) if start < t_end - t else None
-        else:
-            tau = first_upcrossing(f, 0.0, t_end - t)
-        if tau is None:
-            q, p = _flight(omega, q, p, t_end - t)
-            t = t_end
-            break
-        q, p = _flight(omega, q, p, tau)
-        t += tau
-        vn = float(b @ p)
-        if vn <= 0:
-            continue  # grazing touch: no impulse
-        lam_modal = (1 + e) * vn / bb
-        p = p - lam_modal * b
-        times.append(t)
-        lams.append(lam_modal)
-        qs.append(q.copy())
-        ps.append(p.copy())
-        tiny_flights = tiny_flights + 1 if tau < 1e-12 * max(t, 1.0) else 0
-        if len(times) >= max_impacts or tiny_flights > 50:
-            complete = False
-            why = "max_impacts reached" if len(times) >= max_impacts else "impacts accumulate (chattering)"
-            warnings.warn(f"simulate stopped at t = {t:.6g} after {len(times)} impacts: {why}", RuntimeWarning,
-                          stacklevel=2)
-            break
-    phi = sp.phi
-    Q = np.array(qs).T if qs else np.zeros((n, 0))
-    P = np.array(ps).T if ps else np.zeros((n, 0))
-    q0, p0 = _modal(system, x0, v0)
-    return Trajectory(
-        system=system,
-        impact_times=np.array(times),
-        impulses=np.array(lams),
-        x=phi @ Q,
-        v=phi @ P,
-        t_end=t,
-        x_end=phi @ q,
-        v_end=phi @ p,
-        complete=complete,
-        _t0=0.0,
-        _q0=q0,
-        _p0=p0,
-        _q=Q,
-        _p=P,
-    )
+    law = NewtonImpact(restitution)
+    return integrate(ModalFlight(system), law, x0, v0, t_end, max_impacts, _stacklevel=3)

@@ -1,0 +1,207 @@
+"""Every periodic orbit with k impacts per period at one period ``T`` (theory §4).
+
+The orbits solve ``Π(t)Λ = 0``, ``Σ(t)Λ = d·1`` for ``0 < t₁ < … < t_k = T`` (:mod:`bladecase.nsm.modal`).
+k = 2 reduces to the scalar ``s(t₁) = 0`` (the paper's Eq. 15), whose sign changes are all found with certified
+root exclusion; k >= 3 is a multistart (Newton from every cell of a grid of ordered impact times,
+Levenberg–Marquardt from the most promising cells and from repeated lower-order patterns).
+"""
+
+from __future__ import annotations
+
+from itertools import combinations
+
+import numpy as np
+
+from .modal import ModalKernel, check_period, impulses_for, newton_times, solve_times
+from .orbits import REPEAT_RTOL, PeriodicOrbit, make_orbit, orbit_1ipp
+from .signals import TrigSum, all_roots
+from .system import LinearSystem
+
+__all__ = ["canonical_rotation", "check_k", "orbits_kipp"]
+
+
+def check_k(k) -> int:
+    """``k`` as an int; raise ``ValueError`` unless it is an integer >= 1 (numpy integers accepted, not bools)."""
+    if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
+        raise ValueError(f"k (impacts per period) must be an integer >= 1, got {k!r}")
+    return int(k)
+
+
+def orbits_kipp(system: LinearSystem, T: float, k: int, resolution: int | None = None) -> list[PeriodicOrbit]:
+    """Every periodic orbit of period ``T`` with ``k`` impacts per period.
+
+    Solves ``Π(t)Λ = 0``, ``Σ(t)Λ = d·1`` for ``0 < t₁ < … < t_k = T``
+    (theory §4).  k = 1: :func:`orbit_1ipp`.  k = 2: the condition is the
+    scalar ``s(t₁) = 0`` (the paper's Eq. 15, ``Pf(Π) = Π₁₂``); all its sign
+    changes on ``(0, T)`` are found with certified root exclusion
+    (:func:`bladecase.nsm.signals.all_roots`), then ``Λ = Σ⁻¹ d·1``.  k >= 3
+    (``Pf(Π) = 0`` and a two-dimensional null space for even k, the null
+    vector of ``Π`` for odd k): Newton on ``(t₁…t_{k-1}, Λ)`` started from
+    every cell of a grid on the ordered times, ``resolution`` points per time
+    (default: 4 per period of the highest contact mode, between 16 and 48),
+    from the equally spaced and repeated lower-order patterns, and
+    Levenberg–Marquardt from the most promising cells; solutions closer than
+    ``1e-7 T`` are merged.  For k >= 3 completeness is up to that resolution.
+    Solutions that differ only by which impact is placed at ``t = 0`` (a time
+    shift) are the same orbit and are returned once
+    (:func:`canonical_rotation`).
+
+    Each solution is a :class:`PeriodicOrbit` with certified admissibility;
+    orbits with a negative impulse are never admissible.  Solutions that are
+    an orbit of period ``T/j`` counted ``j`` times (e.g. k = 2 with
+    ``t₁ = T/2``, a 1-ipp orbit of period ``T/2``) have ``repeats = j``.
+
+    Returns
+    -------
+    list of PeriodicOrbit, sorted by ``t₁``.
+
+    Examples
+    --------
+    >>> from bladecase.nsm import chain
+    >>> orbits = orbits_kipp(chain(2, k=1.0, m=0.5, gap=1.0), 13.5, 2)
+    >>> [(round(float(o.impact_times[0]), 4), o.repeats, o.admissible) for o in orbits]
+    [(3.6382, 1, False), (6.0829, 1, True), (6.75, 2, True)]
+    """
+    k = check_k(k)
+    if k == 1:
+        return [orbit_1ipp(system, T)]
+    T = check_period(system, T)
+    md = ModalKernel.of(system, T)
+    d = system.gap
+    solutions: list[tuple[np.ndarray, np.ndarray]] = []
+    if k == 2:
+        for t1 in _k2_roots(md):
+            times = np.array([t1, T])
+            lam = impulses_for(md, times, d)
+            if lam is not None:
+                solutions.append((times, lam))
+    else:
+        solutions = _multistart(md, k, d, resolution)
+    unique: list[tuple[np.ndarray, np.ndarray]] = []
+    for times, lam in solutions:
+        times, lam = canonical_rotation(times, lam, T)
+        if not any(np.abs(times - t).max() <= REPEAT_RTOL * T for t, _ in unique):
+            unique.append((times, lam))
+    orbits = [make_orbit(system, T, times, lam, md) for times, lam in unique]
+    return sorted(orbits, key=lambda o: tuple(o.impact_times))
+
+
+def canonical_rotation(times: np.ndarray, impulses: np.ndarray, T: float) -> tuple[np.ndarray, np.ndarray]:
+    """The same orbit re-anchored at the impact that makes ``(t₁, …, t_k)`` smallest
+    lexicographically (times closer than ``REPEAT_RTOL·T`` count as equal, so
+    that round-off cannot pick different representatives of one orbit).
+    Re-anchoring at impact ``r`` (a time shift by ``t_r``) gives the same
+    physical orbit; this picks one representative.
+
+    >>> t, lam = canonical_rotation(np.array([6.0, 10.0]), np.array([2.0, 1.0]), 10.0)
+    >>> t.tolist(), lam.tolist()         # the same orbit, re-anchored at its first impact
+    ([4.0, 10.0], [1.0, 2.0])
+    """
+    tol = REPEAT_RTOL * T
+    best = None
+    for r in range(times.size):
+        shifted = np.mod(times - times[r], T)
+        shifted[(shifted <= tol) | (shifted >= T - tol)] = T
+        order = np.argsort(shifted)
+        cand = (shifted[order], impulses[order])
+        if best is None:
+            best = cand
+            continue
+        diff = cand[0] - best[0]
+        first = np.flatnonzero(np.abs(diff) > tol)
+        if first.size and diff[first[0]] < 0:
+            best = cand
+    best[0][-1] = T
+    return best
+
+
+def _screening(md: ModalKernel, starts: np.ndarray, k: int) -> np.ndarray:
+    """Scale-free residual ``||Π n|| / (||n|| S)`` with ``n = Σ⁻¹1`` at each start (``inf`` if ``Σ`` is singular)."""
+    S = float(md.b @ md.b) / 2
+    score = np.full(len(starts), np.inf)
+    for i, times in enumerate(starts):
+        Pi, Sigma = md.matrices(times)
+        try:
+            n = np.linalg.solve(Sigma, np.ones(k))
+        except np.linalg.LinAlgError:
+            continue
+        score[i] = np.linalg.norm(Pi @ n) / (np.linalg.norm(n) * S)
+    return score
+
+
+def _promising(idx: np.ndarray, score: np.ndarray, k: int) -> list[int]:
+    """Grid cells whose score is a (non-strict) local minimum or among the lowest 5 %."""
+    pos = {tuple(row): i for i, row in enumerate(idx)}
+    finite = np.isfinite(score)
+    low = set(np.flatnonzero(finite & (score <= np.quantile(score[finite], 0.05)))) if finite.any() else set()
+    out = []
+    for i, row in enumerate(idx):
+        if not finite[i]:
+            continue
+        best = i in low
+        if not best:
+            best = True
+            for delta in np.ndindex(*(3,) * (k - 1)):
+                j = pos.get(tuple(row + np.array(delta) - 1))
+                if j is not None and j != i and score[j] < score[i]:
+                    best = False
+                    break
+        if best:
+            out.append(i)
+    return out
+
+
+def _repeated_seeds(md: ModalKernel, k: int, d: float, resolution: int | None) -> list[np.ndarray]:
+    """Patterns that always solve or nearly solve: equally spaced impacts, and repetitions of the
+    solutions with ``k/j`` impacts at period ``T/j``."""
+    T = md.T
+    seeds = [T * np.arange(1, k + 1) / k]
+    for j in range(2, k):
+        if k % j == 0:
+            sub = md.at(T / j)
+            base = [np.array([T / j])] if k // j == 1 else (
+                [t for t, _ in _multistart(sub, k // j, d, resolution)] if k // j >= 3 else
+                [np.array([t1, T / j]) for t1 in _k2_roots(sub)])
+            for t in base:
+                seeds.append(np.concatenate([t + m * T / j for m in range(j)]))
+    return seeds
+
+
+def _multistart(md: ModalKernel, k: int, d: float, resolution: int | None) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Solutions for k >= 3: Levenberg–Marquardt from the equally spaced
+    pattern, from every repeated lower-order solution (period ``T/j``,
+    ``j | k``) and from the grid cells of ordered impact times whose screening
+    residual is a local minimum (non-strict) or among the lowest 5 %; Newton
+    from every grid cell."""
+    T = md.T
+    if resolution is None:
+        resolution = int(np.clip(np.ceil(4 * T * md.omega.max() / (2 * np.pi)), 16, 48))
+    grid = T * (np.arange(1, resolution) / resolution)
+    idx = np.array(list(combinations(range(grid.size), k - 1)))
+    starts = np.column_stack([grid[idx], np.full(len(idx), T)])
+    candidates = [starts[i] for i in _promising(idx, _screening(md, starts, k), k)]
+    seeds = _repeated_seeds(md, k, d, resolution)
+    found: list[tuple[np.ndarray, np.ndarray]] = []
+
+    def keep(sol):
+        if sol is not None and not any(np.abs(sol[0] - t).max() <= REPEAT_RTOL * T for t, _ in found):
+            found.append(sol)
+
+    # Newton (exact Jacobian, cheap) from every cell: the screening score is
+    # a poor guide to Newton's basins; Levenberg–Marquardt (wider basin,
+    # costlier) from the seeds and the promising cells.
+    for times0 in seeds + candidates:
+        keep(solve_times(md, np.asarray(times0, dtype=float), d))
+    for times0 in starts:
+        lam0 = impulses_for(md, times0, d)
+        if lam0 is not None:
+            keep(newton_times(md, times0, lam0, d))
+    return found
+
+
+def _k2_roots(md: ModalKernel) -> np.ndarray:
+    """Every ``t₁`` in ``(0, T)`` with ``s(t₁) = 0`` (the k = 2 condition)."""
+    T = md.T
+    c = md.b**2 / 2
+    s_sum = TrigSum(alpha=c, beta=-c * np.cos(md.omega * T / 2) / md.sin_half, omega=md.omega)
+    return np.array([t for t in all_roots(s_sum, 0.0, T) if 0 < t < T])
