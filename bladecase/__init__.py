@@ -19,38 +19,70 @@ Every public name is re-exported here:
 (True, 0.602841)
 """
 
-from .fe.assembly import DofMap, FEModel, Material, assemble, natural_frequencies
-from .fe.geometry import BladeGeometry, PlateGeometry, blade_mesh
-from .fe.mesh import Mesh, load_mesh, save_mesh
-from .nsm.branches import Arc, Family, nonsmooth_mode
-from .nsm.orbits import PeriodicOrbit, impact_matrices, make_orbit, orbit_1ipp, orbits_kipp
-from .nsm.scan import Backbone, Interval, backbone
-from .nsm.simulation import Trajectory, simulate
-from .nsm.system import LinearSystem, Spectrum, chain
-from .reduction.contact import Contact, radial_normal
-from .reduction.lanczos import (
+from .fe import (
+    BladeGeometry,
+    DofMap,
+    FEModel,
+    Material,
+    Mesh,
+    PlateGeometry,
+    assemble,
+    blade_mesh,
+    load_mesh,
+    natural_frequencies,
+    save_mesh,
+    stiffness_factor,
+)
+from .nsm import (
+    Arc,
+    Backbone,
+    Branch,
+    Family,
+    Interval,
+    LinearSystem,
+    MasslessSystem,
+    PeriodicOrbit,
+    Spectrum,
+    Trajectory,
+    backbone,
+    bar,
+    chain,
+    impact_matrices,
+    make_orbit,
+    nonsmooth_mode,
+    orbit_1ipp,
+    orbits_kipp,
+    simulate,
+    verify,
+)
+from .reduction import (
+    FULL_LIMIT,
+    METHODS,
+    Contact,
     LanczosChain,
     MassFactor,
     PerDofDefect,
+    ReducedModel,
     SymmetryBasis,
     lanczos_chain,
     mass_factor,
     per_dof_defect,
+    radial_normal,
+    reduce,
 )
-from .reduction.methods import FULL_LIMIT, ReducedModel, reduce
-from .study.pipeline import RunResult, run
-from .study.schema import Study, StudyError, demo_study, load_study
+from .study import RunResult, Study, StudyError, demo_study, load_study, run
 
 __all__ = [
     # fe
     "BladeGeometry", "DofMap", "FEModel", "Material", "Mesh", "PlateGeometry",
-    "assemble", "blade_mesh", "load_mesh", "natural_frequencies", "save_mesh",
-    # nsm
-    "Arc", "Backbone", "Family", "Interval", "LinearSystem", "PeriodicOrbit", "Spectrum", "Trajectory",
-    "backbone", "chain", "impact_matrices", "make_orbit", "nonsmooth_mode", "orbit_1ipp", "orbits_kipp", "simulate",
+    "assemble", "blade_mesh", "load_mesh", "natural_frequencies", "save_mesh", "stiffness_factor",
     # reduction
-    "Contact", "FULL_LIMIT", "LanczosChain", "MassFactor", "PerDofDefect", "ReducedModel", "SymmetryBasis",
-    "lanczos_chain", "mass_factor", "per_dof_defect", "radial_normal", "reduce",
+    "Contact", "FULL_LIMIT", "LanczosChain", "METHODS", "MassFactor", "PerDofDefect", "ReducedModel",
+    "SymmetryBasis", "lanczos_chain", "mass_factor", "per_dof_defect", "radial_normal", "reduce",
+    # nsm
+    "Arc", "Backbone", "Branch", "Family", "Interval", "LinearSystem", "MasslessSystem", "PeriodicOrbit",
+    "Spectrum", "Trajectory", "backbone", "bar", "chain", "impact_matrices", "make_orbit", "nonsmooth_mode",
+    "orbit_1ipp", "orbits_kipp", "simulate", "verify",
     # study
     "RunResult", "Study", "StudyError", "demo_study", "load_study", "run",
 ]

@@ -237,7 +237,7 @@ def _cmd_demo(args) -> int:
 
 def _cmd_mesh(args) -> int:
     from .fe import save_mesh
-    from .study.pipeline import build_mesh
+    from .study.stages import build_mesh
 
     _setup(args)
     study = _study(args.study)
@@ -254,7 +254,7 @@ def _cmd_mesh(args) -> int:
 
 def _cmd_assemble(args) -> int:
     from .fe import load_mesh, natural_frequencies, save_model
-    from .study.pipeline import build_mesh, build_model
+    from .study.stages import build_mesh, build_model
 
     _setup(args)
     study = _study(args.study)
@@ -273,7 +273,7 @@ def _cmd_assemble(args) -> int:
 def _cmd_reduce(args) -> int:
     from .fe import load_model
     from .reduction import save_reduced
-    from .study.pipeline import build_contact, build_reduced
+    from .study.stages import build_contact, build_reduced
 
     _setup(args)
     study = _study(args.study)
@@ -289,7 +289,8 @@ def _cmd_reduce(args) -> int:
 
 def _cmd_modes(args) -> int:
     from .io import write_json
-    from .study.pipeline import families_document, search
+    from .study.documents import families_document
+    from .study.stages import search
 
     progress = _setup(args)
     study = _study(args.study, model=args.reduced is not None)  # with --matrices: [search] is enough
@@ -313,7 +314,8 @@ def _cmd_modes(args) -> int:
 
 def _cmd_animate(args) -> int:
     from .reduction import load_reduced
-    from .study.pipeline import animate_families, load_families
+    from .study.documents import load_families
+    from .study.render import animate_families
 
     progress = _setup(args)
     study = _study(args.study)
@@ -373,9 +375,9 @@ def _cmd_backbone(args) -> int:
         curves = nonsmooth_mode(system, args.ipp, (P[0], P[-1]), scan=P.size, progress=progress)
         if curves:
             summary = "\n".join(f.table() for f in curves)
+            table = summary if args.quiet else "\n\n".join(f.table(points=True) for f in curves)
         else:
-            summary = f"no {args.ipp}-ipp family found in T in [{P[0]:g}, {P[-1]:g}]"
-        table = summary if args.quiet else "\n\n".join(_family_table(f) for f in curves) + "\n\n" + summary
+            summary = table = f"no {args.ipp}-ipp family found in T in [{P[0]:g}, {P[-1]:g}]"
         data = {
             "ipp": args.ipp,
             "system": {"n": system.n, "gap": system.gap},
@@ -397,11 +399,6 @@ def _cmd_backbone(args) -> int:
 
 def _save_plot(curves, path: Path) -> None:
     """The frequency–energy plot of backbones/families, written atomically."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     from .io import save_figure
     from .post.plots import frequency_energy
 
@@ -409,19 +406,6 @@ def _save_plot(curves, path: Path) -> None:
         raise ValueError("nothing to plot: no family found")
     fig = frequency_energy(curves)
     save_figure(fig, path, dpi=150)
-    plt.close(fig)
-
-
-def _family_table(family) -> str:
-    """Per-orbit table of one k-ipp family (in continuation order)."""
-    lines = [family.table().split("\n", 1)[0],
-             f"{'T':>14} {'1/T':>12} {'energy':>12} {'impact times':>36} {'impulses':>30} admissible"]
-    for o in family.orbits:
-        times = " ".join(f"{t:.6g}" for t in o.impact_times)
-        imp = " ".join(f"{x:.5g}" for x in o.impulses)
-        lines.append(f"{o.T:14.8g} {1 / o.T:12.6g} {o.energy:12.6g} {times:>36} {imp:>30} "
-                     f"{'yes' if o.admissible else 'no'}")
-    return "\n".join(lines)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -128,22 +128,31 @@ def test_time_series_reads_back(demo_run):
             if min(ti, a["T"] - ti) <= 1e-12 * a["T"]:
                 continue  # t_k = T: the impact at t = 0
             assert np.min(np.abs(times - ti)) < 1e-12 * a["T"]
+        # frames carry every FE node of the P2 model (corners and edge nodes, quadratic cells): the mesh's
+        # nodes are among them at their own positions
+        grid = meshio.read(files[0])
+        assert "tetra10" in grid.cells_dict and len(grid.points) > len(mesh.points)
+        def at(p, points=grid.points):
+            return int(np.argmin(np.linalg.norm(points - p, axis=1)))
+
+        contact = at(mesh.points[node])
+        assert np.array_equal(grid.points[contact], mesh.points[node])
         gaps = []
         for t, f in zip(times, files):
             frame = meshio.read(f)
-            assert frame.points.shape == mesh.points.shape
+            assert np.array_equal(frame.points, grid.points)
             u = frame.point_data["displacement"]
             v = frame.point_data["velocity"]
-            assert u.shape == (len(mesh.points), 3) and v.shape == u.shape
+            assert u.shape == (len(grid.points), 3) and v.shape == u.shape
             assert np.allclose(frame.point_data["displacement_magnitude"], np.linalg.norm(u, axis=1), rtol=1e-12)
             assert float(frame.field_data["time"][0]) == t
             assert float(frame.field_data["period"][0]) == a["T"]
-            gaps.append(float(u[node] @ nu))
+            gaps.append(float(u[contact] @ nu))
         gaps = np.array(gaps)
         assert gaps[0] == pytest.approx(d, rel=1e-9)  # t = 0: the contact node is at the casing
         assert gaps.max() <= d * (1 + 1e-9)           # never through it
         # the clamped root does not move
-        root = mesh.group("root")
+        root = [at(p) for p in mesh.points[mesh.group("root")]]
         assert np.abs(meshio.read(files[3]).point_data["displacement"][root]).max() == 0.0
 
 
@@ -376,3 +385,51 @@ def test_search_resolution_reaches_the_start_search(plate_study, monkeypatch):
     system = bc.chain(3, k=1.0, m=1 / 3, gap=1.0)
     pipeline.search(st, system)
     assert seen == [20, 20]
+
+
+NO_SIDE_EFFECTS = """
+import logging, sys, warnings
+import matplotlib
+warnings.simplefilter("error")   # e.g. tqdm's ipywidgets warning would fail the run
+backend = dict.__getitem__(matplotlib.rcParams, "backend")
+root, lib = logging.getLogger(), logging.getLogger("bladecase")
+before = (list(root.handlers), list(lib.handlers), root.level, lib.level, lib.propagate)
+from bladecase.study.schema import load_study
+from bladecase.study import run
+result = run(load_study(sys.argv[1]), out=sys.argv[2], progress=False)
+after = (list(root.handlers), list(lib.handlers), root.level, lib.level, lib.propagate)
+figures = sys.modules["matplotlib.pyplot"].get_fignums() if "matplotlib.pyplot" in sys.modules else []
+print(after == before, dict.__getitem__(matplotlib.rcParams, "backend") == backend,
+      len(figures), (result.directory / "run.log").read_text().count(" INFO "))
+"""
+
+
+def test_run_changes_no_global_state(plate_study, tmp_path):
+    """No backend switch, no figure left in pyplot's registry (pyvista imports pyplot, the library never
+    uses it), no logging handler or level change, nothing on stderr with progress=False; run.log is
+    written from the run's own transcript all the same."""
+    import subprocess
+    import sys
+
+    proc = subprocess.run([sys.executable, "-c", NO_SIDE_EFFECTS, str(plate_study), str(tmp_path / "out")],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    handlers_kept, backend_kept, figures, infos = proc.stdout.split()
+    assert (handlers_kept, backend_kept, figures) == ("True", "True", "0")
+    assert int(infos) >= 8  # study, mesh, model, contact, reduced model, search, animations, results
+    assert proc.stderr == ""
+
+
+def test_library_code_never_uses_pyplot_or_switches_backend():
+    import ast
+
+    offenders = []
+    for path in sorted((Path(bc.__file__).parent).rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            names = ([a.name for a in node.names] if isinstance(node, ast.Import) else
+                     [f"{node.module}.{a.name}" for a in node.names] if isinstance(node, ast.ImportFrom) else [])
+            if any(n.startswith("matplotlib.pyplot") for n in names):
+                offenders.append(f"{path.name}:{node.lineno} imports pyplot")
+            if isinstance(node, ast.Attribute) and node.attr == "use" and getattr(node.value, "id", "") == "matplotlib":
+                offenders.append(f"{path.name}:{node.lineno} calls matplotlib.use")
+    assert offenders == []

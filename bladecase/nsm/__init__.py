@@ -22,6 +22,7 @@ The pipeline inside, one module per step:
 - :mod:`~bladecase.nsm.flight` and :mod:`~bladecase.nsm.simulation` — the event-driven simulator:
   a flight propagator (:class:`ModalFlight`), an impact law (:class:`NewtonImpact`), the event loop
   (:func:`integrate`) and :func:`simulate`;
+- :mod:`~bladecase.nsm.verify` — the independent check of an orbit by simulation (:func:`verify`);
 - :mod:`~bladecase.nsm.massless`, :mod:`~bladecase.nsm.massless_orbits`, :mod:`~bladecase.nsm.bar` — the
   massless contact model (theory §8).
 """
@@ -46,6 +47,7 @@ from .orbits import PeriodicOrbit, make_orbit, orbit_1ipp
 from .scan import backbone
 from .simulation import Trajectory, integrate, simulate
 from .system import LinearSystem, Spectrum, chain
+from .verify import VERIFY_RTOL, verify
 
 __all__ = [
     "Arc", "Backbone", "Branch", "Curve", "Family", "FlightPropagator", "ImpactLaw", "Interval", "KippCurve",
@@ -53,5 +55,5 @@ __all__ = [
     "Trajectory", "backbone", "bar", "bar_continuum_energy", "bisect", "canonical_rotation", "chain",
     "check_period", "condense", "impact_matrices", "integrate", "kipp_jacobian", "kipp_residual", "make_orbit",
     "newton_times", "nonsmooth_mode", "orbit_1ipp", "orbits_kipp", "simulate", "simulate_massless",
-    "solve_times", "trace",
+    "solve_times", "trace", "verify", "VERIFY_RTOL",
 ]

@@ -1,9 +1,19 @@
-"""Studies — a TOML file (:mod:`.schema`) run through every stage (:mod:`.pipeline`).
+"""Studies — a TOML file run through every stage, on top of the library.
+
+- :mod:`~bladecase.study.schema` — the typed sections of a study file, validated with clear errors;
+- :mod:`~bladecase.study.stages` — one plain function per stage (mesh, model, contact, reduced model, search);
+- :mod:`~bladecase.study.choose` — which orbits to animate, and their frames;
+- :mod:`~bladecase.study.render` — each chosen orbit checked and handed to the output writers;
+- :mod:`~bladecase.study.documents` — the modes file and the summary's parts (JSON);
+- :mod:`~bladecase.study.publish` — staging and all-or-nothing publishing;
+- :mod:`~bladecase.study.executor` — where independent tasks run (serial today);
+- :mod:`~bladecase.study.run` — :func:`run`, the whole chain.
 
 The command line (:mod:`bladecase.cli`) is a thin layer over this package.
 """
 
-from .pipeline import RunResult, run
+from .executor import Executor, SerialExecutor
+from .run import RunResult, run
 from .schema import Study, StudyError, demo_study, load_study
 
-__all__ = ["RunResult", "Study", "StudyError", "demo_study", "load_study", "run"]
+__all__ = ["Executor", "RunResult", "SerialExecutor", "Study", "StudyError", "demo_study", "load_study", "run"]

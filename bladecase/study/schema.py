@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from ..fe import BladeGeometry, PlateGeometry
+from ..post.outputs import FORMATS as OUTPUT_FORMATS
 from ..reduction import METHODS
 
 REQUIRED = object()  #: marks a key without a default
@@ -130,8 +131,9 @@ def _orbit_list(v) -> str | None:
     return None
 
 
-#: Output formats: GIF/MP4 animations, VTK time series (+ manifold samples), PNG plots.
-FORMATS = ("gif", "mp4", "vtu", "png")
+#: The registry of output formats (:mod:`bladecase.post.outputs`): GIF/MP4 animations, VTK time series
+#: (+ manifold samples), PNG plots, and any format registered there.
+FORMATS = OUTPUT_FORMATS
 
 _STR, _INT, _NUM, _BOOL, _LIST = (str,), (int,), (int, float), (bool,), (list,)
 

@@ -1,0 +1,73 @@
+"""The run's Markdown report, written from its summary (``summary.json``) alone."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def report(summary: dict) -> str:
+    """A human-readable Markdown report of a run's :data:`summary`."""
+    m, c, r = summary["model"], summary["contact"], summary["reduction"]
+    lines = [f"# bladecase study `{summary['study']}`", "",
+             f"Study file: `{summary['source']}` — bladecase {summary['bladecase_version']} — "
+             f"total {summary['timings_s']['total']:.1f} s.", "",
+             "## Model", "",
+             f"- Mesh: {m['mesh']['nodes']} nodes, {m['mesh']['cells']} `{m['mesh']['type']}` cells "
+             f"({m['mesh']['source']}).",
+             f"- FE model: {m['dim']}-D, P{m['order']}, {m['dofs']} free dofs, {m['mass_matrix']} mass, "
+             f"{m['material']['name']} (E = {m['material']['E']:.4g} Pa, ν = {m['material']['nu']:g}, "
+             f"ρ = {m['material']['rho']:g} kg/m³), total mass {m['total_mass_kg']:.5g} kg, "
+             f"{m['clamped_nodes']} clamped nodes.",
+             "- Linear frequencies (full FE model, Hz): " + ", ".join(f"{f:.2f}" for f in m["linear_frequencies_hz"]),
+             "", "## Contact", "",
+             f"- Node {c['node']} at ({', '.join(f'{x:.5g}' for x in c['position'])}) m, casing normal "
+             f"({', '.join(f'{x:.4g}' for x in c['normal'])}), clearance {c['clearance_m'] * 1e3:.4g} mm.",
+             "", "## Reduced model", "",
+             f"- {r['method']} (size {r['size']}): {r['reduced_dofs']} reduced dofs.", "",
+             "| mode | reduced f (Hz) | contact weight b² | full FE f (Hz) | rel. error |",
+             "|---:|---:|---:|---:|---:|"]
+    fe = m["linear_frequencies_hz"]
+    for j, (f, b2) in enumerate(zip(r["frequencies_hz"], r["contact_weights_b2"])):
+        if j >= 12:
+            break
+        ref = fe[int(np.argmin(np.abs(np.asarray(fe) - f)))] if fe else float("nan")
+        lines.append(f"| {j + 1} | {f:.3f} | {b2:.3e} | {ref:.3f} | {abs(f - ref) / ref:.2e} |")
+    for cmp in summary["compare"]:
+        errs = ", ".join(f"{e:.1e}" for e in cmp["relative_error_vs_fe"])
+        lines.append("")
+        lines.append(f"- Comparison model {cmp['method']} (size {cmp['size']}, {cmp['reduced_dofs']} dofs): "
+                     f"nearest-frequency errors vs FE [{errs}]; {len(cmp['families'])} families, "
+                     f"{sum(len(f['admissible_arcs']) for f in cmp['families'])} admissible arcs.")
+    s = summary["search"]
+    lines += ["", "## Nonsmooth modes", "",
+              f"Search: ipp {s['ipp']}, periods {s['periods']} × {s['period_unit']} "
+              f"(= [{s['periods'][0] * s['period_unit_s']:.6g}, {s['periods'][1] * s['period_unit_s']:.6g}] s), "
+              f"scan {s['scan']}.", ""]
+    fams = summary["families"]
+    with_arcs = [(i, f) for i, f in enumerate(fams) if f["admissible_arcs"]]
+    lines.append(f"{len(fams)} families found, {len(with_arcs)} with admissible arcs "
+                 f"(families without any are listed in `summary.json`).")
+    lines += ["", "| family | ipp | orbits | f range (Hz) | admissible arc f (Hz) | energy on arc (J) |",
+              "|---:|---:|---:|---|---|---|"]
+    for i, f in with_arcs:
+        for a in f["admissible_arcs"]:
+            lines.append(f"| {i} | {f['ipp']} | {f['orbits']} | {f['frequency_range_hz'][0]:.3f} – "
+                         f"{f['frequency_range_hz'][1]:.3f} | {a['f_lo']:.4f} – {a['f_hi']:.4f} | "
+                         f"{a['energy_range_j'][0]:.3e} – {a['energy_range_j'][1]:.3e} |")
+    files = summary["files"]
+    lines += ["", "## Files", ""]
+    if "frequency_energy_plot" in files:
+        lines += [f"![frequency–energy]({files['frequency_energy_plot']})", ""]
+    lines.append(f"- `{files['mesh']}`: the mesh with its groups; `{files['modes']}`: every family and orbit.")
+    for a in files.get("animations", []):
+        what = ", ".join(f"`{a[k]}`" for k in ("gif", "mp4", "pvd", "manifold") if k in a)
+        phases = ", ".join(f"{t / a['T']:.4f}" for t in a["impact_times"])
+        check = a["verification"]
+        lines.append(f"- family {a['family']}, {a['ipp']}-ipp orbit T = {a['T']:.8g} s (f = {a['frequency_hz']:.3f} "
+                     f"Hz, E = {a['energy_j']:.3e} J, impacts at t/T = "
+                     f"{phases}, displacements × {a['scale']:.4g}; event-driven simulation returns to it to "
+                     f"{check['return_error']:.1e}{'' if check['ok'] else ' — CHECK FAILED'}): {what}")
+        if "gif" in a:
+            lines.append(f"\n  ![{a['gif']}]({a['gif']})\n")
+    lines += ["", "Timings (s): " + ", ".join(f"{k} {v:.2f}" for k, v in summary["timings_s"].items()), ""]
+    return "\n".join(lines)

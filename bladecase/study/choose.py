@@ -1,0 +1,103 @@
+"""Which orbits a run animates, and at which instants: ``[output] orbits`` or the middles of the widest
+admissible arcs; frames with one frame on each impact instant."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import log
+from ..nsm import Branch, PeriodicOrbit
+from .schema import Study, StudyError
+
+
+@dataclass(frozen=True)
+class Choice:
+    """An orbit chosen for animation: family index and the orbit."""
+
+    family: int
+    orbit: PeriodicOrbit
+
+    @property
+    def stem(self) -> str:
+        return f"mode{self.family:02d}_{self.orbit.k}ipp_T{self.orbit.T:.6e}".replace("+", "").replace(".", "p")
+
+
+def _admissible_at(fam: Branch, T: float) -> PeriodicOrbit | None:
+    try:
+        hits = [o for o in fam.orbit_at(T) if o.admissible]
+    except ValueError:
+        hits = []
+    return hits[0] if hits else None
+
+
+def choose_orbits(study: Study, families: list[Branch], unit: float) -> list[Choice]:
+    """The orbits to animate: ``[output] orbits`` if given, else the middles of the widest arcs."""
+    o = study["output"]
+    chosen: list[Choice] = []
+    if o["orbits"]:
+        for req in o["orbits"]:
+            T = req["T"] * unit
+            best = None
+            for i, fam in enumerate(families):
+                if fam.k != req["ipp"]:
+                    continue
+                if any(a.T_lo <= T <= a.T_hi for a in fam.arcs):
+                    orbit = _admissible_at(fam, T)
+                    if orbit is not None:
+                        best = (0.0, i, orbit)
+                        break
+                for orbit in fam.orbits:
+                    if orbit.admissible and (best is None or abs(orbit.T - T) < best[0]):
+                        best = (abs(orbit.T - T), i, orbit)
+            if best is None:
+                raise StudyError(f"[output] orbits: no admissible {req['ipp']}-ipp orbit was found in the search "
+                                 f"range (asked T = {req['T']} {study['search']['period_unit']})")
+            if best[0] > 0:
+                log.info("no admissible %d-ipp orbit at T = %.6g s; animating the nearest one, T = %.6g s",
+                         req["ipp"], T, best[2].T)
+            chosen.append(Choice(best[1], best[2]))
+        return chosen
+    arcs = sorted((((a.T_hi - a.T_lo) / a.T_hi, i, n) for i, fam in enumerate(families)
+                   for n, a in enumerate(fam.arcs)), reverse=True)
+    # Widest arcs first, one per family; then further arcs of the same families if fewer families than asked.
+    order = [x for x in arcs if x[1] not in {y[1] for y in arcs[:arcs.index(x)]}]
+    order += [x for x in arcs if x not in order]
+    for _width, i, n in order:
+        if len(chosen) >= o["animate"]:
+            break
+        fam = families[i]
+        arc = fam.arcs[n]
+        orbit = _admissible_at(fam, 0.5 * (arc.T_lo + arc.T_hi))
+        if orbit is None:  # the arc is a single point, or the middle did not converge
+            candidates = [fam.orbits[j] for j in range(arc.start, arc.stop + 1) if fam.orbits[j].admissible]
+            if not candidates:
+                continue
+            orbit = candidates[len(candidates) // 2]
+        chosen.append(Choice(i, orbit))
+    return chosen
+
+
+def frame_times(orbit: PeriodicOrbit, frames: int) -> tuple[np.ndarray, np.ndarray]:
+    """``frames`` instants over one period, with one frame moved onto each impact instant.
+
+    Each impact takes the nearest frame that is not already an impact and
+    can move there without reordering the frames (so close impacts get
+    neighbouring frames).  Returns the times (increasing, in ``[0, T)``) and
+    the impact-frame mask; ``t = 0`` (``= t_k = T``) is always an impact.
+    """
+    T = orbit.T
+    t = np.arange(frames) * T / frames
+    impact = np.zeros(frames, dtype=bool)
+    impact[0] = True
+    edges = np.append(t, T)
+    for ti in np.sort(np.mod(orbit.impact_times, T)):
+        if ti <= 1e-12 * T or ti >= T * (1 - 1e-12):
+            continue  # the impact at t = 0
+        for j in np.argsort(np.abs(t - ti), kind="stable"):
+            if j > 0 and not impact[j] and edges[j - 1] < ti < edges[j + 1]:
+                t[j] = edges[j] = ti
+                impact[j] = True
+                break
+    return t, impact

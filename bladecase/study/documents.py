@@ -1,0 +1,87 @@
+"""The JSON documents of a study: the modes file (every branch, every orbit) and the run's summary parts.
+
+Branches are serialised in one place, :meth:`bladecase.nsm.Branch.to_dict` / :meth:`~bladecase.nsm.Branch.from_dict`;
+this module only wraps them with the system they belong to.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ..fe import FEModel, Mesh
+from ..nsm import Branch, LinearSystem
+from ..reduction import Contact, ReducedModel
+
+
+def families_document(families: list[Branch], system: LinearSystem) -> dict:
+    """The modes file's content: the system's size and gap, and every branch."""
+    return {"system_dofs": system.n, "gap": system.gap, "families": [f.to_dict() for f in families]}
+
+
+def load_families(path: str | os.PathLike, system: LinearSystem) -> list[Branch]:
+    """Branches from a modes JSON file (``bladecase modes``), attached to ``system`` (orbits as stored)."""
+    try:
+        data = json.loads(Path(path).read_text(encoding="utf-8"))
+        fams = [Branch.from_dict(system, f) for f in data["families"]]
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise ValueError(f"cannot read modes file {str(path)!r}: {exc}") from None
+    n = data.get("system_dofs")
+    if n is not None and n != system.n:
+        raise ValueError(f"modes file {str(path)!r} was computed on a system of {n} dofs, this one has {system.n}")
+    return fams
+
+
+def _range(values: np.ndarray) -> list[float]:
+    values = values[np.isfinite(values)]
+    return [float(values.min()), float(values.max())] if values.size else [float("nan")] * 2
+
+
+def family_summary(fam: Branch) -> dict:
+    """Period, frequency and energy ranges of a branch, and its admissible arcs."""
+    T, E = fam.T, fam.energy
+    return {
+        "ipp": fam.k,
+        "orbits": len(fam.orbits),
+        "period_range_s": _range(T),
+        "frequency_range_hz": _range(1 / T),
+        "energy_range_j": _range(E),
+        "admissible_orbits": int(fam.admissible.sum()),
+        "admissible_arcs": [
+            {"T_lo": a.T_lo, "T_hi": a.T_hi, "f_lo": 1 / a.T_hi, "f_hi": 1 / a.T_lo,
+             "energy_range_j": _range(E[a.start:a.stop + 1][fam.admissible[a.start:a.stop + 1]]),
+             "refined_lo": bool(a.refined_lo), "refined_hi": bool(a.refined_hi)} for a in fam.arcs
+        ],
+    }
+
+
+def reduced_summary(reduced: ReducedModel, reference_hz: np.ndarray) -> dict:
+    """A reduced model's frequencies and contact weights, with the nearest-frequency error vs ``reference_hz``."""
+    sp = reduced.system.spectrum
+    f = sp.frequencies[sp.active]
+    nearest = [float(np.min(np.abs(f - fr)) / fr) if f.size else float("nan") for fr in reference_hz]
+    return {"method": reduced.method, "size": reduced.size, "reduced_dofs": reduced.n,
+            "frequencies_hz": f.tolist(), "contact_weights_b2": (sp.b[sp.active] ** 2).tolist(),
+            "relative_error_vs_fe": nearest}
+
+
+def model_summary(mesh: Mesh, model: FEModel, f_fe: np.ndarray, source: str) -> dict:
+    """The mesh and FE model of a run: sizes, material, mass and linear frequencies."""
+    m = model.material
+    return {
+        "mesh": {"nodes": len(mesh.points), "cells": len(mesh.cells[mesh.body_type]), "type": mesh.body_type,
+                 "source": source},
+        "dim": model.dim, "dofs": model.n_dofs, "order": model.order, "mass_matrix": model.mass,
+        "material": {"name": m.name, "E": m.E, "nu": m.nu, "rho": m.rho},
+        "total_mass_kg": model.total_mass, "clamped_nodes": int(model.clamped.size),
+        "linear_frequencies_hz": np.asarray(f_fe).tolist(),
+    }
+
+
+def contact_summary(contact: Contact, model: FEModel) -> dict:
+    """Contact node, its position, the casing normal and the clearance."""
+    return {"node": contact.node, "position": model.mesh.points[contact.node].tolist(),
+            "normal": contact.normal_for(model).tolist(), "clearance_m": contact.gap}

@@ -1,0 +1,90 @@
+"""The render stage: each chosen orbit checked by simulation, expanded to every node of the mesh and
+handed to the orbit-scope writers of ``[output] formats`` (:mod:`bladecase.post.outputs`)."""
+
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+from .. import log
+from ..nsm import Branch
+from ..nsm.verify import verify
+from ..post.grid import fe_grid, grid_index, nodal_field
+from ..post.outputs import FORMATS, OrbitScene
+from ..progress import progress_bar
+from ..reduction import ReducedModel
+from .choose import Choice, choose_orbits, frame_times
+from .publish import publish, staging_dir
+from .schema import Study
+from .stages import period_unit
+
+
+def orbit_scene(study: Study, reduced: ReducedModel, families: list[Branch], choice: Choice) -> OrbitScene:
+    """The chosen orbit at ``[output] frames`` instants, on every node of the FE model (quadratic cells whole)."""
+    from ..post import animation
+
+    o = study["output"]
+    orbit, model = choice.orbit, reduced.model
+    times, impact = frame_times(orbit, o["frames"])
+    x, v = orbit.state(times)
+    mesh = fe_grid(model)
+    u = nodal_field(model, reduced.free_dofs(x))
+    v = nodal_field(model, reduced.free_dofs(v))
+    scale = animation.auto_scale(mesh, u, o["auto_fraction"]) if o["scale"] == "auto" else float(o["scale"])
+    return OrbitScene(stem=choice.stem, title=f"{study.name}: {orbit.k}-ipp nonsmooth mode (family {choice.family})",
+                      mesh=mesh, orbit=orbit, times=times, u=u, v=v, impact=impact,
+                      contact_node=int(grid_index(model, reduced.contact.node)),
+                      normal=reduced.contact.normal_for(model), scale=scale, options=o,
+                      branch=families[choice.family])
+
+
+def render(study: Study, reduced: ReducedModel, families: list[Branch], choice: Choice, folder: Path) -> dict:
+    """Check one chosen orbit by simulation and write its orbit-scope outputs into ``folder``.
+
+    Returns its ``summary.json`` entry: period, energy, impacts, the check, the files written.
+    """
+    scene = orbit_scene(study, reduced, families, choice)
+    orbit = scene.orbit
+    check = verify(orbit)
+    entry = {"family": choice.family, "ipp": orbit.k, "T": orbit.T, "frequency_hz": 1 / orbit.T,
+             "energy_j": orbit.energy, "impact_times": orbit.impact_times.tolist(),
+             "impulses": orbit.impulses.tolist(), "scale": scene.scale, "frames": int(scene.times.size),
+             "verification": check}
+    if not check["ok"]:
+        log.warning("orbit T = %.8g s failed the independent check (simulation from its post-impact state: "
+                    "return error %.2e, %d impacts for %d): animated anyway, flagged in summary.json", orbit.T,
+                    check["return_error"], check["impacts"], orbit.k)
+    entry.update(FORMATS.write(study["output"]["formats"], "orbit", scene, folder))
+    log.info("animated %d-ipp orbit T = %.8g s (f = %.2f Hz, E = %.3g J; simulator return error %.1e)", orbit.k,
+             orbit.T, 1 / orbit.T, orbit.energy, check["return_error"])
+    return entry
+
+
+def render_all(study: Study, reduced: ReducedModel, families: list[Branch], folder: Path,
+               progress: bool = False) -> list[dict]:
+    """Choose the orbits (:func:`~bladecase.study.choose.choose_orbits`) and render each."""
+    unit, _ = period_unit(study, reduced.system)
+    chosen = choose_orbits(study, families, unit)
+    if not chosen:
+        log.warning("no admissible orbit to animate: widen [search] periods or add ipp values")
+    return [render(study, reduced, families, c, folder)
+            for c in progress_bar(chosen, "animations", enabled=progress, unit="orbit")]
+
+
+def animate_families(study: Study, reduced: ReducedModel, families: list[Branch],
+                     out: str | os.PathLike | None = None, progress: bool = False) -> list[dict]:
+    """The render stage alone (``bladecase animate``): animations and VTK files of the chosen orbits.
+
+    Returns one entry per animated orbit (period, energy, verification, file
+    names relative to the output directory); files are published together.
+    """
+    out = study.output_dir(out)
+    staging = staging_dir(out)
+    try:
+        entries = render_all(study, reduced, families, staging, progress)
+        publish(staging, out, ("animations", "vtk"))
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise
+    return entries

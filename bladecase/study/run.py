@@ -1,0 +1,149 @@
+"""A study run end to end: mesh → FE model → contact → reduced model(s) → nonsmooth modes → results.
+
+:func:`run` writes into a hidden staging folder inside the output directory and publishes the results
+only when everything succeeded (:mod:`~bladecase.study.publish`).  It changes no global state: its
+messages go to the ``bladecase`` logger and into ``run.log`` from its own transcript; progress bars are
+plain tqdm, absent with ``progress=False``.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .. import log
+from ..fe import natural_frequencies, save_mesh, stiffness_factor
+from ..io import write_json, write_text
+from ..post.outputs import FORMATS, PlotScene
+from ..post.report import report
+from ..progress import progress_counter
+from .documents import contact_summary, families_document, family_summary, model_summary, reduced_summary
+from .executor import Executor, SerialExecutor
+from .publish import RUN_RESULTS, publish, staging_dir
+from .render import render_all
+from .schema import Study
+from .stages import build_contact, build_mesh, build_model, build_reduced, period_unit, search
+
+
+@dataclass
+class RunResult:
+    """What :func:`run` produced: the output directory and the summary written there."""
+
+    directory: Path
+    summary: dict = field(repr=False)
+    families: list = field(repr=False, default_factory=list)
+
+
+class _Stages:
+    """Times each stage and advances the run's progress bar."""
+
+    def __init__(self, progress: bool, total: int = 6):
+        self.timings: dict[str, float] = {}
+        self.bar = progress_counter(total, "bladecase run", enabled=progress, unit="stage")
+
+    def __call__(self, name: str) -> _Stages:
+        self.name = name
+        self.bar.set_postfix_str(name)
+        self.timings[name] = time.perf_counter()
+        return self
+
+    def __enter__(self) -> None:
+        return None
+
+    def __exit__(self, *exc) -> None:
+        if exc[0] is None:
+            self.timings[self.name] = round(time.perf_counter() - self.timings[self.name], 3)
+            self.bar.update()
+
+
+def run(study: Study, out: str | os.PathLike | None = None, progress: bool = True,
+        executor: Executor | None = None) -> RunResult:
+    """Run the whole study; write every result into the output directory.
+
+    Files (in ``out``, default ``[output] directory``): ``summary.json``,
+    ``report.md``, ``run.log``, ``modes.json`` (every family, every orbit),
+    ``frequency_energy.png``, ``mesh.vtu`` (the mesh with its groups),
+    ``animations/<stem>.gif`` / ``.mp4``, ``vtk/<stem>.pvd`` with
+    ``vtk/<stem>/`` (one ``.vtu`` per frame) and ``vtk/<stem>_manifold.vtu``.
+    ``executor`` runs the searches of the models (default: :class:`SerialExecutor`).
+    """
+    out = study.output_dir(out)
+    t_start = time.perf_counter()
+    staging = staging_dir(out)
+    stages = _Stages(progress)
+    try:
+        with log.transcript() as lines:
+            log.info("study %s (%s) → %s", study.name, study.source, out)
+            summary, families = _compute(study, staging, stages, progress, executor or SerialExecutor())
+            summary["timings_s"] = dict(stages.timings, total=round(time.perf_counter() - t_start, 3))
+            log.info("results in %s (%.1f s)", out, summary["timings_s"]["total"])
+        write_text(staging / "run.log", "\n".join(lines) + "\n")
+        write_json(staging / "summary.json", summary)
+        write_text(staging / "report.md", report(summary))
+        publish(staging, out, RUN_RESULTS)
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise
+    finally:
+        stages.bar.close()
+    return RunResult(directory=out, summary=summary, families=families)
+
+
+def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, executor: Executor) -> tuple[dict, list]:
+    """Every stage of :func:`run`, writing into ``staging``; returns the summary (without timings) and families."""
+    o = study["output"]
+    files: dict[str, object] = {}
+    with stage("mesh"):
+        mesh = build_mesh(study)
+        save_mesh(mesh, staging / "mesh.vtu")
+        files["mesh"] = "mesh.vtu"
+        log.info("mesh: %d nodes, %d %s cells (%s)", len(mesh.points), len(mesh.cells[mesh.body_type]),
+                 mesh.body_type, "gmsh" if study.parametric else mesh.source)
+    with stage("assemble"):
+        model = build_model(study, mesh)
+        factor = stiffness_factor(model)
+        f_fe = natural_frequencies(model, min(study["fem"]["frequencies"], model.n_dofs - 1), factor=factor)
+        log.info("FE model: %s; first frequencies %s Hz", model, ", ".join(f"{x:.1f}" for x in f_fe[:6]))
+    with stage("reduce"):
+        contact = build_contact(study, model)
+        reduced = build_reduced(study, model, contact, factor=factor)
+        compares = [build_reduced(study, model, contact, c["method"], c.get("size"), factor=factor)
+                    for c in study["reduction"]["compare"]]
+        log.info("contact: node %d at %s, normal %s, clearance %g m", contact.node,
+                 np.round(mesh.points[contact.node], 6).tolist(), np.round(contact.normal_for(model), 6).tolist(),
+                 contact.gap)
+        log.info("reduced model: %s", reduced)
+    with stage("search"):
+        unit, _ = period_unit(study, reduced.system)
+        found = executor.map(lambda r: search(study, r.system, progress=progress, unit=unit), [reduced, *compares],
+                             desc="models", progress=progress)
+        families, compare_families = found[0], found[1:]
+        write_json(staging / "modes.json", families_document(families, reduced.system))
+        files["modes"] = "modes.json"
+    with stage("plots"):
+        scene = PlotScene(study.name, [(f"{r.method} ({r.n} dofs)", fams) for r, fams in
+                                       zip([reduced, *compares], found)], f_fe)
+        files.update(FORMATS.write(o["formats"], "run", scene, staging))
+    with stage("render"):
+        files["animations"] = render_all(study, reduced, families, staging, progress)
+    files["log"] = "run.log"
+    from .. import __version__
+
+    summary = {
+        "study": study.name, "source": study.source, "bladecase_version": __version__,
+        "model": model_summary(mesh, model, f_fe, "gmsh (parametric [geometry])" if study.parametric
+                               else str(study.mesh_path())),
+        "contact": contact_summary(contact, model),
+        "reduction": reduced_summary(reduced, f_fe),
+        "compare": [dict(reduced_summary(r, f_fe), families=[family_summary(f) for f in fams])
+                    for r, fams in zip(compares, compare_families)],
+        "search": {**study["search"], "period_unit_s": unit},
+        "families": [family_summary(f) for f in families],
+        "files": files,
+    }
+    return summary, families

@@ -1,0 +1,165 @@
+"""The stages of a study, each a plain function of the validated :class:`~bladecase.study.schema.Study`
+and the previous stage's data: mesh → FE model → contact → reduced model → nonsmooth modes.
+
+The command line runs one stage from files (``bladecase mesh / assemble / reduce / modes``) or all of
+them (:func:`bladecase.study.run`).  Bad study values raise :class:`~bladecase.study.schema.StudyError`
+naming the key.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+
+import numpy as np
+
+from .. import log
+from ..fe import FEModel, Material, Mesh, assemble, blade_mesh, load_mesh
+from ..linalg import SPDFactor
+from ..nsm import Branch, LinearSystem, nonsmooth_mode
+from ..reduction import Contact, ReducedModel, reduce
+from .schema import Study, StudyError
+
+
+def build_mesh(study: Study, path: str | os.PathLike | None = None) -> Mesh:
+    """The study's mesh: gmsh on ``[geometry]`` (written to ``path`` if given) or the ``[mesh]`` file.
+
+    The clamp group and, when the contact is picked by group, the contact group must exist.
+    """
+    need = [study["fem"]["clamp"]]
+    group = contact_group(study)
+    if group is not None:
+        need.append(group)
+    if study.parametric:
+        g = study["geometry"]
+        try:
+            mesh = blade_mesh(study.geometry(), size=g["size"], tip_size=g["tip_size"], order=g["mesh_order"],
+                              path=path)
+        except ValueError as exc:
+            raise StudyError(f"[geometry] {exc}") from None
+    else:
+        source = study.mesh_path()
+        if not source.exists():
+            raise StudyError(f"[mesh] path: no such file {str(source)!r}")
+        mesh = load_mesh(source)
+        if path is not None:
+            from ..fe import save_mesh
+
+            save_mesh(mesh, path)
+    for name, key in zip(need, ("[fem] clamp", "[contact] group")):
+        if name not in mesh.groups:
+            have = ", ".join(sorted(mesh.groups)) or "none"
+            raise StudyError(f"{key}: the mesh {mesh.source} has no group {name!r} (groups: {have})")
+    return mesh
+
+
+def material(study: Study) -> Material:
+    m = study["material"]
+    if m["E"] is not None:
+        return Material(float(m["E"]), float(m["nu"]), float(m["rho"]), "custom")
+    try:
+        return Material.preset(m["preset"])
+    except ValueError as exc:
+        raise StudyError(f"[material] preset: {exc}") from None
+
+
+def build_model(study: Study, mesh: Mesh) -> FEModel:
+    """Assemble the FE model of ``[material]`` and ``[fem]`` on ``mesh``."""
+    f = study["fem"]
+    if mesh.dim == 2 and f["thickness"] is None:
+        raise StudyError("[fem] thickness: required for a 2-D (plane) mesh, e.g. thickness = 0.002 (metres)")
+    if mesh.dim == 3 and f["thickness"] is not None:
+        raise StudyError(f"[fem] thickness: only for 2-D meshes; this mesh is 3-D (got {f['thickness']!r})")
+    return assemble(mesh, material(study), order=f["order"], mass=f["mass"], clamp=f["clamp"],
+                    thickness=f["thickness"], plane=f["plane"])
+
+
+def contact_group(study: Study) -> str | None:
+    """The mesh group ``[contact]`` selects from (``None``: a node index, or every free node)."""
+    c = study["contact"]
+    if c["node"] is not None:
+        return None
+    if c["farthest"] is not None:
+        return c["group"] or "tip"
+    if c["nearest"] is not None:
+        return c["group"]
+    return c["group"] or "contact"
+
+
+def build_contact(study: Study, model: FEModel) -> Contact:
+    """The contact of ``[contact]`` on ``model`` (node checked to be free).
+
+    ``node`` → that node; ``farthest`` → the free node of ``group`` (default
+    ``tip``) farthest along the direction; ``nearest`` → the free node nearest
+    the point (within ``group`` if given); otherwise the node of the one-node
+    ``group`` (default ``contact``).
+    """
+    c = study["contact"]
+    normal, gap = c["normal"], c["clearance"]
+    group = contact_group(study)
+    try:
+        if c["node"] is not None:
+            return Contact.at(model, c["node"], normal, gap)
+        if c["farthest"] is not None:
+            return Contact.farthest(model, c["farthest"], normal, gap, group=group)
+        if c["nearest"] is not None:
+            return Contact.nearest(model, c["nearest"], normal, gap, group=group)
+        nodes = model.mesh.group(group)
+        if len(nodes) != 1:
+            raise StudyError(f"[contact] group: group {group!r} has {len(nodes)} nodes; the contact is one "
+                             "node: name a one-node group, or add farthest = [dx, dy, dz] or nearest = [x, y, z]")
+        return Contact.at(model, int(nodes[0]), normal, gap)
+    except StudyError:
+        raise
+    except ValueError as exc:
+        raise StudyError(f"[contact] {exc}") from None
+
+
+def build_reduced(study: Study, model: FEModel, contact: Contact, method: str | None = None,
+                  size: int | None = None, factor: SPDFactor | None = None) -> ReducedModel:
+    """The reduced model of ``[reduction]`` (or of ``method``/``size``).
+
+    ``factor``: :func:`bladecase.fe.stiffness_factor` of ``model`` to share one factorisation of ``K``
+    between the models of a study.
+    """
+    r = study["reduction"]
+    method = method or r["method"]
+    size = (r["size"] if size is None else size) if method != "full" else None
+    try:
+        return reduce(model, contact, method, size, factor=factor)
+    except ValueError as exc:
+        raise StudyError(f"[reduction] {exc}") from None
+
+
+def period_unit(study: Study, system: LinearSystem) -> tuple[float, str]:
+    """Seconds per unit of ``[search] periods``, and the unit's label."""
+    unit = study["search"]["period_unit"]
+    if unit == "s":
+        return 1.0, "s"
+    j = int(unit[1:])
+    omega = system.spectrum.contact_modes[0]
+    if j > omega.size:
+        raise StudyError(f"[search] period_unit: {unit!r} but the reduced model has only {omega.size} modes "
+                         "that see the contact")
+    return float(2 * np.pi / omega[j - 1]), unit
+
+
+def search(study: Study, system: LinearSystem, progress: bool = False, unit: float | None = None) -> list[Branch]:
+    """Every family of every ``[search] ipp`` in the study's period range.
+
+    ``unit``: seconds per period unit (default: from ``system``; comparison
+    models pass the primary model's, so that every model searches the same
+    periods).
+    """
+    s = study["search"]
+    scale = period_unit(study, system)[0] if unit is None else unit
+    T_range = (s["periods"][0] * scale, s["periods"][1] * scale)
+    families: list[Branch] = []
+    for k in s["ipp"]:
+        t0 = time.perf_counter()
+        found = nonsmooth_mode(system, k, T_range, scan=s["scan"], step=s["step"], max_points=s["max_points"],
+                               progress=progress, resolution=s["resolution"])
+        n_arcs = sum(len(f.arcs) for f in found)
+        log.info("%d-ipp: %d families, %d admissible arcs (%.1f s)", k, len(found), n_arcs, time.perf_counter() - t0)
+        families.extend(found)
+    return families
