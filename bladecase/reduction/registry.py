@@ -49,12 +49,13 @@ ValueError: unknown demo method 'thrice' (valid: 'twice')
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from ..checks import integer
 from ..fe import FEModel
 from ..linalg import SPDFactor, check_factor
+from ..registry import Registry as BaseRegistry
 from .contact import Contact
 from .model import ReducedModel
 
@@ -74,8 +75,8 @@ class Entry:
     sized: bool = True
 
 
-class Registry(Sequence[str]):
-    """Named entries in registration order; a read-only sequence of their names.
+class Registry(BaseRegistry[Entry]):
+    """Reduction methods by name, in registration order; a read-only sequence of their names.
 
     Parameters
     ----------
@@ -83,61 +84,11 @@ class Registry(Sequence[str]):
         What an entry is, for messages (``"reduction method"``).
     """
 
-    def __init__(self, kind: str):
-        self.kind = kind
-        self._entries: dict[str, Entry] = {}
-
     def register(self, name: str, builder: Builder, summary: str, *, sized: bool = True) -> Entry:
         """Add an entry; ``ValueError`` for an empty or taken name or a builder that is not callable."""
-        if not isinstance(name, str) or not name:
-            raise ValueError(f"a {self.kind} name must be a non-empty string, got {name!r}")
-        if name in self._entries:
-            raise ValueError(f"{self.kind} {name!r} is already registered")
         if not callable(builder):
             raise ValueError(f"the builder of {self.kind} {name!r} must be callable, got {builder!r}")
-        entry = Entry(name, builder, str(summary), bool(sized))
-        self._entries[name] = entry
-        return entry
-
-    def unregister(self, name: str) -> Entry:
-        """Remove the entry called ``name`` and return it (``ValueError`` if there is none)."""
-        entry = self.entry(name)
-        del self._entries[name]
-        return entry
-
-    def entry(self, name) -> Entry:
-        """The entry called ``name``; ``ValueError`` listing the valid names otherwise."""
-        if name not in self:
-            valid = ", ".join(repr(m) for m in self)
-            raise ValueError(f"unknown {self.kind} {name!r} (valid: {valid})")
-        return self._entries[name]
-
-    def summaries(self) -> dict[str, str]:
-        """``{name: summary}`` in registration order."""
-        return {name: e.summary for name, e in self._entries.items()}
-
-    def __getitem__(self, index):
-        names = tuple(self._entries)
-        return names[index]
-
-    def __len__(self) -> int:
-        return len(self._entries)
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(tuple(self._entries))
-
-    def __contains__(self, name) -> bool:
-        return isinstance(name, str) and name in self._entries
-
-    def __eq__(self, other) -> bool:
-        if isinstance(other, (Registry, tuple, list)):
-            return tuple(self) == tuple(other)
-        return NotImplemented
-
-    __hash__ = None  # mutable
-
-    def __repr__(self) -> str:
-        return repr(tuple(self))
+        return self.add(Entry(name, builder, str(summary), bool(sized)))
 
 
 #: The reduction methods of :func:`reduce`, by name (filled by :mod:`bladecase.reduction.methods`).

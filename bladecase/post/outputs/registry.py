@@ -39,7 +39,7 @@ ValueError: unknown output format 'pdf' (valid: 'txt')
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -47,6 +47,7 @@ import numpy as np
 
 from ...fe import Mesh
 from ...nsm import Branch, PeriodicOrbit
+from ...registry import Registry
 
 SCOPES = ("run", "orbit")
 
@@ -107,44 +108,21 @@ class OrbitScene:
         return self.normal @ self.u[self.contact_node]
 
 
-class OutputRegistry:
+class OutputRegistry(Registry[Output]):
     """Output formats in registration order; iterating gives their names."""
 
-    kind = "output format"
-
     def __init__(self) -> None:
-        self._entries: dict[str, Output] = {}
+        super().__init__("output format")
 
     def register(self, name: str, writer: Writer, scope: str, summary: str) -> Output:
         """Add a format; ``ValueError`` for an empty or taken name, a bad scope, a writer that is not callable."""
         if not isinstance(name, str) or not name.isidentifier():
             raise ValueError(f"an {self.kind} name must be a plain word, got {name!r}")
-        if name in self._entries:
-            raise ValueError(f"{self.kind} {name!r} is already registered")
         if scope not in SCOPES:
             raise ValueError(f"scope of {self.kind} {name!r} must be one of {SCOPES}, got {scope!r}")
         if not callable(writer):
             raise ValueError(f"the writer of {self.kind} {name!r} must be callable, got {writer!r}")
-        entry = Output(name, writer, scope, str(summary))
-        self._entries[name] = entry
-        return entry
-
-    def unregister(self, name: str) -> Output:
-        """Remove the format called ``name`` and return it."""
-        entry = self.entry(name)
-        del self._entries[name]
-        return entry
-
-    def entry(self, name) -> Output:
-        """The format called ``name``; ``ValueError`` listing the valid names otherwise."""
-        if name not in self:
-            valid = ", ".join(repr(m) for m in self)
-            raise ValueError(f"unknown {self.kind} {name!r} (valid: {valid})")
-        return self._entries[name]
-
-    def summaries(self) -> dict[str, str]:
-        """``{name: summary}`` in registration order."""
-        return {name: e.summary for name, e in self._entries.items()}
+        return self.add(Output(name, writer, scope, str(summary)))
 
     def write(self, formats: Iterable[str], scope: str, scene, folder: Path) -> dict[str, str]:
         """Call each writer of the requested ``formats`` of ``scope`` once; merge what they return."""
@@ -157,15 +135,6 @@ class OutputRegistry:
         for writer, names in groups.items():
             written.update(writer(scene, Path(folder), names))
         return written
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(tuple(self._entries))
-
-    def __len__(self) -> int:
-        return len(self._entries)
-
-    def __contains__(self, name) -> bool:
-        return isinstance(name, str) and name in self._entries
 
     def __repr__(self) -> str:
         return f"OutputRegistry{tuple(self)!r}"
