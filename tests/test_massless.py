@@ -108,7 +108,7 @@ def test_non_admissible_orbits_are_told_apart():
     flags = [o.admissible for o in orbits]
     assert flags[1] and not all(flags)  # admissible near grazing, λ < 0 inside the contact further on
     bad = orbits[flags.index(False)]
-    _, closed = bad.proofs()
+    _, closed = bad.proofs
     assert not closed.certified and closed.value > 0  # d - y > 0 somewhere in the contact phase: λ < 0
 
 

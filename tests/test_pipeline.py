@@ -45,7 +45,9 @@ def tiny_demo():
     c["geometry"].update(size=0.01, tip_size=0.005)
     c["reduction"]["size"] = 6
     c["search"]["scan"] = 4
-    c["output"].update(frames=FRAMES, window=list(WINDOW), manifold_size=[10, 16])
+    # rendering tests: the Newton orbits of a 6-dof Lanczos model do not survive in a reference model
+    # (tests/test_reference.py), so the reference check is off here
+    c["output"].update(frames=FRAMES, window=list(WINDOW), manifold_size=[10, 16], reference=False)
     return validate(as_raw(c), source="<tiny demo>")
 
 
@@ -228,6 +230,7 @@ PLATE = PLATE_BASE.replace("size = 10\n", 'size = 10\ncompare = [{method = "lanc
 frames = 10
 window = [240, 180]
 formats = ["gif", "vtu", "png"]
+reference = false  # rendering tests; the reference check is tested in tests/test_reference.py
 """
 
 

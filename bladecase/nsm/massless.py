@@ -35,6 +35,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from .signals import TrigSum, first_upcrossing
+from .system import INACTIVE_RTOL, Spectrum
 
 #: Largest interior size handled (dense eigenproblems of both phases).
 MASSLESS_DENSE_LIMIT = 4000
@@ -130,6 +131,12 @@ class MasslessSystem:
         """Closed phase: ``M x'' + (S + k_c ŵŵᵀ) x = k_c d ŵ``."""
         return _phase(self.M, self.S + self.kc * np.outer(self.w, self.w), self.kc * self.gap * self.w, self.w,
                       "closed")
+
+    @cached_property
+    def spectrum(self) -> Spectrum:
+        """The open-phase modes (contact free): the linear modes from which the nonsmooth modes grow."""
+        o = self.open
+        return Spectrum(o.omega, o.phi, o.b, np.abs(o.b) > INACTIVE_RTOL * np.abs(o.b).max())
 
     @cached_property
     def transfer(self) -> np.ndarray:

@@ -16,7 +16,8 @@ The closing condition leaves ONE scalar equation ``r(α, β) = b_oᵀ diag(cos �
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 import scipy.linalg as sla
@@ -30,14 +31,80 @@ ADMISSIBILITY_RTOL = 1e-9
 
 @dataclass(frozen=True, eq=False)
 class SymmetricOrbit:
-    """A symmetric periodic orbit with one contact phase: open ``2α``, closed ``2β``, mid-open state ``(Φ_o a, 0)``."""
+    """A symmetric periodic orbit with one contact phase: open ``2α``, closed ``2β``, mid-open state ``(Φ_o a, 0)``.
 
-    system: MasslessSystem
+    Time origin: the contact closes at ``t = 0`` (``≡ T``) and opens at ``t = 2β``. The record reads like a
+    :class:`~bladecase.nsm.PeriodicOrbit` for branches, plots and reports: ``impact_times = [T]`` (the closing
+    instant), ``impulses = [∫λ dt]`` (the momentum the casing transfers during the contact phase),
+    ``max_violation`` (the largest ``y - d`` over the open phase, ``<= 0`` when admissible). Pickles without its
+    system (:meth:`bind` re-attaches one).
+    """
+
+    system: MasslessSystem | None = field(repr=False)
     alpha: float
     beta: float
-    a: np.ndarray
+    a: np.ndarray = field(repr=False)
 
     k = 1
+    repeats = 1
+    stable = None
+    multipliers = None
+    contact_model = "massless"
+
+    def __getstate__(self) -> dict:
+        state = dict(self.__dict__)
+        state["system"] = None
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+
+    def _bound(self) -> MasslessSystem:
+        if self.system is None:
+            raise ValueError("this orbit is not bound to a system (it was unpickled): call orbit.bind(system)")
+        return self.system
+
+    def bind(self, system: MasslessSystem) -> SymmetricOrbit:
+        """This orbit attached to ``system`` (a copy)."""
+        if not isinstance(system, MasslessSystem):
+            raise ValueError(f"bind needs a MasslessSystem, got {type(system).__name__}")
+        return SymmetricOrbit(system, self.alpha, self.beta, self.a)
+
+    @property
+    def impact_times(self) -> np.ndarray:
+        """``[T]``: the contact closes at ``t = 0 ≡ T`` (the convention of the Newton orbits' last impact)."""
+        return np.array([self.T])
+
+    @cached_property
+    def impulses(self) -> np.ndarray:
+        """``[∫λ dt]`` over the closed phase (exact: ``λ = k_c (y - d)`` is a trigonometric sum)."""
+        s = self._bound()
+        x1, v1 = self.closing_state()
+        y = s.closed.contact(x1, v1)
+        tau, om = 2 * self.beta, y.omega
+        safe = np.where(om > 0, om, 1.0)
+        integral = (y.const - s.gap) * tau + np.sum(np.where(om > 0, (y.alpha * np.sin(om * tau)
+                                                                      + y.beta * (1 - np.cos(om * tau))) / safe,
+                                                             y.alpha * tau))
+        return np.array([s.kc * float(integral)])
+
+    @property
+    def max_violation(self) -> float:
+        """Largest ``y - d`` found over the open phase (``<= 0`` up to the tolerance when admissible)."""
+        return float(self.proofs[0].value)
+
+    def to_dict(self) -> dict:
+        """Plain-data record (JSON-ready); :meth:`from_dict` reads it back."""
+        return {"T": self.T, "frequency": self.frequency, "ipp": 1, "contact_model": "massless",
+                "alpha": self.alpha, "beta": self.beta, "a": self.a.tolist(), "contact_time": self.contact_time,
+                "impact_times": self.impact_times.tolist(), "impulses": self.impulses.tolist(),
+                "energy": self.energy, "admissible": self.admissible, "max_violation": self.max_violation,
+                "repeats": 1, "stable": None, "multipliers": None}
+
+    @classmethod
+    def from_dict(cls, system: MasslessSystem | None, data: dict) -> SymmetricOrbit:
+        """The orbit back from :meth:`to_dict` (its state is exact: it is re-flown from ``α, β, a``)."""
+        return cls(system, float(data["alpha"]), float(data["beta"]), np.asarray(data["a"], dtype=float))
 
     @property
     def T(self) -> float:
@@ -57,9 +124,9 @@ class SymmetricOrbit:
     def x_mid_open(self) -> np.ndarray:
         return self.system.open.phi @ self.a
 
-    @property
+    @cached_property
     def energy(self) -> float:
-        return self.system.energy(self.x_mid_open, np.zeros(self.system.n))
+        return self._bound().energy(self.x_mid_open, np.zeros(self.system.n))
 
     def band_energy(self, modes: int) -> float:
         """Energy held by the lowest ``modes`` open-phase modes (at mid-open, where ``v = 0`` and ``λ = 0``).
@@ -88,9 +155,11 @@ class SymmetricOrbit:
                 s.open.advance(x2, v2, tj - 2 * self.beta)
         return X, V
 
+    @cached_property
     def proofs(self):
         """Certified ``max(y - d)`` over the open phase and ``max(d - y)`` over the closed phase."""
-        s, d = self.system, self.system.gap
+        s = self._bound()
+        d = s.gap
         tol = ADMISSIBILITY_RTOL * d
         y = s.open.contact(self.x_mid_open, np.zeros(s.n))
         open_ = certified_max(TrigSum(y.alpha, y.beta, y.omega, y.const - d), self.alpha, tol)
@@ -103,7 +172,7 @@ class SymmetricOrbit:
     @property
     def admissible(self) -> bool:
         """``y <= d`` throughout the open phase and ``λ >= 0`` throughout the closed phase (proved)."""
-        o, c = self.proofs()
+        o, c = self.proofs
         return bool(o.certified and c.certified)
 
 

@@ -31,6 +31,8 @@ def verify(orbit: PeriodicOrbit) -> dict:
     >>> check["ok"], check["impacts"], check["return_error"] < 1e-12
     (True, 1, True)
     """
+    if getattr(orbit, "contact_model", "newton") == "massless":
+        return _verify_massless(orbit)
     T, k = orbit.T, orbit.k
     x0, v0 = orbit.state(np.array([0.0]))
     x0, v0 = x0[:, 0], v0[:, 0]
@@ -47,3 +49,21 @@ def verify(orbit: PeriodicOrbit) -> dict:
     err = max(np.abs(traj.x[:, last] - x0).max() / sx, np.abs(traj.v[:, last] - v0).max() / sv,
               abs(traj.impact_times[last] - T) / T)
     return {"return_error": float(err), "impacts": int(hits.size), "ok": bool(err <= VERIFY_RTOL and hits.size == k)}
+
+
+def _verify_massless(orbit) -> dict:
+    """The massless model's check: from the orbit's state at mid-contact, one period of
+    :func:`~bladecase.nsm.massless.simulate_massless` must come back with one opening and one closing."""
+    from .massless import simulate_massless
+
+    T = orbit.T
+    x0, v0 = (z[:, 0] for z in orbit.state(np.array([orbit.beta])))  # mid-contact: no switch at t = 0
+    try:
+        traj = simulate_massless(orbit.system, x0, v0, T)
+    except ValueError as exc:
+        return {"return_error": float("inf"), "impacts": 0, "ok": False, "reason": str(exc)}
+    sx = max(float(np.abs(x0).max()), 1e-300)
+    sv = max(float(np.abs(orbit.state(np.linspace(0, T, 16))[1]).max()), 1e-300)  # v0 may be ~0 at mid-contact
+    err = max(np.abs(traj.x_end - x0).max() / sx, np.abs(traj.v_end - v0).max() / sv)
+    closings = sum(p == "closed" for p in traj.phases)
+    return {"return_error": float(err), "impacts": int(closings), "ok": bool(err <= VERIFY_RTOL and closings == 1)}

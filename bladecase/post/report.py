@@ -55,6 +55,12 @@ def report(summary: dict) -> str:
                          f"{f['frequency_range_hz'][1]:.3f} | {a['f_lo']:.4f} – {a['f_hi']:.4f} | "
                          f"{a['energy_range_j'][0]:.3e} – {a['energy_range_j'][1]:.3e} |")
     files = summary["files"]
+    if summary.get("reference") and not files.get("animations"):
+        ref = summary["reference"]
+        lines += ["", f"**No orbit animated:** no admissible orbit of the {r['method']} model that was tried survives "
+                  f"in the reference model {ref['method']} ({ref['reduced_dofs']} dofs) — the families above are "
+                  "artefacts of the reduced model (see run.log); enlarge or change the reduced model, or use the "
+                  "massless contact model."]
     lines += ["", "## Files", ""]
     if "frequency_energy_plot" in files:
         lines += [f"![frequency–energy]({files['frequency_energy_plot']})", ""]
@@ -67,7 +73,18 @@ def report(summary: dict) -> str:
                      f"Hz, E = {a['energy_j']:.3e} J, impacts at t/T = "
                      f"{phases}, displacements × {a['scale']:.4g}; event-driven simulation returns to it to "
                      f"{check['return_error']:.1e}{'' if check['ok'] else ' — CHECK FAILED'}): {what}")
+        if "reference_check" in a:
+            lines.append(f"  - {_reference_words(a['reference_check'], a['ipp'])}")
         if "gif" in a:
             lines.append(f"\n  ![{a['gif']}]({a['gif']})\n")
     lines += ["", "Timings (s): " + ", ".join(f"{k} {v:.2f}" for k, v in summary["timings_s"].items()), ""]
     return "\n".join(lines)
+
+
+def _reference_words(check: dict, k: int) -> str:
+    where = f"in the reference model {check['reference']}"
+    if check["survives"]:
+        return f"Survives {where}: one period later it is back within {check['drift']:.1%} (energy norm)."
+    return (f"**Does not survive** {where}: after one period it has drifted by {check['drift']:.1%} (energy norm), "
+            f"with {check['contacts']} contact(s) for {k} — an artefact of the reduced model, animated only because "
+            "it was asked for in [output] orbits.")

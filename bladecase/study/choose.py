@@ -3,6 +3,7 @@ admissible arcs; frames with one frame on each impact instant."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -32,8 +33,14 @@ def _admissible_at(fam: Branch, T: float) -> PeriodicOrbit | None:
     return hits[0] if hits else None
 
 
-def choose_orbits(study: Study, families: list[Branch], unit: float) -> list[Choice]:
-    """The orbits to animate: ``[output] orbits`` if given, else the middles of the widest arcs."""
+def choose_orbits(study: Study, families: list[Branch], unit: float,
+                  accept: Callable[[PeriodicOrbit], bool] | None = None) -> list[Choice]:
+    """The orbits to animate: ``[output] orbits`` if given, else the middles of the widest arcs.
+
+    ``accept``: a further test of an automatically chosen orbit (e.g. that it survives in a reference model);
+    an orbit it rejects is not animated and the next arc is tried. Orbits named in ``[output] orbits`` are
+    animated whatever it says (the caller flags them).
+    """
     o = study["output"]
     chosen: list[Choice] = []
     if o["orbits"]:
@@ -75,6 +82,8 @@ def choose_orbits(study: Study, families: list[Branch], unit: float) -> list[Cho
             if not candidates:
                 continue
             orbit = candidates[len(candidates) // 2]
+        if accept is not None and not accept(orbit):
+            continue
         chosen.append(Choice(i, orbit))
     return chosen
 

@@ -16,6 +16,7 @@ from ..progress import progress_bar
 from ..reduction import ReducedModel
 from .choose import Choice, choose_orbits, frame_times
 from .publish import publish, staging_dir
+from .reference import check_in_reference, log_check, reference_model
 from .schema import Study
 from .stages import period_unit
 
@@ -39,10 +40,12 @@ def orbit_scene(study: Study, reduced: ReducedModel, families: list[Branch], cho
                       branch=families[choice.family])
 
 
-def render(study: Study, reduced: ReducedModel, families: list[Branch], choice: Choice, folder: Path) -> dict:
-    """Check one chosen orbit by simulation and write its orbit-scope outputs into ``folder``.
+def render(study: Study, reduced: ReducedModel, families: list[Branch], choice: Choice, folder: Path,
+           reference: ReducedModel | None = None) -> dict:
+    """Check one chosen orbit by simulation (in its own model, and in ``reference`` if given) and write its
+    orbit-scope outputs into ``folder``.
 
-    Returns its ``summary.json`` entry: period, energy, impacts, the check, the files written.
+    Returns its ``summary.json`` entry: period, energy, impacts, the checks, the files written.
     """
     scene = orbit_scene(study, reduced, families, choice)
     orbit = scene.orbit
@@ -51,6 +54,9 @@ def render(study: Study, reduced: ReducedModel, families: list[Branch], choice: 
              "energy_j": orbit.energy, "impact_times": orbit.impact_times.tolist(),
              "impulses": orbit.impulses.tolist(), "scale": scene.scale, "frames": int(scene.times.size),
              "verification": check}
+    if reference is not None:
+        entry["reference_check"] = check_in_reference(orbit, reduced, reference)
+        log_check(entry["reference_check"], orbit.k, orbit.T)
     if not check["ok"]:
         log.warning("orbit T = %.8g s failed the independent check (simulation from its post-impact state: "
                     "return error %.2e, %d impacts for %d): animated anyway, flagged in summary.json", orbit.T,
@@ -62,13 +68,28 @@ def render(study: Study, reduced: ReducedModel, families: list[Branch], choice: 
 
 
 def render_all(study: Study, reduced: ReducedModel, families: list[Branch], folder: Path,
-               progress: bool = False) -> list[dict]:
-    """Choose the orbits (:func:`~bladecase.study.choose.choose_orbits`) and render each."""
+               progress: bool = False, reference: ReducedModel | None = None) -> list[dict]:
+    """Choose the orbits (:func:`~bladecase.study.choose.choose_orbits`; with a ``reference`` model, only
+    orbits that survive there) and render each."""
     unit, _ = period_unit(study, reduced.system)
-    chosen = choose_orbits(study, families, unit)
+    rejected: list = []
+
+    def survives(orbit) -> bool:
+        ok = check_in_reference(orbit, reduced, reference)["survives"]
+        if not ok:
+            rejected.append(orbit)
+        return ok
+
+    chosen = choose_orbits(study, families, unit, accept=None if reference is None else survives)
+    if rejected:
+        log.warning("%d admissible orbit(s) of the %s model were not animated: they do not survive in the "
+                    "reference model %s (%d dofs) — artefacts of the reduced model", len(rejected),
+                    reduced.method, reference.method, reference.n)
     if not chosen:
-        log.warning("no admissible orbit to animate: widen [search] periods or add ipp values")
-    return [render(study, reduced, families, c, folder)
+        log.warning("no admissible orbit to animate%s: widen [search] periods, add ipp values%s",
+                    " that survives in the reference model" if reference is not None else "",
+                    ", or enlarge/change the reduced model" if reference is not None else "")
+    return [render(study, reduced, families, c, folder, reference)
             for c in progress_bar(chosen, "animations", enabled=progress, unit="orbit")]
 
 
@@ -82,7 +103,8 @@ def animate_families(study: Study, reduced: ReducedModel, families: list[Branch]
     out = study.output_dir(out)
     staging = staging_dir(out)
     try:
-        entries = render_all(study, reduced, families, staging, progress)
+        reference = reference_model(reduced.model, reduced.contact, reduced) if study["output"]["reference"] else None
+        entries = render_all(study, reduced, families, staging, progress, reference)
         publish(staging, out, ("animations", "vtk"))
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)

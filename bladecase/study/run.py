@@ -25,6 +25,7 @@ from ..progress import progress_counter
 from .documents import contact_summary, families_document, family_summary, model_summary, reduced_summary
 from .executor import Executor, SerialExecutor
 from .publish import RUN_RESULTS, publish, staging_dir
+from .reference import reference_model
 from .render import render_all
 from .schema import Study
 from .stages import build_contact, build_mesh, build_model, build_reduced, period_unit, search
@@ -118,6 +119,9 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
                  np.round(mesh.points[contact.node], 6).tolist(), np.round(contact.normal_for(model), 6).tolist(),
                  contact.gap)
         log.info("reduced model: %s", reduced)
+        reference = reference_model(model, contact, reduced, factor) if o["reference"] else None
+        if reference is not None:
+            log.info("reference model for the orbits' check: %s", reference)
     with stage("search"):
         unit, _ = period_unit(study, reduced.system)
         found = executor.map(lambda r: search(study, r.system, progress=progress, unit=unit), [reduced, *compares],
@@ -130,7 +134,7 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
                                        zip([reduced, *compares], found)], f_fe)
         files.update(FORMATS.write(o["formats"], "run", scene, staging))
     with stage("render"):
-        files["animations"] = render_all(study, reduced, families, staging, progress)
+        files["animations"] = render_all(study, reduced, families, staging, progress, reference)
     files["log"] = "run.log"
     from .. import __version__
 
@@ -140,6 +144,7 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
                                else str(study.mesh_path())),
         "contact": contact_summary(contact, model),
         "reduction": reduced_summary(reduced, f_fe),
+        "reference": None if reference is None else reduced_summary(reference, f_fe),
         "compare": [dict(reduced_summary(r, f_fe), families=[family_summary(f) for f in fams])
                     for r, fams in zip(compares, compare_families)],
         "search": {**study["search"], "period_unit_s": unit},

@@ -213,6 +213,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
                        "widest admissible arcs, one per family.", _int_at_least(0)),
         "orbits": Key(_LIST, [], "Orbits to animate: [{ipp = 1, T = 0.95}, …], T in search.period_unit "
                       "(the nearest admissible orbit of a family of that ipp).", _orbit_list),
+        "reference": Key(_BOOL, True, "Check each chosen orbit in a reference model (another reduction method, "
+                         "4 times the size): an orbit that does not survive there is not animated (unless named "
+                         "in 'orbits', then it is flagged), and the report says so."),
         "frames": Key(_INT, 40, "Frames per period of the animations and VTK time series.", _int_at_least(2)),
         "scale": Key((str, int, float), "auto", "Amplitude scale of the animations, or 'auto' (largest "
                      "displacement drawn at 'auto_fraction' of the blade's bounding-box diagonal).", _scale),

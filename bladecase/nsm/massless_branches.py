@@ -1,0 +1,113 @@
+"""Nonsmooth modes of the massless contact model as :class:`~bladecase.nsm.Branch` es.
+
+Each branch grows from an open-phase linear mode at grazing (contact time ``2β → 0``, ``T → 2π/ω_j``) and is
+followed by pseudo-arclength continuation of the closing residual in ``(α, β)`` with its exact gradient
+(:func:`~bladecase.nsm.massless_orbits.follow_from_grazing`), through folds in ``T`` on the same branch. Its
+admissible arcs are the maximal runs of certified admissible orbits; their ends are refined by bisection along
+the curve. The branch is the same type as the Newton modes': plots, reports, files and animations take it as is.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .massless import MasslessSystem
+from .massless_orbits import SymmetricOrbit, _correct, closing_residual, follow_from_grazing, orbit_at_period
+
+#: Relative precision (of ``T``) of the admissible arcs' ends.
+ARC_RTOL = 1e-9
+
+
+def massless_modes(system: MasslessSystem, T_range: tuple[float, float], max_points: int = 400,
+                   refine: bool = True, ds: float = 1e-3, ds_max: float = 0.02) -> list:
+    """The one-contact-phase branches of ``system`` in ``T_range``: one per open-phase mode whose linear period
+    ``2π/ω_j`` is at least ``T_range[0]``, kept from where it enters the range until it leaves it.
+
+    Branches are ordered by mode; a branch that never enters the range is left out.
+    """
+    from .branches import Arc, Branch
+
+    T_lo, T_hi = T_range
+    out = []
+    for j in np.flatnonzero(2 * np.pi / system.open.omega >= T_lo):
+        if abs(system.open.b[j]) <= 1e-12 * np.abs(system.open.b).max():
+            continue  # the contact does not see this mode: no branch grows from it
+        orbits = follow_from_grazing(system, T_lo, mode=int(j), ds=ds, ds_max=ds_max,
+                                     max_points=max_points + _entry(system, j, T_hi))
+        Ts = np.array([o.T for o in orbits])
+        inside = np.flatnonzero((Ts >= T_lo) & (Ts <= T_hi))
+        if inside.size < 2:
+            continue
+        orbits = orbits[inside[0]: inside[0] + max_points]
+        orbits = orbits[: _first_exit(np.array([o.T for o in orbits]), T_lo, T_hi)]
+        if len(orbits) >= 2:
+            out.append(Branch(system, 1, orbits, [Arc(*a) for a in _arcs(system, orbits, refine)]))
+    return out
+
+
+def _entry(system: MasslessSystem, j: int, T_hi: float) -> int:
+    """Points to allow for the stretch above ``T_hi`` (grazing at ``2π/ω_j`` may lie above the range)."""
+    return 0 if 2 * np.pi / system.open.omega[j] <= T_hi else 2000
+
+
+def _first_exit(T: np.ndarray, T_lo: float, T_hi: float) -> int:
+    out = np.flatnonzero((T < T_lo) | (T > T_hi))
+    return int(out[0]) if out.size else T.size
+
+
+def _arcs(system: MasslessSystem, orbits: list[SymmetricOrbit], refine: bool) -> list[tuple]:
+    """``(start, stop, T_lo, T_hi, refined_lo, refined_hi)`` of every maximal admissible run."""
+    adm = np.array([o.admissible for o in orbits], dtype=bool)
+    arcs = []
+    i = 0
+    while i < adm.size:
+        if not adm[i]:
+            i += 1
+            continue
+        j = i
+        while j + 1 < adm.size and adm[j + 1]:
+            j += 1
+        ends = [orbits[i].T, orbits[j].T]
+        ref_lo, ref_hi = refine and i > 0, refine and j + 1 < adm.size
+        if ref_lo:
+            ends[0] = _edge(system, orbits[i - 1], orbits[i]).T
+        if ref_hi:
+            ends[1] = _edge(system, orbits[j + 1], orbits[j]).T
+        Ts = [o.T for o in orbits[i: j + 1]] + ends
+        arcs.append((i, j, min(Ts), max(Ts), ref_lo, ref_hi))
+        i = j + 1
+    return arcs
+
+
+def _edge(system: MasslessSystem, bad: SymmetricOrbit, good: SymmetricOrbit) -> SymmetricOrbit:
+    """The last admissible orbit between ``good`` and ``bad`` (bisection along the curve, to :data:`ARC_RTOL`)."""
+    zb, zg = np.array([bad.alpha, bad.beta]), np.array([good.alpha, good.beta])
+    best = good
+    for _ in range(60):
+        z, ok, _ = _correct(system, 0.5 * (zb + zg))
+        if not ok:
+            break
+        a, _ = closing_residual(system, *z)
+        mid = SymmetricOrbit(system, z[0], z[1], a)
+        if mid.admissible:
+            zg, best = z, mid
+        else:
+            zb = z
+        if abs(2 * (zb - zg).sum()) <= ARC_RTOL * best.T:
+            break
+    return best
+
+
+def massless_orbit_at(system: MasslessSystem, orbits: list[SymmetricOrbit], T: float) -> list[SymmetricOrbit]:
+    """The orbits of period ``T`` on a massless branch (one per crossing), each solved by Newton from the
+    interpolated contact half-time of its neighbours."""
+    out = []
+    for o1, o2 in zip(orbits[:-1], orbits[1:]):
+        lo, hi = sorted((o1.T, o2.T))
+        if o1 is None or o2 is None or not lo <= T <= hi or hi == lo:
+            continue
+        s = (T - o1.T) / (o2.T - o1.T)
+        orbit = orbit_at_period(system, T, (1 - s) * o1.beta + s * o2.beta)
+        if orbit is not None:
+            out.append(orbit)
+    return out

@@ -1,0 +1,99 @@
+"""Verification in a richer model: does a reduced model's orbit exist in the structure it stands for?
+
+The event-driven check of :mod:`bladecase.nsm.verify` re-simulates an orbit in the model that produced it, so it
+cannot see a reduction artefact (an orbit whose energy sits in a mesh-scale Ritz mode). Here the orbit is
+expanded to the FE model's free dofs, projected onto a *reference* model — a reduced model of another method and
+at least :data:`REFERENCE_FACTOR` times the size (or the full model when it is small enough) — and simulated
+there for one period from a state in an open phase. The drift between where it starts and where it is one period
+later, in the reference's energy norm, says whether the orbit survives:
+
+    drift = ‖z(T) − z(0)‖_E / ‖z(0)‖_E,   ‖(x, v)‖²_E = xᵀK x + vᵀM v.
+
+It is ``~1e-10`` for an orbit of the reference itself, a few percent where the reduced model is converged, and
+of order one when the orbit does not exist in the structure.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import log
+from ..fe import FEModel
+from ..linalg import SPDFactor
+from ..reduction import METHODS, Contact, ReducedModel, reduce
+
+#: The reference model is at least this many times larger than the model it checks.
+REFERENCE_FACTOR = 4
+
+#: Largest drift (energy norm, relative) for which an orbit is said to survive in the reference model.
+SURVIVAL_RTOL = 0.05
+
+#: Reference methods, in order of preference, for each contact model (the first one unlike the checked model).
+REFERENCE_METHODS = {"newton": ("modal", "craig-bampton", "lanczos-si"), "massless": ("massless",)}
+
+
+def reference_model(model: FEModel, contact: Contact, reduced: ReducedModel,
+                    factor: SPDFactor | None = None) -> ReducedModel:
+    """A reduced model of another method (when the contact model offers one) and ``REFERENCE_FACTOR`` × the size."""
+    contact_model = getattr(reduced.system, "contact_model", "newton")
+    methods = [m for m in REFERENCE_METHODS[contact_model] if m in METHODS]
+    method = next((m for m in methods if m != reduced.method), methods[0])
+    size = min(REFERENCE_FACTOR * max(reduced.size, reduced.n), model.n_dofs // 2)
+    return reduce(model, contact, method, size, factor=factor)
+
+
+def _project(reference: ReducedModel, x_free: np.ndarray) -> np.ndarray:
+    """Reference coordinates of free-dof vectors: the M-orthogonal projection onto the reference's basis."""
+    V, M = reference.basis, reference.model.M
+    MV = M @ V
+    return np.linalg.solve(np.asarray(V.T @ MV), np.asarray(MV.T @ x_free))
+
+
+def check_in_reference(orbit, reduced: ReducedModel, reference: ReducedModel) -> dict:
+    """Expand ``orbit`` (of ``reduced.system``), project it onto ``reference``, simulate one period there.
+
+    Returns ``{"reference": "<method> (<n> dofs)", "drift": relative drift in the energy norm,
+    "contacts": impacts or contact phases in the period (the orbit has ``orbit.k``), "survives": bool}``.
+    """
+    from ..nsm import simulate
+    from ..nsm.massless import simulate_massless
+
+    massless = getattr(orbit, "contact_model", "newton") == "massless"
+    t0 = 2 * orbit.beta + orbit.alpha if massless else 0.5 * float(np.diff(np.r_[0.0, orbit.impact_times]).min())
+    x_r, v_r = (z[:, 0] for z in orbit.state(np.array([t0])))  # in an open phase: no switch at the start
+    q0 = _project(reference, reduced.free_dofs(x_r))
+    p0 = _project(reference, reduced.free_dofs(v_r))
+    s = reference.system
+    penetration = float(s.w @ q0) - s.gap
+    if penetration > 0:  # the reference's contact sees more of the motion: it starts beyond the casing
+        return {"reference": f"{reference.method} ({reference.n} dofs)", "drift": float("inf"), "contacts": 0,
+                "survives": False, "reason": f"its expanded state lies beyond the casing of the reference model "
+                                             f"by {penetration / s.gap:.1%} of the clearance in an open phase"}
+    if massless:
+        traj = simulate_massless(s, q0, p0, orbit.T)
+        contacts = sum(p == "closed" for p in traj.phases)
+        K = s.S
+    else:
+        traj = simulate(s, q0, p0, orbit.T)
+        contacts = int(traj.impact_times.size)
+        K = s.K
+    M = s.M
+
+    def norm2(x, v):
+        return float(x @ (K @ x) + v @ (M @ v))
+
+    drift = np.sqrt(norm2(traj.x_end - q0, traj.v_end - p0) / norm2(q0, p0))
+    survives = bool(drift <= SURVIVAL_RTOL and contacts == orbit.k)
+    return {"reference": f"{reference.method} ({reference.n} dofs)", "drift": float(drift), "contacts": contacts,
+            "survives": survives}
+
+
+def log_check(check: dict, k: int, T: float) -> None:
+    """The check in words, in the run's log (a warning when the orbit does not survive)."""
+    if check["survives"]:
+        log.info("orbit T = %.8g s survives in the reference model %s: back within %.1e (energy norm) after one "
+                 "period", T, check["reference"], check["drift"])
+    else:
+        log.warning("orbit T = %.8g s does NOT survive in the reference model %s: drift %.1e (energy norm), %d "
+                    "contact(s) for %d — an artefact of the reduced model", T, check["reference"], check["drift"],
+                    check["contacts"], k)
