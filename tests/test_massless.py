@@ -171,3 +171,27 @@ def test_band_limited_energy_of_the_bar_mode_converges_to_the_continuum():
     assert orders.min() >= 1.5, (errors, orders)
     assert errors[-1] <= 0.01
     assert min(totals) > 0.10  # the total energy does not converge: say so, do not hide it
+
+
+def test_nonsmooth_mode_api_on_the_massless_bar():
+    """The API contract: ``nonsmooth_mode(bar(...), k=1, T_range)`` gives the branch type whose ``orbit_at(T)``
+    returns orbits with ``.T``, ``.energy``, ``.admissible``, ``.state(t)``; records and pickles are light."""
+    import pickle
+
+    import bladecase as bc
+
+    s = bc.bar(20, 0.5, contact="massless")
+    (branch,) = bc.nonsmooth_mode(s, k=1, T_range=(3.8, 4.1))
+    assert isinstance(branch, bc.Branch) and branch.k == 1 and len(branch.arcs) >= 1
+    arc = branch.arcs[0]
+    assert arc.T_hi == pytest.approx(4.0, abs=0.01) and arc.refined_hi
+    (orbit,) = [o for o in branch.orbit_at(3.95) if o.admissible]
+    assert orbit.T == 3.95 and orbit.state(np.array([0.0, 1.0]))[0].shape == (s.n, 2)
+    # within 10 % of the continuum (the discrete branch's energy is not the converging measure: docs/massless.md)
+    assert orbit.energy == pytest.approx(bc.nsm.bar_continuum_energy(3.95, 0.5), rel=0.1)
+    assert bc.verify(orbit)["ok"]
+    back = bc.Branch.from_dict(s, branch.to_dict())
+    assert back.arcs == branch.arcs and np.allclose(back.energy, branch.energy, rtol=1e-12)
+    assert len(pickle.dumps(orbit)) < 4000 and pickle.loads(pickle.dumps(orbit)).system is None
+    with pytest.raises(ValueError, match="one contact phase per period"):
+        bc.nonsmooth_mode(s, k=2, T_range=(3.8, 4.1))

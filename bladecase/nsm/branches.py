@@ -26,6 +26,9 @@ __all__ = ["ARC_RTOL", "MERGE_RTOL", "Arc", "Backbone", "Branch", "Family", "Int
 
 SPACINGS = ("index", "state", "period")
 
+#: Least point budget of a massless branch: its steps are short where the contact time grows fast.
+MASSLESS_MIN_POINTS = 4000
+
 
 @dataclass(frozen=True)
 class Arc:
@@ -199,6 +202,10 @@ class Branch:
         [(13.5, 6.082917, True)]
         """
         system = self._bound()
+        if getattr(system, "contact_model", "newton") == "massless":
+            from .massless_branches import massless_orbit_at
+
+            return massless_orbit_at(system, self.orbits, float(T))
         out = []
         Ts = self.T
         T = check_period(system, T)
@@ -328,7 +335,7 @@ class Branch:
                 raise ValueError(f"the branch was computed on a system of {n} dofs, this one has {system.n}")
             orbits, periods = [], []
             for rec in data["orbits"]:
-                orbit = None if rec.get("resonant") else PeriodicOrbit.from_dict(system, rec)
+                orbit = None if rec.get("resonant") else _orbit_from_dict(system, rec)
                 orbits.append(orbit)
                 periods.append(float(rec["T"]))
             if "arcs" in data:
@@ -381,6 +388,15 @@ def _interval_arc(iv: dict, periods: list[float], orbits: list) -> Arc:
     return Arc(idx[0], idx[-1], float(iv["T_lo"]), float(iv["T_hi"]), bool(iv["refined_lo"]), bool(iv["refined_hi"]))
 
 
+def _orbit_from_dict(system, rec: dict):
+    """An orbit record of either contact model (``contact_model`` key; Newton when absent)."""
+    if rec.get("contact_model") == "massless":
+        from .massless_orbits import SymmetricOrbit
+
+        return SymmetricOrbit.from_dict(system, rec)
+    return PeriodicOrbit.from_dict(system, rec)
+
+
 #: Former names: the continuation family and the 1-ipp scan are one type now.
 Family = Branch
 Backbone = Branch
@@ -403,9 +419,13 @@ def nonsmooth_mode(
 
     Parameters
     ----------
-    system : LinearSystem
+    system : LinearSystem or MasslessSystem
+        A Newton-contact system, or a massless-contact one (:class:`~bladecase.nsm.MasslessSystem`, from
+        :func:`~bladecase.nsm.bar` or a massless reduced model): then ``k = 1`` (one contact phase per
+        period) and each branch grows from an open-phase linear mode at grazing
+        (:mod:`~bladecase.nsm.massless_branches`).
     k : int
-        Impacts per period (>= 1).
+        Impacts (contact phases) per period (>= 1).
     T_range : (T_min, T_max)
         Periods of interest; the curves are followed until they leave it.
     scan : int
@@ -448,6 +468,13 @@ def nonsmooth_mode(
     T_lo, T_hi = (float(x) for x in T_range)
     if not (np.isfinite(T_lo) and np.isfinite(T_hi)) or not 0 < T_lo < T_hi:
         raise ValueError(f"T_range must be (T_min, T_max) with 0 < T_min < T_max, got {T_range!r}")
+    if getattr(system, "contact_model", "newton") == "massless":
+        if k != 1:
+            raise ValueError(f"the massless contact model has modes with one contact phase per period (k = 1) "
+                             f"so far; got k = {k}")
+        from .massless_branches import massless_modes
+
+        return massless_modes(system, (T_lo, T_hi), max_points=max(max_points, MASSLESS_MIN_POINTS), refine=refine)
     if k == 1:
         from .scan import backbone
 

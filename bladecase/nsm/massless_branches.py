@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import log
 from .massless import MasslessSystem
 from .massless_orbits import SymmetricOrbit, _correct, closing_residual, follow_from_grazing, orbit_at_period
 
@@ -39,7 +40,12 @@ def massless_modes(system: MasslessSystem, T_range: tuple[float, float], max_poi
         if inside.size < 2:
             continue
         orbits = orbits[inside[0]: inside[0] + max_points]
-        orbits = orbits[: _first_exit(np.array([o.T for o in orbits]), T_lo, T_hi)]
+        exit_ = _first_exit(np.array([o.T for o in orbits]), T_lo, T_hi)
+        if exit_ == len(orbits) and len(orbits) == max_points:
+            log.info("massless branch of open mode %d: the point budget (%d) ran out at T = %.6g, inside the range "
+                     "[%.6g, %.6g] (the branch winds through internal resonances); raise max_points to follow it "
+                     "further", j + 1, max_points, orbits[-1].T, T_lo, T_hi)
+        orbits = orbits[:exit_]
         if len(orbits) >= 2:
             out.append(Branch(system, 1, orbits, [Arc(*a) for a in _arcs(system, orbits, refine)]))
     return out
