@@ -90,7 +90,7 @@ def _edge(system: MasslessSystem, bad: SymmetricOrbit, good: SymmetricOrbit) -> 
     zb, zg = np.array([bad.alpha, bad.beta]), np.array([good.alpha, good.beta])
     best = good
     for _ in range(60):
-        z, ok, _ = _correct(system, 0.5 * (zb + zg))
+        z, ok, _ = _correct(system, 0.5 * (zb + zg), good.T / 4)
         if not ok:
             break
         a, _ = closing_residual(system, *z)

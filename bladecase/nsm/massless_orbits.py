@@ -210,13 +210,13 @@ def orbit_at_period(system: MasslessSystem, T: float, beta0: float, maxiter: int
     return None
 
 
-def _correct(system: MasslessSystem, z: np.ndarray) -> tuple[np.ndarray, bool, int]:
-    """Newton on ``r = 0`` with steps along ``∇r`` (orthogonal to the tangent)."""
+def _correct(system: MasslessSystem, z: np.ndarray, scale: float = 1.0) -> tuple[np.ndarray, bool, int]:
+    """Newton on ``r = 0`` with steps along ``∇r`` (orthogonal to the tangent); ``scale``: the time scale of ``z``."""
     for it in range(10):
         _, r, g = closing_residual(system, *z, True)
         dz = -r * g / (g @ g)
         z = z + dz
-        if np.hypot(*dz) <= 1e-11 * (1 + np.hypot(*z)):
+        if np.hypot(*dz) <= 1e-11 * (scale + np.hypot(*z)):
             return z, abs(r) <= 1e-8 * system.gap, it
     return z, False, 10
 
@@ -227,9 +227,11 @@ def follow_from_grazing(system: MasslessSystem, T_min: float, mode: int = 0, ds:
 
     Pseudo-arclength in ``(α, β)``: tangent ``⊥ ∇r`` oriented by the previous one (so turning points in ``T``
     are passed on the same branch), step accepted only if the corrected point is within twice the step and
-    ahead; adaptive step between ``1e-10`` and ``ds_max``.
+    ahead; adaptive step between ``1e-10`` and ``ds_max``. Steps are relative to a quarter of the mode's linear
+    period ``π/(2ω)``, so the same ``ds`` serves a bar in units of ``L/c`` and a blade in seconds.
     """
     w = system.open.omega[mode]
+    L = np.pi / (2 * w)
     z = np.array([np.pi / w, 1e-6 / w])
     for _ in range(50):  # first point: r(α, β₀) = 0 in α near half the linear period
         _, r, g = closing_residual(system, *z, True)
@@ -237,7 +239,7 @@ def follow_from_grazing(system: MasslessSystem, T_min: float, mode: int = 0, ds:
         if abs(r / g[0]) <= 1e-14 * z[0]:
             break
     out: list[SymmetricOrbit] = []
-    tangent, h = None, ds
+    tangent, h, ds_max = None, ds * L, ds_max * L
     while len(out) < max_points:
         a, _, g = closing_residual(system, *z, True)
         out.append(SymmetricOrbit(system, z[0], z[1], a))
@@ -245,12 +247,12 @@ def follow_from_grazing(system: MasslessSystem, T_min: float, mode: int = 0, ds:
         t = t if (t[1] > 0 if tangent is None else t @ tangent > 0) else -t
         tangent = t
         while True:
-            zp, ok, it = _correct(system, z + h * tangent)
+            zp, ok, it = _correct(system, z + h * tangent, L)
             if ok and np.hypot(*(zp - z)) < 2 * h and (zp - z) @ tangent > 0:
                 h = min(h * (1.5 if it <= 3 else 1.0), ds_max)
                 break
             h /= 2
-            if h < 1e-10:
+            if h < 1e-10 * L:
                 return out
         z = zp
         if 2 * (z[0] + z[1]) < T_min or min(z) <= 0:

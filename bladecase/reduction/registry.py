@@ -154,7 +154,7 @@ def reduce(
     >>> reduce(model, contact, "guyan", 6)
     Traceback (most recent call last):
         ...
-    ValueError: unknown reduction method 'guyan' (valid: 'full', 'modal', 'lanczos', 'lanczos-si', 'craig-bampton')
+    ValueError: unknown reduction method 'guyan' (valid: 'full', 'modal', 'lanczos', 'lanczos-si', 'craig-bampton', 'massless')
     """
     if not isinstance(model, FEModel):
         raise ValueError(f"model must be an FEModel (from bladecase.assemble), got {type(model).__name__}")

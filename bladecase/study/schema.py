@@ -184,6 +184,11 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "nearest": Key(_LIST, None, "Pick the free node nearest this point (within 'group' if given).", _vector),
         "normal": Key(_LIST, None, "Casing normal, from the blade towards the casing; default: radial "
                       "(+z in 3-D, +y in 2-D).", _vector),
+        "model": Key(_STR, "newton", "Contact model: 'newton' (the node keeps its mass; Newton's impact law, "
+                     "the seed paper's formulation) or 'massless' (the contact dofs carry no inertia, their lumped "
+                     "mass is moved to the neighbours; Signorini without an impact law; needs [fem] mass = "
+                     "'lumped', [reduction] method = 'massless', [search] ipp = [1]).",
+                     _one_of("newton", "massless")),
     },
     "reduction": {
         "method": Key(_STR, "lanczos-si", f"Reduced model: {', '.join(METHODS)}.", _one_of(*METHODS)),
@@ -402,11 +407,32 @@ def _cross_checks(c: dict) -> None:
     r = c["reduction"]
     if r["method"] == "full":
         r["size"] = None
+    _contact_model_checks(c)
     o, s = c["output"], c["search"]
     for i, item in enumerate(o["orbits"]):
         if item["ipp"] not in s["ipp"]:
             raise StudyError(f"[output] orbits: item {i} asks for ipp = {item['ipp']}, which [search] ipp = "
                              f"{s['ipp']} does not look for")
+
+
+def _contact_model_checks(c: dict) -> None:
+    """The massless contact model and the keys it needs go together."""
+    massless = c["contact"]["model"] == "massless"
+    methods = [c["reduction"]["method"]] + [x["method"] for x in c["reduction"]["compare"]]
+    if massless:
+        bad = [m for m in methods if m != "massless"]
+        if bad:
+            raise StudyError(f"[reduction] method: the massless contact model needs method = 'massless' "
+                             f"(for every model, compare included), got {bad[0]!r}")
+        if c["search"]["ipp"] != [1]:
+            raise StudyError(f"[search] ipp: the massless contact model has modes with one contact phase per "
+                             f"period: ipp = [1], got {c['search']['ipp']}")
+        if c["fem"]["mass"] != "lumped":
+            raise StudyError("[fem] mass: the massless contact model moves lumped masses: mass = 'lumped', got "
+                             f"{c['fem']['mass']!r}")
+    elif "massless" in methods:
+        raise StudyError("[reduction] method: 'massless' is the reduction of the massless contact model: set "
+                         "[contact] model = 'massless'")
 
 
 def loads(text: str, source: str = "<string>", base: str | os.PathLike | None = None, model: bool = True) -> Study:

@@ -23,6 +23,11 @@
     ``(K_ii, M_ii)``.  Its ``M_r`` is not diagonal, so the Moreau impact law
     (theory §1) is the one that conserves energy.
 
+``"massless"`` (:mod:`.massless`)
+    The massless contact model (theory §8): the contact dofs' lumped mass is moved to their neighbours,
+    they are condensed statically in each phase; ``size`` modes of the massless structure plus the static
+    attachment vector of the contact; the system is a :class:`~bladecase.nsm.MasslessSystem`.
+
 Every method but ``"full"`` works on sparse matrices only (no dense
 ``n × n`` array), so the ~100k-dof blades of the FE front end reduce in
 seconds; see ``benchmarks/bench_reduction.py``.
@@ -35,7 +40,7 @@ This module also keeps the old import path ``bladecase.reduction.methods`` of :f
 from ..model import ReducedModel, node_operator
 from ..registry import METHODS, reduce, register
 from ..storage import REDUCED_FORMAT, load_reduced, save_reduced
-from . import craig_bampton, full, lanczos, modal
+from . import craig_bampton, full, lanczos, massless, modal
 from .common import FULL_LIMIT
 
 __all__ = [
@@ -50,3 +55,5 @@ register("lanczos", lanczos.build_plain, "size Lanczos steps from the contact: a
 register("lanczos-si", lanczos.build_shift_invert, "size shift-invert Lanczos steps about 0: the lowest modes "
          "the contact sees, as a chain")
 register("craig-bampton", craig_bampton.build, "the contact node's dofs plus size fixed-interface modes")
+register("massless", massless.build, "massless contact dofs (mass moved to their neighbours, no impact law): size "
+         "modes of the massless structure plus the contact's attachment vector")
