@@ -62,3 +62,37 @@ def test_run_animates_no_orbit_that_fails_and_says_why(tmp_path):
     log = (result.directory / "run.log").read_text()
     assert "do not survive in the reference model" in log
     assert not np.isnan(s["reference"]["reduced_dofs"])
+
+
+MASSLESS_PLATE = PLATE.replace("[contact]\n", '[contact]\nmodel = "massless"\n').replace(
+    'method = "modal"', 'method = "massless"').replace("periods = [0.5, 0.9999]", "periods = [0.8, 1.001]") + """
+[output]
+formats = ["vtu"]
+frames = 6
+manifold = false
+"""
+
+
+def test_massless_study_animates_orbits_that_survive_in_the_reference(tmp_path):
+    """The massless contact model end to end on the plate: its animated orbits re-simulate in their own model
+    (1e-10) and survive in the 4 × larger massless reference (drift < SURVIVAL_RTOL, one contact phase)."""
+    result = run(loads(MASSLESS_PLATE, base=ROOT), out=tmp_path / "out", progress=False)
+    anims = result.summary["files"]["animations"]
+    assert anims and result.summary["reference"]["method"] == "massless"
+    for a in anims:
+        assert a["verification"]["ok"] and a["verification"]["return_error"] < 1e-10
+        check = a["reference_check"]
+        assert check["survives"] and check["drift"] < SURVIVAL_RTOL and check["contacts"] == 1
+        assert 0 < a["contact_time"] < a["T"]
+    assert "in contact for t/T in [0, " in (result.directory / "report.md").read_text()
+
+
+def test_massless_study_keys_go_together():
+    from bladecase.study.schema import StudyError
+
+    with pytest.raises(StudyError, match=r"\[reduction\] method: the massless contact model needs"):
+        loads(PLATE.replace("[contact]\n", '[contact]\nmodel = "massless"\n'), base=ROOT)
+    with pytest.raises(StudyError, match=r"\[reduction\] method: 'massless' is the reduction of the massless"):
+        loads(PLATE.replace('method = "modal"', 'method = "massless"'), base=ROOT)
+    with pytest.raises(StudyError, match=r"\[contact\] model"):
+        loads(PLATE.replace("[contact]\n", '[contact]\nmodel = "penalty"\n'), base=ROOT)

@@ -47,6 +47,19 @@ class Material:
     ------
     ValueError
         A value that is not a finite number in its valid range.
+
+    Examples
+    --------
+    >>> steel = Material(E=200e9, nu=0.3, rho=7850.0, name="steel")
+    >>> lam, mu = steel.lame()             # 3-D: μ = E / 2(1 + ν)
+    >>> round(lam / 1e9, 3), round(mu / 1e9, 3)
+    (115.385, 76.923)
+    >>> round(steel.lame("stress")[0] / 1e9, 3)   # plane stress: λ* = Eν / (1 - ν²)
+    65.934
+    >>> Material(E=200e9, nu=0.5, rho=7850.0)
+    Traceback (most recent call last):
+        ...
+    ValueError: Poisson's ratio nu must be in (-1, 0.5) (open interval), got 0.5
     """
 
     E: float

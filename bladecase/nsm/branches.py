@@ -41,6 +41,18 @@ class Arc:
     impacts merging, branch point with a repeated orbit).  Along a curve with a
     turning point ``T`` is not monotone: ``T_lo``/``T_hi`` are the extreme
     periods of the arc.
+
+    Examples
+    --------
+    The admissible arcs of a 1-ipp scan of the two-mass chain: the first starts where the scan
+    starts (``T = 4``, not refined), both other ends are where admissibility is lost, found by bisection:
+
+    >>> from bladecase.nsm import backbone, chain
+    >>> branch = backbone(chain(2, k=1.0, m=0.5, gap=1.0), np.linspace(4.0, 12.0, 9))
+    >>> [(a.start, a.stop, round(a.T_lo, 6), round(a.T_hi, 6), a.refined_lo) for a in branch.arcs]
+    [(0, 1, 4.0, 5.491705, False), (2, 3, 5.650149, 7.188736, True)]
+    >>> Arc.from_dict(branch.arcs[1].to_dict()) == branch.arcs[1]
+    True
     """
 
     start: int
@@ -79,6 +91,25 @@ class Branch:
         The scanned periods (a scan); ``None`` for a curve (the orbits' periods).
     source : str
         ``"scan"`` (periods given) or ``"curve"``.
+
+    Examples
+    --------
+    A scan of 1-ipp orbits of the two-mass chain (one orbit per period; :func:`~bladecase.nsm.scan.backbone`):
+
+    >>> from bladecase.nsm import backbone, chain
+    >>> system = chain(2, k=1.0, m=0.5, gap=1.0)
+    >>> branch = backbone(system, np.linspace(4.0, 12.0, 9))
+    >>> branch.k, branch.source, branch.T.tolist()
+    (1, 'scan', [4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0, 11.0, 12.0])
+    >>> branch.energy.round(6)[:4].tolist(), branch.admissible.tolist()
+    ([14.800367, 0.854346, 0.602841, 0.265441], [True, True, True, True, False, False, False, False, False])
+    >>> [(round(a.T_lo, 6), round(a.T_hi, 6)) for a in branch.arcs]   # admissible period ranges
+    [(4.0, 5.491705), (5.650149, 7.188736)]
+    >>> [(o.T, o.admissible) for o in branch.orbit_at(5.2)]           # re-solved between scanned points
+    [(5.2, True)]
+    >>> again = Branch.from_dict(system, branch.to_dict())            # plain data (JSON) and back
+    >>> again.arcs == branch.arcs, again.energy.tolist() == branch.energy.tolist()
+    (True, True)
     """
 
     system: LinearSystem | None = field(repr=False)

@@ -78,6 +78,19 @@ class PeriodicOrbit:
         Floquet stability; ``None`` when not computed.
     multipliers : ndarray or None
         Floquet multipliers; ``None`` when not computed.
+
+    Examples
+    --------
+    The 1-ipp orbit of period 6 of the two-mass chain (:func:`orbit_1ipp`):
+
+    >>> from bladecase.nsm import chain, orbit_1ipp
+    >>> orbit = orbit_1ipp(chain(2, k=1.0, m=0.5, gap=1.0), 6.0)
+    >>> orbit.k, round(orbit.frequency, 6), orbit.impact_times.tolist(), round(float(orbit.impulses[0]), 6)
+    (1, 0.166667, [6.0], 0.791202)
+    >>> round(orbit.energy, 6), orbit.admissible, orbit.max_violation, orbit.repeats
+    (0.602841, True, 0.0, 1)
+    >>> orbit.contact([0.0, 3.0, 6.0]).round(6).tolist()   # wᵀx: at the obstacle (gap 1) at the impacts
+    [1.0, -1.493426, 1.0]
     """
 
     system: LinearSystem | None = field(repr=False)
@@ -238,6 +251,21 @@ def make_orbit(
     constraint): it is checked first, so a violated orbit is rejected cheaply.
     ``certify=False`` skips the admissibility check altogether (the orbit is
     then marked non-admissible with a NaN ``max_violation``).
+
+    Examples
+    --------
+    The 1-ipp orbit of period 6 rebuilt from its impact data; the same impact with the opposite
+    (pulling) impulse is a periodic solution too, but not a motion of the impacting system:
+
+    >>> from bladecase.nsm import chain, orbit_1ipp
+    >>> system = chain(2, k=1.0, m=0.5, gap=1.0)
+    >>> impulse = orbit_1ipp(system, 6.0).impulses
+    >>> orbit = make_orbit(system, 6.0, [6.0], impulse)
+    >>> round(orbit.energy, 6), orbit.admissible
+    (0.602841, True)
+    >>> pulled = make_orbit(system, 6.0, [6.0], -impulse)
+    >>> pulled.admissible, round(pulled.max_violation, 6)     # wᵀx - d > 0: it crosses the casing
+    (False, 0.493426)
     """
     times = np.asarray(impact_times, dtype=float)
     lam = np.asarray(impulses, dtype=float)

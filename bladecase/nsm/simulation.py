@@ -45,6 +45,24 @@ class Trajectory:
         accumulation of impacts — chattering — with ``restitution < 1``).
     flight : FlightPropagator
         The propagator of the run (its coordinates are those of the stored states).
+
+    Examples
+    --------
+    Started from the post-impact state of the 1-ipp orbit of period 6, the simulation impacts every
+    6 time units and conserves the orbit's energy (restitution 1):
+
+    >>> from bladecase.nsm import chain, orbit_1ipp
+    >>> system = chain(2, k=1.0, m=0.5, gap=1.0)
+    >>> orbit = orbit_1ipp(system, 6.0)
+    >>> x0, v0 = orbit.state(0.0)
+    >>> tr = simulate(system, x0[:, 0], v0[:, 0], 13.0)
+    >>> tr.impact_times.round(9).tolist(), tr.impulses.round(6).tolist(), tr.complete, tr.t_end
+    ([6.0, 12.0], [0.791202, 0.791202], True, 13.0)
+    >>> tr.energy().round(6).tolist()
+    [0.602841, 0.602841]
+    >>> x, v = tr.state([12.0])                     # back at the start: the last mass at the obstacle
+    >>> bool(np.allclose(x, x0, atol=1e-9)), round(float(x[1, 0]), 9)
+    (True, 1.0)
     """
 
     system: LinearSystem = field(repr=False)

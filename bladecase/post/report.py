@@ -67,10 +67,11 @@ def report(summary: dict) -> str:
     lines.append(f"- `{files['mesh']}`: the mesh with its groups; `{files['modes']}`: every family and orbit.")
     for a in files.get("animations", []):
         what = ", ".join(f"`{a[k]}`" for k in ("gif", "mp4", "pvd", "manifold") if k in a)
-        phases = ", ".join(f"{t / a['T']:.4f}" for t in a["impact_times"])
+        phases = ("in contact for t/T in [0, " + f"{a['contact_time'] / a['T']:.4f}]" if "contact_time" in a else
+                  "impacts at t/T = " + ", ".join(f"{t / a['T']:.4f}" for t in a["impact_times"]))
         check = a["verification"]
         lines.append(f"- family {a['family']}, {a['ipp']}-ipp orbit T = {a['T']:.8g} s (f = {a['frequency_hz']:.3f} "
-                     f"Hz, E = {a['energy_j']:.3e} J, impacts at t/T = "
+                     f"Hz, E = {a['energy_j']:.3e} J, "
                      f"{phases}, displacements × {a['scale']:.4g}; event-driven simulation returns to it to "
                      f"{check['return_error']:.1e}{'' if check['ok'] else ' — CHECK FAILED'}): {what}")
         if "reference_check" in a:

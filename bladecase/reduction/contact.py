@@ -33,7 +33,15 @@ from ..nsm import LinearSystem
 
 
 def radial_normal(dim: int) -> np.ndarray:
-    """The default contact normal: the unit vector of the last axis (``+z`` in 3-D, ``+y`` in 2-D)."""
+    """The default contact normal: the unit vector of the last axis (``+z`` in 3-D, ``+y`` in 2-D).
+
+    >>> radial_normal(3).tolist(), radial_normal(2).tolist()
+    ([0.0, 0.0, 1.0], [0.0, 1.0])
+    >>> radial_normal(1)
+    Traceback (most recent call last):
+        ...
+    ValueError: dim must be 2 or 3, got 1
+    """
     if isinstance(dim, bool) or dim not in (2, 3):
         raise ValueError(f"dim must be 2 or 3, got {dim!r}")
     e = np.zeros(dim)
@@ -122,6 +130,30 @@ class Contact:
         ``node`` not an integer >= 0, ``normal`` zero, non-finite or of the
         wrong size, ``gap <= 0``.  Whether the node is free is checked when a
         model is given (:meth:`w`, :meth:`at`, :meth:`nearest`, :meth:`farthest`).
+
+    Examples
+    --------
+    A steel strip 100 mm × 20 mm × 2 mm clamped at ``x = 0``, touching a casing normal to ``+x`` with its
+    corner node ``(0.1, 0.02)`` (node 104) after a 0.1 mm clearance:
+
+    >>> from skfem import MeshTri
+    >>> from bladecase.fe import Mesh, assemble
+    >>> t = MeshTri.init_tensor(np.linspace(0, 0.1, 21), np.linspace(0, 0.02, 5))
+    >>> points = np.c_[t.p.T, np.zeros(t.p.shape[1])]
+    >>> strip = Mesh(points, {"triangle": t.t.T}, dim=2, groups={"root": np.flatnonzero(points[:, 0] == 0)})
+    >>> model = assemble(strip, "steel", order=1, thickness=0.002)
+    >>> contact = Contact(104, normal=(2.0, 0.0), gap=1e-4)     # the normal is stored normalised
+    >>> contact
+    Contact(node=104, normal=(1.0, 0.0), gap=0.0001)
+    >>> w = contact.w(model)                                    # wᵀx = ν·u of node 104
+    >>> w.size, np.flatnonzero(w).tolist(), contact.dofs(model).tolist()
+    (200, [198], [198, 199])
+    >>> contact.system(model)
+    LinearSystem(n=200, sparse, gap=0.0001)
+    >>> Contact(104, normal=None, gap=0.0)
+    Traceback (most recent call last):
+        ...
+    ValueError: gap must be a finite clearance > 0, got 0.0
     """
 
     node: int

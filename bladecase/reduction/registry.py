@@ -151,10 +151,10 @@ def reduce(
     >>> reduced = reduce(model, contact, "lanczos-si", 6)
     >>> reduced
     ReducedModel('lanczos-si', size=6, 6 reduced dofs of 200 free dofs, gap=0.0001)
-    >>> reduce(model, contact, "guyan", 6)
+    >>> reduce(model, contact, "guyan", 6)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
         ...
-    ValueError: unknown reduction method 'guyan' (valid: 'full', 'modal', 'lanczos', 'lanczos-si', 'craig-bampton', 'massless')
+    ValueError: unknown reduction method 'guyan' (valid: 'full', 'modal', 'lanczos', 'lanczos-si', ...)
     """
     if not isinstance(model, FEModel):
         raise ValueError(f"model must be an FEModel (from bladecase.assemble), got {type(model).__name__}")

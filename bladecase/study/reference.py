@@ -44,7 +44,8 @@ def reference_model(model: FEModel, contact: Contact, reduced: ReducedModel,
 
 def _project(reference: ReducedModel, x_free: np.ndarray) -> np.ndarray:
     """Reference coordinates of free-dof vectors: the M-orthogonal projection onto the reference's basis."""
-    V, M = reference.basis, reference.model.M
+    V = reference.basis
+    M = getattr(reference, "mass_matrix", reference.model.M)  # the massless model's redistributed masses
     MV = M @ V
     return np.linalg.solve(np.asarray(V.T @ MV), np.asarray(MV.T @ x_free))
 

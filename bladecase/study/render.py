@@ -28,10 +28,13 @@ def orbit_scene(study: Study, reduced: ReducedModel, families: list[Branch], cho
     o = study["output"]
     orbit, model = choice.orbit, reduced.model
     times, impact = frame_times(orbit, o["frames"])
+    if hasattr(orbit, "contact_time"):  # the casing is drawn in contact during the whole contact phase
+        impact = impact | (times <= orbit.contact_time)
     x, v = orbit.state(times)
     mesh = fe_grid(model)
     u = nodal_field(model, reduced.free_dofs(x))
-    v = nodal_field(model, reduced.free_dofs(v))
+    free_v = getattr(reduced, "free_velocities", None)  # the massless model's contact dofs move with λ' too
+    v = nodal_field(model, free_v(x, v) if free_v is not None else reduced.free_dofs(v))
     scale = animation.auto_scale(mesh, u, o["auto_fraction"]) if o["scale"] == "auto" else float(o["scale"])
     return OrbitScene(stem=choice.stem, title=f"{study.name}: {orbit.k}-ipp nonsmooth mode (family {choice.family})",
                       mesh=mesh, orbit=orbit, times=times, u=u, v=v, impact=impact,
@@ -54,6 +57,8 @@ def render(study: Study, reduced: ReducedModel, families: list[Branch], choice: 
              "energy_j": orbit.energy, "impact_times": orbit.impact_times.tolist(),
              "impulses": orbit.impulses.tolist(), "scale": scene.scale, "frames": int(scene.times.size),
              "verification": check}
+    if hasattr(orbit, "contact_time"):  # the massless model: a contact phase of finite duration from t = 0
+        entry["contact_time"] = orbit.contact_time
     if reference is not None:
         entry["reference_check"] = check_in_reference(orbit, reduced, reference)
         log_check(entry["reference_check"], orbit.k, orbit.T)

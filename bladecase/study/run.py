@@ -72,6 +72,35 @@ def run(study: Study, out: str | os.PathLike | None = None, progress: bool = Tru
     ``animations/<stem>.gif`` / ``.mp4``, ``vtk/<stem>.pvd`` with
     ``vtk/<stem>/`` (one ``.vtu`` per frame) and ``vtk/<stem>_manifold.vtu``.
     ``executor`` runs the searches of the models (default: :class:`SerialExecutor`).
+
+    Examples
+    --------
+    A small plate study end to end (under a second: a coarse gmsh plate, 4 modes, no pictures):
+
+    >>> import tempfile
+    >>> from bladecase.study.schema import loads
+    >>> study = loads('''
+    ... study = {name = "strip"}
+    ... geometry = {kind = "plate", span = 0.1, chord = 0.02, contact_point = [0.005, 0.1], size = 0.005}
+    ... material = {preset = "steel"}
+    ... fem = {order = 1, thickness = 0.002}
+    ... contact = {clearance = 1e-4}
+    ... reduction = {method = "modal", size = 4}
+    ... search = {ipp = [1], periods = [0.5, 0.9999], scan = 2}
+    ... output = {animate = 1, frames = 4, formats = [], reference = false}
+    ... ''')
+    >>> with tempfile.TemporaryDirectory() as out:
+    ...     result = run(study, out, progress=False)
+    ...     written = sorted(p.name for p in Path(out).iterdir())
+    >>> written
+    ['mesh.vtu', 'modes.json', 'report.md', 'run.log', 'summary.json']
+    >>> model = result.summary["model"]
+    >>> model["dim"], model["material"]["name"], round(model["total_mass_kg"], 6)   # 7850 × 0.1 × 0.02 × 0.002
+    (2, 'steel', 0.0314)
+    >>> result.summary["contact"]["position"], round(model["linear_frequencies_hz"][0], -1)
+    ([0.005, 0.1, 0.0], 1650.0)
+    >>> [(a["ipp"], a["frames"], a["verification"]["ok"]) for a in result.summary["files"]["animations"]]
+    [(1, 4, True)]
     """
     out = study.output_dir(out)
     t_start = time.perf_counter()

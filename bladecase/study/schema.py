@@ -257,6 +257,20 @@ class Study:
         The study file (or ``"<demo>"``) for messages.
     base : Path
         Folder that relative paths in the study (the mesh file) are relative to.
+
+    Examples
+    --------
+    Sections read as dicts, with every default filled in:
+
+    >>> study = demo_study()
+    >>> study.name, study.source, study.parametric
+    ('demo', '<demo>', True)
+    >>> study["contact"]["clearance"], study["reduction"]["method"], study["reduction"]["size"]
+    (0.0001, 'lanczos-si', 8)
+    >>> study["search"]["max_points"], study["fem"]["frequencies"]        # defaults: not in the file
+    (400, 6)
+    >>> study.output_dir().as_posix(), study.output_dir("elsewhere").as_posix()
+    ('results/demo', 'elsewhere')
     """
 
     config: dict
@@ -447,7 +461,35 @@ def loads(text: str, source: str = "<string>", base: str | os.PathLike | None = 
 def load_study(path: str | os.PathLike, model: bool = True) -> Study:
     """Read and validate a study file; relative paths in it are relative to its folder.
 
-    ``model=False``: a search-only study (see :func:`validate`)."""
+    ``model=False``: a search-only study (see :func:`validate`).
+
+    Examples
+    --------
+    A study on a mesh file next to it (TOML inline tables are sections too):
+
+    >>> import tempfile
+    >>> folder = tempfile.TemporaryDirectory()
+    >>> path = Path(folder.name, "plate.toml")
+    >>> _ = path.write_text('''
+    ... mesh = {path = "meshes/plate.vtu"}
+    ... fem = {order = 1, thickness = 0.002}
+    ... contact = {clearance = 1e-4}
+    ... ''')
+    >>> study = load_study(path)
+    >>> study.name, study.parametric, study.mesh_path() == Path(folder.name, "meshes", "plate.vtu").resolve()
+    ('study', False, True)
+    >>> study["fem"]["order"], study["reduction"]["method"], study["reduction"]["size"]   # defaults filled in
+    (1, 'lanczos-si', 20)
+    >>> _ = path.write_text('''
+    ... mesh = {path = "meshes/plate.vtu"}
+    ... contact = {clearance = -1e-4}
+    ... ''')
+    >>> load_study(path)
+    Traceback (most recent call last):
+        ...
+    bladecase.study.schema.StudyError: [contact] clearance: must be > 0 (metres), got -0.0001
+    >>> folder.cleanup()
+    """
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
@@ -462,5 +504,15 @@ def demo_text() -> str:
 
 
 def demo_study() -> Study:
-    """The embedded demo study: a twisted, leaned 3-D blade of a few thousand dofs."""
+    """The embedded demo study: a twisted, leaned 3-D blade of a few thousand dofs.
+
+    >>> study = demo_study()
+    >>> blade = study.geometry()
+    >>> type(blade).__name__, blade.naca, blade.span, blade.twist_deg, blade.lean, blade.contact_point
+    ('BladeGeometry', '2412', 0.15, 40.0, 0.03, (0.0, 0.03, 0.15))
+    >>> study["material"]["preset"], study["fem"]["order"], study["contact"]["group"]
+    ('Ti-6Al-4V', 2, 'contact')
+    >>> study["search"]["ipp"], study["search"]["periods"], study["output"]["formats"]
+    ([1, 2], [0.9, 0.9999], ['gif', 'mp4', 'vtu', 'png'])
+    """
     return loads(demo_text(), source="<demo>")
