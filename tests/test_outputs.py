@@ -140,3 +140,19 @@ def test_write_calls_a_shared_writer_once(tmp_path):
         for name in added:
             FORMATS.unregister(name)
     assert not {"alpha", "beta", "gamma"} & set(FORMATS)
+
+
+def test_a_later_run_removes_a_format_folder_it_no_longer_writes_and_nothing_else(tmp_path):
+    """The folder of a format written by an earlier run (recorded in the results manifest) goes when the next
+    run does not write it; a user's file in the output directory stays."""
+    out = tmp_path / "run"
+    register_csv()
+    try:
+        run(loads(STUDY), out, progress=False)
+    finally:
+        FORMATS.unregister("csv")
+    assert (out / "csv").is_dir()
+    (out / "notes.txt").write_text("mine")
+    run(loads(STUDY.replace('formats = ["csv"]', 'formats = ["png"]')), out, progress=False)
+    assert not (out / "csv").exists() and (out / "frequency_energy.png").is_file()
+    assert (out / "notes.txt").read_text() == "mine"

@@ -4,6 +4,7 @@ were; a run removes only result names it owns (:data:`RUN_RESULTS`), never a use
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import tempfile
@@ -22,9 +23,22 @@ def staging_dir(out: Path) -> Path:
     return Path(tempfile.mkdtemp(prefix=".bladecase-run-", dir=out))
 
 
-def publish(staging: Path, out: Path, owned: tuple[str, ...] = ()) -> None:
+def _written(out: Path) -> set[str]:
+    """The top-level names the previous complete run recorded in its ``summary.json`` (``"outputs"``)."""
+    try:
+        names = json.loads((out / "summary.json").read_text(encoding="utf-8")).get("outputs", [])
+    except (OSError, ValueError, AttributeError):
+        return set()
+    return {n for n in names if isinstance(n, str) and n and "/" not in n and "\\" not in n and n not in (".", "..")}
+
+
+def publish(staging: Path, out: Path, owned: tuple[str, ...] = (), whole: bool = False) -> None:
     """Move every entry of ``staging`` into ``out`` (replacing older results of the same name);
-    remove the ``owned`` names this run did not write (stale results of an older run)."""
+    remove the ``owned`` names this run did not write (stale results of an older run) — with ``whole`` (a
+    complete run), also every name the previous run recorded in its ``summary.json`` (``"outputs"``: e.g. the
+    folder of an output format no longer asked for); never anything else."""
+    previous = _written(out)
+    owned = tuple(sorted(set(owned) | (previous if whole else set())))
     for name in owned:
         stale = out / name
         if not (staging / name).exists() and stale.exists():

@@ -113,9 +113,10 @@ def run(study: Study, out: str | os.PathLike | None = None, progress: bool = Tru
             summary["timings_s"] = dict(stages.timings, total=round(time.perf_counter() - t_start, 3))
             log.info("results in %s (%.1f s)", out, summary["timings_s"]["total"])
         write_text(staging / "run.log", "\n".join(lines) + "\n")
+        summary["outputs"] = sorted({p.name for p in staging.iterdir()} | {"summary.json", "report.md"})
         write_json(staging / "summary.json", summary)
         write_text(staging / "report.md", report(summary))
-        publish(staging, out, RUN_RESULTS)
+        publish(staging, out, RUN_RESULTS, whole=True)
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
         raise
