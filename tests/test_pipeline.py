@@ -371,7 +371,7 @@ def test_explicit_orbit_requests(plate_study):
 
 
 def test_search_resolution_reaches_the_start_search(plate_study, monkeypatch):
-    from bladecase.nsm import branches as continuation
+    from bladecase.nsm import modes as continuation
 
     seen = []
     real = continuation.orbits_kipp

@@ -17,7 +17,8 @@ import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 from .material import Material
-from .mesh import _P2_EDGES, Mesh
+from .mesh import Mesh
+from .quality import _P2_EDGES
 
 _DIRECTIONS = {"x": 0, "y": 1, "z": 2}
 

@@ -17,7 +17,8 @@ The pipeline inside, one module per step:
   exact Jacobian (:class:`Curve`, :func:`trace`, :func:`bisect`);
 - :mod:`~bladecase.nsm.families` — the k-ipp residual as such a curve (:class:`KippCurve`);
 - :mod:`~bladecase.nsm.branches` — :class:`Branch` and :class:`Arc`, the one result type of
-  :func:`nonsmooth_mode` (continuation, any k) and :func:`backbone` (:mod:`~bladecase.nsm.scan`, 1-ipp scan);
+  :func:`nonsmooth_mode` (:mod:`~bladecase.nsm.modes`: continuation, any k, either contact model) and
+  :func:`backbone` (:mod:`~bladecase.nsm.scan`, 1-ipp scan);
   ``Family``, ``Backbone``, ``Interval`` are their former names;
 - :mod:`~bladecase.nsm.flight` and :mod:`~bladecase.nsm.simulation` — the event-driven simulator:
   a flight propagator (:class:`ModalFlight`), an impact law (:class:`NewtonImpact`), the event loop
@@ -28,7 +29,7 @@ The pipeline inside, one module per step:
 """
 
 from .bar import bar, bar_continuum_energy
-from .branches import Arc, Backbone, Branch, Family, Interval, nonsmooth_mode
+from .branches import Arc, Backbone, Branch, Family, Interval
 from .continuation import Curve, bisect, trace
 from .families import KippCurve
 from .flight import FlightPropagator, ImpactLaw, ModalFlight, NewtonImpact
@@ -43,6 +44,7 @@ from .modal import (
     newton_times,
     solve_times,
 )
+from .modes import nonsmooth_mode
 from .orbits import PeriodicOrbit, make_orbit, orbit_1ipp
 from .scan import backbone
 from .simulation import Trajectory, integrate, simulate
