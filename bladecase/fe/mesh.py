@@ -19,7 +19,13 @@ from io import StringIO
 import numpy as np
 
 from ..io import atomic_path
-from .quality import DEGENERATE_RTOL, _check_orientation, jacobian_dets, signed_measures  # noqa: F401
+from .quality import (  # noqa: F401  (the former home of these names)
+    _P2_EDGES,
+    DEGENERATE_RTOL,
+    _check_orientation,
+    jacobian_dets,
+    signed_measures,
+)
 
 #: meshio cell types accepted as the body of a model, by dimension and order.
 VOLUME_TYPES = {3: {1: "tetra", 2: "tetra10"}, 2: {1: "triangle", 2: "triangle6"}}
