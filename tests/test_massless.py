@@ -184,7 +184,8 @@ def test_nonsmooth_mode_api_on_the_massless_bar():
     (branch,) = bc.nonsmooth_mode(s, k=1, T_range=(3.8, 4.1))
     assert isinstance(branch, bc.Branch) and branch.k == 1 and len(branch.arcs) >= 1
     arc = branch.arcs[0]
-    assert arc.T_hi == pytest.approx(4.0, abs=0.01) and arc.refined_hi
+    assert arc.T_hi == pytest.approx(4.0, abs=0.01) and not arc.refined_hi  # starts at grazing: T_hi = T₁
+    assert arc.refined_lo  # where admissibility is lost, refined by bisection along the curve
     (orbit,) = [o for o in branch.orbit_at(3.95) if o.admissible]
     assert orbit.T == 3.95 and orbit.state(np.array([0.0, 1.0]))[0].shape == (s.n, 2)
     # within 10 % of the continuum (the discrete branch's energy is not the converging measure: docs/massless.md)

@@ -248,6 +248,16 @@ def passes(problem: KippCurve, zs, start: tuple[float, PeriodicOrbit]) -> bool:
 
 def _arcs(problem: KippCurve, zs, orbits, refine: bool) -> list[tuple]:
     """``(start, stop, T_lo, T_hi, refined_lo, refined_hi)`` of every maximal admissible run of ``orbits``."""
+    return admissible_arcs(orbits, lambda i, out: _bisect_end(problem, zs[i], zs[out]) if refine else None)
+
+
+def admissible_arcs(orbits, refine_end) -> list[tuple]:
+    """``(start, stop, T_lo, T_hi, refined_lo, refined_hi)`` of every maximal admissible run of ``orbits`` (a curve).
+
+    ``refine_end(i, out)``: the period where admissibility is lost between the run's end point ``i`` and its
+    non-admissible neighbour ``out``, and whether that was found — ``(T, True)`` — or ``None`` not to refine.
+    Along a curve ``T`` need not be monotone: the refined flags go with whichever end gives ``T_lo``/``T_hi``.
+    """
     adm = np.array([o.admissible for o in orbits], dtype=bool)
     arcs = []
     i = 0
@@ -258,12 +268,11 @@ def _arcs(problem: KippCurve, zs, orbits, refine: bool) -> list[tuple]:
         j = i
         while j + 1 < adm.size and adm[j + 1]:
             j += 1
-        ref_a, ref_b = refine and i > 0, refine and j + 1 < adm.size
-        T_a, T_b = orbits[i].T, orbits[j].T
-        if ref_a:
-            T_a, ref_a = _bisect_end(problem, zs[i], zs[i - 1])
-        if ref_b:
-            T_b, ref_b = _bisect_end(problem, zs[j], zs[j + 1])
+        (T_a, ref_a), (T_b, ref_b) = (orbits[i].T, False), (orbits[j].T, False)
+        if i > 0:
+            T_a, ref_a = refine_end(i, i - 1) or (T_a, False)
+        if j + 1 < adm.size:
+            T_b, ref_b = refine_end(j, j + 1) or (T_b, False)
         Ts = [o.T for o in orbits[i:j + 1]] + [T_a, T_b]
         lo, hi = min(Ts), max(Ts)
         arcs.append((i, j, float(lo), float(hi), bool((lo == T_a and ref_a) or (lo == T_b and ref_b)),

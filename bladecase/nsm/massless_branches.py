@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import log
+from .families import admissible_arcs
 from .massless import MasslessSystem
 from .massless_orbits import SymmetricOrbit, _correct, closing_residual, follow_from_grazing, orbit_at_period
 
@@ -63,26 +64,7 @@ def _first_exit(T: np.ndarray, T_lo: float, T_hi: float) -> int:
 
 def _arcs(system: MasslessSystem, orbits: list[SymmetricOrbit], refine: bool) -> list[tuple]:
     """``(start, stop, T_lo, T_hi, refined_lo, refined_hi)`` of every maximal admissible run."""
-    adm = np.array([o.admissible for o in orbits], dtype=bool)
-    arcs = []
-    i = 0
-    while i < adm.size:
-        if not adm[i]:
-            i += 1
-            continue
-        j = i
-        while j + 1 < adm.size and adm[j + 1]:
-            j += 1
-        ends = [orbits[i].T, orbits[j].T]
-        ref_lo, ref_hi = refine and i > 0, refine and j + 1 < adm.size
-        if ref_lo:
-            ends[0] = _edge(system, orbits[i - 1], orbits[i]).T
-        if ref_hi:
-            ends[1] = _edge(system, orbits[j + 1], orbits[j]).T
-        Ts = [o.T for o in orbits[i: j + 1]] + ends
-        arcs.append((i, j, min(Ts), max(Ts), ref_lo, ref_hi))
-        i = j + 1
-    return arcs
+    return admissible_arcs(orbits, lambda i, out: (_edge(system, orbits[out], orbits[i]).T, True) if refine else None)
 
 
 def _edge(system: MasslessSystem, bad: SymmetricOrbit, good: SymmetricOrbit) -> SymmetricOrbit:
