@@ -59,8 +59,9 @@ def report(summary: dict) -> str:
         ref = summary["reference"]
         lines += ["", f"**No orbit animated:** no admissible orbit of the {r['method']} model that was tried survives "
                   f"in the reference model {ref['method']} ({ref['reduced_dofs']} dofs) — the families above are "
-                  "artefacts of the reduced model (see run.log); enlarge or change the reduced model, or use the "
-                  "massless contact model."]
+                  "artefacts of the reduced model (see run.log). With Newton's impact law the orbits depend on the "
+                  "node's reduced mass; enlarging the model does not cure that: the massless contact model "
+                  "([contact] model = \"massless\", docs/massless.md) removes the impact law."]
     lines += ["", "## Files", ""]
     if "frequency_energy_plot" in files:
         lines += [f"![frequency–energy]({files['frequency_energy_plot']})", ""]
