@@ -100,3 +100,16 @@ def test_bad_input():
     model, contact = strip()
     with pytest.raises(ValueError, match="too large for method 'massless'"):
         bc.reduce(model, contact, "massless", model.n_dofs)
+
+
+def test_massless_reduced_model_file_round_trip(exact, tmp_path):
+    from bladecase.reduction import load_reduced, save_reduced
+
+    model, contact, *_ = exact
+    r = bc.reduce(model, contact, "massless", 5)
+    save_reduced(r, tmp_path / "r.npz")
+    back = load_reduced(tmp_path / "r.npz")
+    assert type(back) is type(r) and back.system.kc == r.system.kc
+    assert np.array_equal(back.system.S, r.system.S) and np.array_equal(back.closed_shape, r.closed_shape)
+    q = np.linspace(-1, 3, back.n) * 1e-5
+    assert np.array_equal(back.free_dofs(q), r.free_dofs(q))

@@ -30,8 +30,12 @@ def save_reduced(reduced: ReducedModel, path) -> None:
            "size": np.array(-1 if reduced.size is None else reduced.size), "w": s.w, "gap": np.array(s.gap),
            "contact/node": np.array(c.node), "contact/gap": np.array(c.gap),
            "contact/normal": np.array([] if c.normal is None else c.normal, dtype=float)}
-    for name, A in (("Mr", s.M), ("Kr", s.K)):
-        out.update(sparse_to_arrays(name, A) if sp.issparse(A) else {name: np.asarray(A)})
+    if getattr(s, "contact_model", "newton") == "massless":  # MasslessSystem: S and kc instead of K
+        out.update({"contact_model": np.array("massless"), "Mr": s.M, "Sr": s.S, "kc": np.array(s.kc),
+                    "closed_shape": reduced.closed_shape, "masses": reduced.masses})
+    else:
+        for name, A in (("Mr", s.M), ("Kr", s.K)):
+            out.update(sparse_to_arrays(name, A) if sp.issparse(A) else {name: np.asarray(A)})
     if sp.issparse(reduced.basis):
         out.update(sparse_to_arrays("basis", reduced.basis))
     else:
@@ -58,6 +62,16 @@ def load_reduced(path) -> ReducedModel:
             contact = Contact(int(data["contact/node"]), tuple(normal) if normal.size else None,
                               float(data["contact/gap"]))
             size = int(data["size"])
+            if "contact_model" in data and str(data["contact_model"]) == "massless":
+                from ..nsm import MasslessSystem
+                from .methods.massless import MasslessReducedModel
+
+                system = MasslessSystem(np.asarray(data["Mr"]), np.asarray(data["Sr"]), np.asarray(data["w"]),
+                                        float(data["kc"]), float(data["gap"]))
+                return MasslessReducedModel(method=str(data["method"]), size=size, system=system,
+                                            basis=matrix("basis"), model=model, contact=contact,
+                                            closed_shape=np.asarray(data["closed_shape"]),
+                                            masses=np.asarray(data["masses"]))
             system = LinearSystem(matrix("Mr"), matrix("Kr"), np.asarray(data["w"]), float(data["gap"]))
             return ReducedModel(method=str(data["method"]), size=None if size < 0 else size, system=system,
                                 basis=matrix("basis"), model=model, contact=contact)
