@@ -23,7 +23,7 @@ mesh oriented otherwise.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -159,6 +159,9 @@ class Contact:
     node: int
     normal: tuple[float, ...] | None
     gap: float
+    #: A weighted node set instead of one node (``Contact.face``): ``wᵀx`` is the mean of ``ν·u`` over these
+    #: nodes (equal weights); ``node`` is then the set's node nearest its centroid (drawn, reported).
+    nodes: tuple[int, ...] = field(default=(), repr=False)
 
     def __post_init__(self) -> None:
         node = self.node
@@ -168,6 +171,11 @@ class Contact:
         if self.normal is not None:
             object.__setattr__(self, "normal", _unit("normal", self.normal))
         object.__setattr__(self, "gap", _gap(self.gap))
+        nodes = tuple(int(k) for k in self.nodes)
+        if nodes and (min(nodes) < 0 or self.node not in nodes):
+            raise ValueError(f"nodes of a face contact must be mesh node indices including node {self.node}, "
+                             f"got {self.nodes!r}")
+        object.__setattr__(self, "nodes", nodes)
 
     # ------------------------------------------------------------------ helpers to pick the node
 
@@ -246,7 +254,7 @@ class Contact:
         return _in_dim("normal", self.normal, dim)
 
     def dofs(self, model: FEModel) -> np.ndarray:
-        """Free dofs of the contact node (one per direction, in direction order).
+        """Free dofs of the contact node (one per direction, in direction order); of every node of a face set.
 
         Raises
         ------
@@ -254,6 +262,8 @@ class Contact:
             The node is not a mesh node, is clamped, or is not a vertex of the body cells.
         """
         _check_model(model)
+        if self.nodes:
+            return np.concatenate([Contact(k, self.normal, self.gap).dofs(model) for k in self.nodes])
         n_nodes = model.mesh.points.shape[0]
         if self.node >= n_nodes:
             raise ValueError(f"contact node {self.node} is not a mesh node (mesh nodes 0..{n_nodes - 1})")
@@ -275,7 +285,7 @@ class Contact:
         idx = self.dofs(model)
         nu = self.normal_for(model)
         w = np.zeros(model.n_dofs)
-        w[idx] = nu[model.dofs.direction[idx]]
+        w[idx] = nu[model.dofs.direction[idx]] / max(len(self.nodes), 1)
         if not np.any(w):  # a free node always has all its directions free; guard anyway
             raise ValueError(f"the normal {tuple(nu)} has no component on the free dofs of node {self.node}")
         return w
@@ -293,7 +303,37 @@ class Contact:
     def _resolved(self, model: FEModel) -> Contact:
         """This contact with its normal made explicit for ``model``, after checking the node."""
         self.dofs(model)
-        return Contact(self.node, tuple(self.normal_for(model)), self.gap)
+        return Contact(self.node, tuple(self.normal_for(model)), self.gap, self.nodes)
+
+    @classmethod
+    def face(cls, model: FEModel, group: str = "tip", normal: Sequence[float] | None = None,
+             gap: float | None = None) -> Contact:
+        """The contact of a whole face: ``wᵀx`` = the mean normal displacement of the free vertices of ``group``.
+
+        One constraint vector all the same. Unlike a single node in 3-D — a point load, whose static compliance
+        ``wᵀK⁻¹w`` grows without bound as the mesh is refined — a face's mean displacement has a compliance that
+        converges. Equal weights: a uniform mesh of the face is assumed (say so when it is not).
+
+        >>> from skfem import MeshTri
+        >>> from bladecase.fe import Mesh, assemble
+        >>> t = MeshTri.init_tensor(np.linspace(0, 0.1, 21), np.linspace(0, 0.02, 5))
+        >>> p = np.c_[t.p.T, np.zeros(t.p.shape[1])]
+        >>> tip = np.flatnonzero(p[:, 0] == 0.1)
+        >>> strip = Mesh(p, {"triangle": t.t.T}, dim=2, groups={"root": np.flatnonzero(p[:, 0] == 0), "tip": tip})
+        >>> model = assemble(strip, "steel", order=1, thickness=0.002)
+        >>> c = Contact.face(model, "tip", (1.0, 0.0), 1e-4)
+        >>> c, len(c.nodes), float(c.w(model).sum())
+        (Contact(face of 5 nodes around node=102, normal=(1.0, 0.0), gap=0.0001), 5, 1.0)
+        """
+        _check_model(model)
+        nodes = _in_group(model, free_nodes(model), group)
+        centre = model.mesh.points[nodes].mean(axis=0)
+        middle = int(nodes[np.argmin(np.linalg.norm(model.mesh.points[nodes] - centre, axis=1))])
+        return cls(middle, normal, gap, tuple(int(k) for k in nodes))._resolved(model)
+
+    def __repr__(self) -> str:
+        where = f"face of {len(self.nodes)} nodes around node={self.node}" if self.nodes else f"node={self.node}"
+        return f"Contact({where}, normal={self.normal}, gap={self.gap})"
 
 
 def _finite_vector(name: str, value) -> np.ndarray:

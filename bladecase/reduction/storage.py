@@ -29,7 +29,8 @@ def save_reduced(reduced: ReducedModel, path) -> None:
     out = {"format": np.array(REDUCED_FORMAT), "method": np.array(reduced.method),
            "size": np.array(-1 if reduced.size is None else reduced.size), "w": s.w, "gap": np.array(s.gap),
            "contact/node": np.array(c.node), "contact/gap": np.array(c.gap),
-           "contact/normal": np.array([] if c.normal is None else c.normal, dtype=float)}
+           "contact/normal": np.array([] if c.normal is None else c.normal, dtype=float),
+           "contact/nodes": np.array(c.nodes, dtype=np.int64)}
     if getattr(s, "contact_model", "newton") == "massless":  # MasslessSystem: S and kc instead of K
         out.update({"contact_model": np.array("massless"), "Mr": s.M, "Sr": s.S, "kc": np.array(s.kc),
                     "closed_shape": reduced.closed_shape, "masses": reduced.masses})
@@ -59,8 +60,9 @@ def load_reduced(path) -> ReducedModel:
 
             model = model_from_arrays(data, prefix="model/", source=str(path))
             normal = np.asarray(data["contact/normal"])
+            nodes = tuple(int(k) for k in data["contact/nodes"]) if "contact/nodes" in data else ()
             contact = Contact(int(data["contact/node"]), tuple(normal) if normal.size else None,
-                              float(data["contact/gap"]))
+                              float(data["contact/gap"]), nodes)
             size = int(data["size"])
             if "contact_model" in data and str(data["contact_model"]) == "massless":
                 from ..nsm import MasslessSystem

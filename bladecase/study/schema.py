@@ -182,6 +182,8 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "farthest": Key(_LIST, None, "Pick the free node of 'group' (default 'tip') farthest along this "
                         "direction, e.g. [-1, 0, 0].", _vector),
         "nearest": Key(_LIST, None, "Pick the free node nearest this point (within 'group' if given).", _vector),
+        "face": Key(_STR, None, "Contact on a whole face instead of one node: the mean normal displacement of "
+                    "the free nodes of this mesh group (e.g. 'tip'), one constraint all the same."),
         "normal": Key(_LIST, None, "Casing normal, from the blade towards the casing; default: radial "
                       "(+z in 3-D, +y in 2-D).", _vector),
         "model": Key(_STR, "newton", "Contact model: 'newton' (the node keeps its mass; Newton's impact law, "
@@ -415,9 +417,9 @@ def _cross_checks(c: dict) -> None:
         missing = [k for k in ("E", "nu", "rho") if m[k] is None]
         raise StudyError(f"[material] {', '.join(missing)}: give E, nu and rho together (or only 'preset')")
     ct = c["contact"]
-    pickers = [k for k in ("node", "farthest", "nearest") if ct[k] is not None]
+    pickers = [k for k in ("node", "farthest", "nearest", "face") if ct[k] is not None]
     if len(pickers) > 1:
-        raise StudyError(f"[contact] {pickers[1]}: give at most one of node, farthest, nearest (got {pickers})")
+        raise StudyError(f"[contact] {pickers[1]}: give at most one of node, farthest, nearest, face (got {pickers})")
     r = c["reduction"]
     if r["method"] == "full":
         r["size"] = None

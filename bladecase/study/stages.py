@@ -77,6 +77,8 @@ def build_model(study: Study, mesh: Mesh) -> FEModel:
 def contact_group(study: Study) -> str | None:
     """The mesh group ``[contact]`` selects from (``None``: a node index, or every free node)."""
     c = study["contact"]
+    if c["face"] is not None:
+        return c["face"]
     if c["node"] is not None:
         return None
     if c["farthest"] is not None:
@@ -98,6 +100,8 @@ def build_contact(study: Study, model: FEModel) -> Contact:
     normal, gap = c["normal"], c["clearance"]
     group = contact_group(study)
     try:
+        if c["face"] is not None:
+            return Contact.face(model, c["face"], normal, gap)
         if c["node"] is not None:
             return Contact.at(model, c["node"], normal, gap)
         if c["farthest"] is not None:
