@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..progress import progress_bar
+from ..progress import progress_bar, progress_counter
 from .branches import Arc, Branch
 from .families import follow_family, passes
 from .kipp import check_k, orbits_kipp
@@ -106,12 +106,15 @@ def nonsmooth_mode(
         starts.extend((T, o) for o in sols if o.repeats == 1)
     families: list[Branch] = []
     covered = [False] * len(starts)
-    for n, (_, o) in enumerate(starts):
-        if covered[n]:
-            continue
-        fam = follow_family(system, k, o, (T_lo, T_hi), step, max_points, refine)
-        for m in range(n + 1, len(starts)):
-            if not covered[m] and passes(fam.problem, fam.points, starts[m]):
-                covered[m] = True
-        families.append(Branch(system=system, k=k, orbits=fam.orbits, arcs=[Arc(*a) for a in fam.arcs]))
+    with progress_counter(len(starts), f"{k}-ipp families", enabled=progress, unit="start") as bar:
+        for n, (_, o) in enumerate(starts):
+            bar.update()
+            if covered[n]:
+                continue
+            fam = follow_family(system, k, o, (T_lo, T_hi), step, max_points, refine)
+            for m in range(n + 1, len(starts)):
+                if not covered[m] and passes(fam.problem, fam.points, starts[m]):
+                    covered[m] = True
+            families.append(Branch(system=system, k=k, orbits=fam.orbits, arcs=[Arc(*a) for a in fam.arcs]))
+            bar.set_postfix_str(f"{len(families)} families, {sum(1 for f in families if f.arcs)} with arcs")
     return families

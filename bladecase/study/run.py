@@ -154,7 +154,8 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
             log.info("reference model for the orbits' check: %s", reference)
     with stage("search"):
         unit, _ = period_unit(study, reduced.system)
-        found = executor.map(lambda r: search(study, r.system, progress=progress, unit=unit), [reduced, *compares],
+        found = executor.map(lambda r: search(study, r.system, progress=progress, unit=unit,
+                                              label=f"{r.method} {r.size} ({r.n} dofs)"), [reduced, *compares],
                              desc="models", progress=progress)
         families, compare_families = found[0], found[1:]
         write_json(staging / "modes.json", families_document(families, reduced.system))

@@ -148,12 +148,13 @@ def period_unit(study: Study, system: LinearSystem) -> tuple[float, str]:
     return float(2 * np.pi / omega[j - 1]), unit
 
 
-def search(study: Study, system: LinearSystem, progress: bool = False, unit: float | None = None) -> list[Branch]:
+def search(study: Study, system: LinearSystem, progress: bool = False, unit: float | None = None,
+           label: str = "") -> list[Branch]:
     """Every family of every ``[search] ipp`` in the study's period range.
 
     ``unit``: seconds per period unit (default: from ``system``; comparison
     models pass the primary model's, so that every model searches the same
-    periods).
+    periods).  ``label``: the model's name in the log lines.
     """
     s = study["search"]
     scale = period_unit(study, system)[0] if unit is None else unit
@@ -164,6 +165,7 @@ def search(study: Study, system: LinearSystem, progress: bool = False, unit: flo
         found = nonsmooth_mode(system, k, T_range, scan=s["scan"], step=s["step"], max_points=s["max_points"],
                                progress=progress, resolution=s["resolution"])
         n_arcs = sum(len(f.arcs) for f in found)
-        log.info("%d-ipp: %d families, %d admissible arcs (%.1f s)", k, len(found), n_arcs, time.perf_counter() - t0)
+        log.info("%s%d-ipp: %d families, %d with admissible arcs (%d arcs) (%.1f s)", f"{label}: " if label else "",
+                 k, len(found), sum(1 for f in found if f.arcs), n_arcs, time.perf_counter() - t0)
         families.extend(found)
     return families
