@@ -34,7 +34,7 @@ from .continuation import Curve, bisect, trace
 from .families import KippCurve
 from .flight import FlightPropagator, ImpactLaw, ModalFlight, NewtonImpact
 from .kipp import canonical_rotation, orbits_kipp
-from .massless import MasslessSystem, condense, simulate_massless
+from .massless import MASSLESS_DENSE_LIMIT, MasslessSystem, condense, redistribute_mass, simulate_massless
 from .modal import (
     ModalKernel,
     check_period,
@@ -53,9 +53,11 @@ from .verify import VERIFY_RTOL, verify
 
 __all__ = [
     "Arc", "Backbone", "Branch", "Curve", "Family", "FlightPropagator", "ImpactLaw", "Interval", "KippCurve",
-    "LinearSystem", "MasslessSystem", "ModalFlight", "ModalKernel", "NewtonImpact", "PeriodicOrbit", "Spectrum",
+    "LinearSystem", "MASSLESS_DENSE_LIMIT", "MasslessSystem", "ModalFlight", "ModalKernel", "NewtonImpact",
+    "PeriodicOrbit", "Spectrum",
     "Trajectory", "backbone", "bar", "bar_continuum_energy", "bisect", "canonical_rotation", "chain",
     "check_period", "condense", "impact_matrices", "integrate", "kipp_jacobian", "kipp_residual", "make_orbit",
-    "newton_times", "nonsmooth_mode", "orbit_1ipp", "orbits_kipp", "simulate", "simulate_massless",
+    "newton_times", "nonsmooth_mode", "orbit_1ipp", "orbits_kipp", "redistribute_mass", "simulate",
+    "simulate_massless",
     "solve_times", "trace", "verify", "VERIFY_RTOL",
 ]

@@ -6,13 +6,15 @@ reduced states back to the mesh.
 
 Modules: :mod:`~bladecase.reduction.contact` (:class:`Contact`), :mod:`~bladecase.reduction.symmetry`
 (mass factor, symmetry basis, per-dof defect), :mod:`~bladecase.reduction.lanczos` (the Lanczos chain),
-:mod:`~bladecase.reduction.model` (:class:`ReducedModel`), :mod:`~bladecase.reduction.registry`
+:mod:`~bladecase.reduction.model` (:class:`ReducedModel`), :mod:`~bladecase.reduction.massless` (the massless
+contact model of an FE structure, :func:`massless_model`), :mod:`~bladecase.reduction.registry`
 (:data:`METHODS`, :func:`register`, :func:`reduce`), :mod:`~bladecase.reduction.methods` (one module per
 method), :mod:`~bladecase.reduction.storage` (stage files).
 """
 
 from .contact import Contact, radial_normal
 from .lanczos import LanczosChain, chain_grounding, chain_jacobi, lanczos_chain
+from .massless import MasslessReducedModel, massless_masses, massless_model
 from .methods import FULL_LIMIT
 from .model import ReducedModel, node_operator
 from .registry import METHODS, Registry, reduce, register
@@ -20,7 +22,8 @@ from .storage import load_reduced, save_reduced
 from .symmetry import MassFactor, PerDofDefect, SymmetryBasis, mass_factor, per_dof_defect, per_dof_law
 
 __all__ = [
-    "FULL_LIMIT", "METHODS", "Contact", "LanczosChain", "MassFactor", "PerDofDefect", "ReducedModel", "Registry",
-    "SymmetryBasis", "chain_grounding", "chain_jacobi", "lanczos_chain", "load_reduced", "mass_factor",
-    "node_operator", "per_dof_defect", "per_dof_law", "radial_normal", "reduce", "register", "save_reduced",
+    "FULL_LIMIT", "METHODS", "Contact", "LanczosChain", "MassFactor", "MasslessReducedModel", "PerDofDefect",
+    "ReducedModel", "Registry", "SymmetryBasis", "chain_grounding", "chain_jacobi", "lanczos_chain", "load_reduced",
+    "mass_factor", "massless_masses", "massless_model", "node_operator", "per_dof_defect", "per_dof_law",
+    "radial_normal", "reduce", "register", "save_reduced",
 ]

@@ -1,4 +1,4 @@
-"""The blade–casing contact of a finite-element model: one node, a normal, a gap.
+"""The blade–casing contact of a finite-element model: one node (or a face), a normal, a gap.
 
 A :class:`Contact` says which mesh node touches the casing, along which unit
 normal ``ν`` and after which clearance ``d``.  On an :class:`~bladecase.fe.FEModel`
@@ -11,7 +11,10 @@ Picking the node:
 * by id: ``Contact(node, normal, gap)`` or :meth:`Contact.at` (checked against a model);
 * the free node nearest a point: :meth:`Contact.nearest`;
 * the node of a group (``"tip"`` by default) farthest along a direction, e.g.
-  the leading-edge tip corner: :meth:`Contact.farthest`.
+  the leading-edge tip corner: :meth:`Contact.farthest`;
+* a whole face, ``wᵀx`` = the weighted mean of ``ν·u`` over the free vertices of a group (equal or tributary-area
+  weights): :meth:`Contact.face`. One constraint all the same; unlike a single node (a point load in 3-D), its
+  static compliance converges under mesh refinement.
 
 Default normal (``normal=None``): the casing's radial direction.  The blades of
 :mod:`bladecase.fe.geometry` are radial along the LAST axis — 3-D blades along
@@ -162,6 +165,9 @@ class Contact:
     #: A weighted node set instead of one node (``Contact.face``): ``wᵀx`` is the mean of ``ν·u`` over these
     #: nodes (equal weights); ``node`` is then the set's node nearest its centroid (drawn, reported).
     nodes: tuple[int, ...] = field(default=(), repr=False)
+    #: The weights ``ω_k >= 0`` of ``nodes`` (``Σ ω_k = 1``; less when the face touches the clamp), e.g. the
+    #: tributary areas of ``Contact.face(..., weights="area")``; empty: equal weights ``1/len(nodes)``.
+    weights: tuple[float, ...] = field(default=(), repr=False)
 
     def __post_init__(self) -> None:
         node = self.node
@@ -176,6 +182,14 @@ class Contact:
             raise ValueError(f"nodes of a face contact must be mesh node indices including node {self.node}, "
                              f"got {self.nodes!r}")
         object.__setattr__(self, "nodes", nodes)
+        weights = tuple(float(x) for x in self.weights)
+        if weights:
+            total = sum(weights)
+            if (len(weights) != len(nodes) or not all(np.isfinite(weights)) or min(weights) < 0
+                    or not 0 < total <= 1 + 1e-12):
+                raise ValueError(f"weights of a face contact must be one finite value >= 0 per node of nodes "
+                                 f"({len(nodes)}), summing to at most 1 and more than 0, got {self.weights!r}")
+        object.__setattr__(self, "weights", weights)
 
     # ------------------------------------------------------------------ helpers to pick the node
 
@@ -285,7 +299,12 @@ class Contact:
         idx = self.dofs(model)
         nu = self.normal_for(model)
         w = np.zeros(model.n_dofs)
-        w[idx] = nu[model.dofs.direction[idx]] / max(len(self.nodes), 1)
+        if self.weights:  # the weight of each dof's node (dofs() lists the nodes in order)
+            weight = dict(zip(self.nodes, self.weights, strict=True))
+            scale = np.array([weight[k] for k in model.dofs.node[idx]])
+        else:
+            scale = 1.0 / max(len(self.nodes), 1)
+        w[idx] = nu[model.dofs.direction[idx]] * scale
         if not np.any(w):  # a free node always has all its directions free; guard anyway
             raise ValueError(f"the normal {tuple(nu)} has no component on the free dofs of node {self.node}")
         return w
@@ -303,16 +322,24 @@ class Contact:
     def _resolved(self, model: FEModel) -> Contact:
         """This contact with its normal made explicit for ``model``, after checking the node."""
         self.dofs(model)
-        return Contact(self.node, tuple(self.normal_for(model)), self.gap, self.nodes)
+        return Contact(self.node, tuple(self.normal_for(model)), self.gap, self.nodes, self.weights)
 
     @classmethod
     def face(cls, model: FEModel, group: str = "tip", normal: Sequence[float] | None = None,
-             gap: float | None = None) -> Contact:
+             gap: float | None = None, weights: str = "equal") -> Contact:
         """The contact of a whole face: ``wᵀx`` = the mean normal displacement of the free vertices of ``group``.
 
         One constraint vector all the same. Unlike a single node in 3-D — a point load, whose static compliance
-        ``wᵀK⁻¹w`` grows without bound as the mesh is refined — a face's mean displacement has a compliance that
-        converges. Equal weights: a uniform mesh of the face is assumed (say so when it is not).
+        ``wᵀK⁻¹w`` grows without bound as the mesh is refined (like ``1/h``; like ``log(1/h)`` in 2-D) — a face's
+        mean displacement has a compliance that converges.
+
+        ``weights="equal"`` (default): ``ω_k = 1/len(nodes)``, the mean over the nodes; it is the face's mean
+        displacement only on a uniform mesh, and even there the face's edge nodes are over-weighted (point loads
+        of weight ``~h^(dim-1)``), so the compliance converges erratically at first. ``weights="area"``: the
+        tributary areas (lengths in 2-D) of the boundary facets of the body cells whose vertices are all in
+        ``group``, ``ω_k = Σ_f |f|/dim / Σ_f |f|`` — the exact mean of the (P1-interpolated) normal displacement
+        over the face, on any mesh; a clamped vertex's share is dropped (``Σ ω_k < 1``), and the mid-edge dofs of
+        P2 models get no weight.
 
         >>> from skfem import MeshTri
         >>> from bladecase.fe import Mesh, assemble
@@ -324,17 +351,47 @@ class Contact:
         >>> c = Contact.face(model, "tip", (1.0, 0.0), 1e-4)
         >>> c, len(c.nodes), float(c.w(model).sum())
         (Contact(face of 5 nodes around node=102, normal=(1.0, 0.0), gap=0.0001), 5, 1.0)
+        >>> np.round(Contact.face(model, "tip", (1.0, 0.0), 1e-4, weights="area").weights, 12)  # ends: half
+        array([0.125, 0.25 , 0.25 , 0.25 , 0.125])
         """
+        if weights not in ("equal", "area"):
+            raise ValueError(f"weights must be 'equal' or 'area', got {weights!r}")
         _check_model(model)
         nodes = _in_group(model, free_nodes(model), group)
         centre = model.mesh.points[nodes].mean(axis=0)
         middle = int(nodes[np.argmin(np.linalg.norm(model.mesh.points[nodes] - centre, axis=1))])
-        return cls(middle, normal, gap, tuple(int(k) for k in nodes))._resolved(model)
+        omega = tuple(float(x) for x in _area_weights(model, group, nodes)) if weights == "area" else ()
+        return cls(middle, normal, gap, tuple(int(k) for k in nodes), omega)._resolved(model)
 
     def __repr__(self) -> str:
         where = f"face of {len(self.nodes)} nodes around node={self.node}" if self.nodes else f"node={self.node}"
+        if self.weights:
+            where = "area-weighted " + where
         return f"Contact({where}, normal={self.normal}, gap={self.gap})"
 
+
+def _area_weights(model: FEModel, group: str, nodes: np.ndarray) -> np.ndarray:
+    """Tributary weights of ``nodes``: each boundary facet of the body cells whose vertices all lie in ``group``
+    gives ``|f|/dim`` to each of its vertices; divided by the face's total measure (see :meth:`Contact.face`)."""
+    from itertools import combinations
+
+    mesh, dim = model.mesh, model.dim
+    vertices = mesh.cells[mesh.body_type][:, :dim + 1]  # gmsh/meshio order: the corner vertices first
+    facets = np.vstack([np.sort(vertices[:, list(f)], axis=1) for f in combinations(range(dim + 1), dim)])
+    unique, count = np.unique(facets, axis=0, return_counts=True)
+    inside = np.zeros(mesh.points.shape[0], dtype=bool)
+    inside[mesh.group(group)] = True
+    face = unique[(count == 1) & inside[unique].all(axis=1)]
+    if face.size == 0:
+        raise ValueError(f"group {group!r} holds no boundary facet of the body cells: weights='area' needs a face "
+                         "(use weights='equal' for a set of nodes)")
+    P = mesh.points[:, :dim]
+    edge = P[face[:, 1]] - P[face[:, 0]]
+    size = np.linalg.norm(edge if dim == 2 else np.cross(edge, P[face[:, 2]] - P[face[:, 0]]), axis=1)
+    size = size if dim == 2 else 0.5 * size
+    share = np.zeros(mesh.points.shape[0])
+    np.add.at(share, face.ravel(), np.repeat(size / dim, dim))
+    return share[nodes] / size.sum()
 
 def _finite_vector(name: str, value) -> np.ndarray:
     try:

@@ -80,6 +80,11 @@ class ReducedModel:
             )
         return np.asarray(self.basis @ x_r)
 
+    def free_velocities(self, x_r, v_r) -> np.ndarray:
+        """Free-dof velocities of reduced states ``(x_r, v_r)``: ``V v_r`` (a model whose expansion depends on
+        the state, e.g. the massless contact model's closed phase, adds its own term)."""
+        return self.free_dofs(v_r)
+
     def expand_state(self, x_r) -> np.ndarray:
         """Per-node displacements of reduced states.
 
@@ -94,7 +99,10 @@ class ReducedModel:
             Displacement of every mesh node (see :meth:`expand` for which
             nodes carry what).
         """
-        x = self.free_dofs(x_r)
+        return self._at_nodes(self.free_dofs(x_r))
+
+    def _at_nodes(self, x: np.ndarray) -> np.ndarray:
+        """Per-node values of free-dof vectors ``(n_free,)`` or ``(n_free, k)``."""
         u = self._node_operator @ (x if x.ndim == 2 else x[:, None])
         u = u.reshape(self.model.mesh.points.shape[0], self.model.dim, -1)
         return u if x.ndim == 2 else u[:, :, 0]
@@ -129,7 +137,7 @@ class ReducedModel:
                 "reduced dofs: expand an orbit of reduced.system"
             )
         x_r, v_r = orbit.state(np.atleast_1d(np.asarray(t, dtype=float)))
-        return self.expand_state(x_r), self.expand_state(v_r)
+        return self._at_nodes(self.free_dofs(x_r)), self._at_nodes(self.free_velocities(x_r, v_r))
 
     @cached_property
     def _node_operator(self) -> sp.csr_array:

@@ -114,14 +114,17 @@ def reduce(
         ``contact.w(model)`` is the constraint vector on the free dofs.
     method : str
         One of :data:`METHODS`: ``"full"``, ``"modal"``, ``"lanczos"``, ``"lanczos-si"``,
-        ``"craig-bampton"`` (see :mod:`bladecase.reduction.methods`).
+        ``"craig-bampton"``, ``"massless"`` (see :mod:`bladecase.reduction.methods`).
     size : int or None
         Modes (``"modal"``, ``1 <= size <= n_free``), fixed-interface modes
         (``"craig-bampton"``, ``1 <= size <= n_free - n_boundary``) or
         Lanczos steps (``1 <= size <= n_free``).  Asking for more than half
         of the available modes switches to a dense eigen-solution, allowed
         up to :data:`~bladecase.reduction.FULL_LIMIT` dofs.  ``"full"`` takes
-        ``None`` (or ``n_free``).
+        ``None`` (or ``n_free``).  ``"massless"``: modes of the massless
+        structure (``1 <= size <= n_interior - 1``, plus the attachment
+        vector), or ``None`` for the exact condensation of a small model
+        (:func:`bladecase.reduction.massless_model`).
     factor : SPDFactor or None
         ``bladecase.fe.stiffness_factor(model)`` to reuse a factorisation of
         ``K`` (``"modal"`` and ``"lanczos-si"`` use it); computed when needed if ``None``.

@@ -30,7 +30,7 @@ def save_reduced(reduced: ReducedModel, path) -> None:
            "size": np.array(-1 if reduced.size is None else reduced.size), "w": s.w, "gap": np.array(s.gap),
            "contact/node": np.array(c.node), "contact/gap": np.array(c.gap),
            "contact/normal": np.array([] if c.normal is None else c.normal, dtype=float),
-           "contact/nodes": np.array(c.nodes, dtype=np.int64)}
+           "contact/nodes": np.array(c.nodes, dtype=np.int64), "contact/weights": np.array(c.weights, dtype=float)}
     if getattr(s, "contact_model", "newton") == "massless":  # MasslessSystem: S and kc instead of K
         out.update({"contact_model": np.array("massless"), "Mr": s.M, "Sr": s.S, "kc": np.array(s.kc),
                     "closed_shape": reduced.closed_shape, "masses": reduced.masses})
@@ -61,16 +61,18 @@ def load_reduced(path) -> ReducedModel:
             model = model_from_arrays(data, prefix="model/", source=str(path))
             normal = np.asarray(data["contact/normal"])
             nodes = tuple(int(k) for k in data["contact/nodes"]) if "contact/nodes" in data else ()
+            weights = tuple(float(x) for x in data["contact/weights"]) if "contact/weights" in data else ()
             contact = Contact(int(data["contact/node"]), tuple(normal) if normal.size else None,
-                              float(data["contact/gap"]), nodes)
+                              float(data["contact/gap"]), nodes, weights)
             size = int(data["size"])
             if "contact_model" in data and str(data["contact_model"]) == "massless":
                 from ..nsm import MasslessSystem
-                from .methods.massless import MasslessReducedModel
+                from .massless import MasslessReducedModel
 
                 system = MasslessSystem(np.asarray(data["Mr"]), np.asarray(data["Sr"]), np.asarray(data["w"]),
                                         float(data["kc"]), float(data["gap"]))
-                return MasslessReducedModel(method=str(data["method"]), size=size, system=system,
+                return MasslessReducedModel(method=str(data["method"]), size=None if size < 0 else size,
+                                            system=system,
                                             basis=matrix("basis"), model=model, contact=contact,
                                             closed_shape=np.asarray(data["closed_shape"]),
                                             masses=np.asarray(data["masses"]))

@@ -63,7 +63,7 @@ def check_in_reference(orbit, reduced: ReducedModel, reference: ReducedModel) ->
     t0 = 2 * orbit.beta + orbit.alpha if massless else 0.5 * float(np.diff(np.r_[0.0, orbit.impact_times]).min())
     x_r, v_r = (z[:, 0] for z in orbit.state(np.array([t0])))  # in an open phase: no switch at the start
     q0 = _project(reference, reduced.free_dofs(x_r))
-    p0 = _project(reference, reduced.free_dofs(v_r))
+    p0 = _project(reference, reduced.free_velocities(x_r, v_r))
     s = reference.system
     penetration = float(s.w @ q0) - s.gap
     if penetration > 0:  # the reference's contact sees more of the motion: it starts beyond the casing

@@ -33,8 +33,7 @@ def orbit_scene(study: Study, reduced: ReducedModel, families: list[Branch], cho
     x, v = orbit.state(times)
     mesh = fe_grid(model)
     u = nodal_field(model, reduced.free_dofs(x))
-    free_v = getattr(reduced, "free_velocities", None)  # the massless model's contact dofs move with λ' too
-    v = nodal_field(model, free_v(x, v) if free_v is not None else reduced.free_dofs(v))
+    v = nodal_field(model, reduced.free_velocities(x, v))  # the massless model's contact dofs move with λ' too
     scale = animation.auto_scale(mesh, u, o["auto_fraction"]) if o["scale"] == "auto" else float(o["scale"])
     return OrbitScene(stem=choice.stem, title=f"{study.name}: {orbit.k}-ipp nonsmooth mode (family {choice.family})",
                       mesh=mesh, orbit=orbit, times=times, u=u, v=v, impact=impact,

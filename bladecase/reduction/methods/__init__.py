@@ -26,7 +26,9 @@
 ``"massless"`` (:mod:`.massless`)
     The massless contact model (theory §8): the contact dofs' lumped mass is moved to their neighbours,
     they are condensed statically in each phase; ``size`` modes of the massless structure plus the static
-    attachment vector of the contact; the system is a :class:`~bladecase.nsm.MasslessSystem`.
+    attachment vector of the contact (``size=None``: every interior dof, the exact condensation); the system is
+    a :class:`~bladecase.nsm.MasslessSystem` (:func:`bladecase.reduction.massless_model`, which checks ``size``
+    itself: registered with ``sized=False``).
 
 Every method but ``"full"`` works on sparse matrices only (no dense
 ``n × n`` array), so the ~100k-dof blades of the FE front end reduce in
@@ -56,4 +58,4 @@ register("lanczos-si", lanczos.build_shift_invert, "size shift-invert Lanczos st
          "the contact sees, as a chain")
 register("craig-bampton", craig_bampton.build, "the contact node's dofs plus size fixed-interface modes")
 register("massless", massless.build, "massless contact dofs (mass moved to their neighbours, no impact law): size "
-         "modes of the massless structure plus the contact's attachment vector")
+         "modes of the massless structure plus the contact's attachment vector (None: exact)", sized=False)
