@@ -38,7 +38,7 @@ def reference_model(model: FEModel, contact: Contact, reduced: ReducedModel,
     contact_model = getattr(reduced.system, "contact_model", "newton")
     methods = [m for m in REFERENCE_METHODS[contact_model] if m in METHODS]
     method = next((m for m in methods if m != reduced.method), methods[0])
-    size = min(REFERENCE_FACTOR * max(reduced.size, reduced.n), model.n_dofs // 2)
+    size = min(REFERENCE_FACTOR * max(reduced.size or 0, reduced.n), model.n_dofs // 2)
     return reduce(model, contact, method, size, factor=factor)
 
 
