@@ -77,7 +77,8 @@ def main() -> None:
             table.append(energies)
         last = np.array(table[-2:])
         change = np.abs(last[1] / last[0] - 1)
-        verdict = ", ".join(f"{x} T₁: {c:.1%}" if np.isfinite(c) else f"{x} T₁: no orbit" for x, c in zip(RATIOS, change))
+        verdict = ", ".join(f"{x} T₁: {c:.1%}" if np.isfinite(c) else f"{x} T₁: no orbit"
+                            for x, c in zip(RATIOS, change))
         ok = np.isfinite(change).all() and (change < 0.01).all()
         print(f"   change between sizes {SIZES[-2]} and {SIZES[-1]}: {verdict} — "
               f"{'CONVERGED (< 1 %)' if ok else 'NOT converged: the energy at a fixed period depends on the model'}")
