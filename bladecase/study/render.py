@@ -90,9 +90,10 @@ def render_all(study: Study, reduced: ReducedModel, families: list[Branch], fold
                     "reference model %s (%d dofs) — artefacts of the reduced model", len(rejected),
                     reduced.method, reference.method, reference.n)
     if not chosen:
-        log.warning("no admissible orbit to animate%s: widen [search] periods, add ipp values%s",
+        log.warning("no admissible orbit to animate%s: widen [search] periods or add ipp values%s",
                     " that survives in the reference model" if reference is not None else "",
-                    ", or enlarge/change the reduced model" if reference is not None else "")
+                    "; with Newton's impact law the orbits depend on the reduced model ([contact] model = "
+                    "'massless' removes the impact law)" if reference is not None else "")
     return [render(study, reduced, families, c, folder, reference)
             for c in progress_bar(chosen, "animations", enabled=progress, unit="orbit")]
 
