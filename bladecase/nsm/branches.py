@@ -166,8 +166,11 @@ class Branch:
 
     @property
     def impact_times(self) -> np.ndarray:
-        """``(N, k)`` impact times (NaN rows where no orbit)."""
-        return np.array([np.full(self.k, np.nan) if o is None else o.impact_times for o in self.orbits])
+        """``(N, k)`` impact times (NaN rows where no orbit; rows padded with NaN when the orbits' counts differ,
+        as along a massless mode whose number of contact phases changes)."""
+        rows = [np.full(self.k, np.nan) if o is None else np.asarray(o.impact_times, float) for o in self.orbits]
+        width = max([self.k] + [r.size for r in rows])
+        return np.array([np.pad(r, (0, width - r.size), constant_values=np.nan) for r in rows])
 
     @property
     def impulses(self) -> np.ndarray:
@@ -420,6 +423,11 @@ def _orbit_from_dict(system, rec: dict):
     """An orbit record of either contact model (``contact_model`` key; Newton when absent)."""
     if rec.get("contact_model") == "massless":
         from .massless_orbits import SymmetricOrbit
+
+        if "durations" in rec:
+            from .massless_phases import PhasedOrbit
+
+            return PhasedOrbit.from_dict(system, rec)
 
         return SymmetricOrbit.from_dict(system, rec)
     return PeriodicOrbit.from_dict(system, rec)

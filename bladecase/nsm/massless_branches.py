@@ -99,3 +99,38 @@ def massless_orbit_at(system: MasslessSystem, orbits: list[SymmetricOrbit], T: f
         if orbit is not None:
             out.append(orbit)
     return out
+
+
+def massless_mode(system: MasslessSystem, T_range: tuple[float, float], mode: int = 0, max_points: int = 4000):
+    """The nonsmooth mode grown from open-phase mode ``mode`` at grazing, followed through changes of its number
+    of contact phases (:func:`~bladecase.nsm.massless_follow.follow_mode`): a :class:`~bladecase.nsm.Branch` of
+    admissible :class:`~bladecase.nsm.massless_phases.PhasedOrbit` s (``orbit.k`` contact phases each), ordered
+    along the curve from grazing, or ``None`` when nothing admissible lies in ``T_range``.
+
+    Where the one-phase orbit loses admissibility (``λ`` turning negative inside the contact, or the open phase
+    touching the casing) the mode goes on with more phases instead of stopping; every point is proved admissible
+    and the boundaries where the pattern changes are refined to ``1e-9 T``.
+
+    >>> from bladecase.nsm import bar
+    >>> branch = massless_mode(bar(10, 0.5, contact="massless"), (3.2, 4.1))
+    >>> sorted({o.k for o in branch.orbits})[:2], bool(branch.admissible.all())
+    ([1, 2], True)
+    """
+    from .branches import Arc, Branch
+    from .massless_follow import follow_mode
+    from .massless_phases import PhasedOrbit
+
+    T_lo, T_hi = T_range
+    if not 0 <= int(mode) < system.n:
+        raise ValueError(f"mode must be an open-phase mode index in [0, {system.n}), got {mode!r}")
+    if abs(system.open.b[mode]) <= 1e-12 * np.abs(system.open.b).max():
+        raise ValueError(f"the contact does not see open-phase mode {mode} (b = {system.open.b[mode]:.3g}): "
+                         "no nonsmooth mode grows from it")
+    seed = follow_from_grazing(system, 0.0, mode=int(mode), max_points=2)[-1]
+    start = PhasedOrbit(system, "open", [seed.alpha, seed.beta], seed.a)
+    orbits = follow_mode(system, start, (T_lo, max(T_hi, start.T)), grow=1, max_points=max_points)
+    orbits = [o for o in orbits if T_lo <= o.T <= T_hi]
+    if len(orbits) < 2:
+        return None
+    return Branch(system, 1, orbits, [Arc(0, len(orbits) - 1, min(o.T for o in orbits), max(o.T for o in orbits),
+                                          False, False)])
