@@ -24,8 +24,10 @@ The pipeline inside, one module per step:
   a flight propagator (:class:`ModalFlight`), an impact law (:class:`NewtonImpact`), the event loop
   (:func:`integrate`) and :func:`simulate`;
 - :mod:`~bladecase.nsm.verify` — the independent check of an orbit by simulation (:func:`verify`);
-- :mod:`~bladecase.nsm.massless`, :mod:`~bladecase.nsm.massless_orbits`, :mod:`~bladecase.nsm.bar` — the
-  massless contact model (theory §8).
+- :mod:`~bladecase.nsm.massless`, :mod:`~bladecase.nsm.massless_orbits` (one contact phase),
+  :mod:`~bladecase.nsm.massless_phases` (any number: :class:`PhasedOrbit`), :mod:`~bladecase.nsm.massless_follow`
+  and :func:`massless_mode` (a mode followed through phase changes), :mod:`~bladecase.nsm.bar` — the massless
+  contact model (theory §8).
 """
 
 from .bar import bar, bar_continuum_energy
@@ -35,6 +37,8 @@ from .families import KippCurve
 from .flight import FlightPropagator, ImpactLaw, ModalFlight, NewtonImpact
 from .kipp import canonical_rotation, orbits_kipp
 from .massless import MASSLESS_DENSE_LIMIT, MasslessSystem, condense, redistribute_mass, simulate_massless
+from .massless_branches import massless_mode
+from .massless_phases import PhasedOrbit
 from .modal import (
     ModalKernel,
     check_period,
@@ -54,9 +58,10 @@ from .verify import VERIFY_RTOL, verify
 __all__ = [
     "Arc", "Backbone", "Branch", "Curve", "Family", "FlightPropagator", "ImpactLaw", "Interval", "KippCurve",
     "LinearSystem", "MASSLESS_DENSE_LIMIT", "MasslessSystem", "ModalFlight", "ModalKernel", "NewtonImpact",
-    "PeriodicOrbit", "Spectrum",
+    "PeriodicOrbit", "PhasedOrbit", "Spectrum",
     "Trajectory", "backbone", "bar", "bar_continuum_energy", "bisect", "canonical_rotation", "chain",
     "check_period", "condense", "impact_matrices", "integrate", "kipp_jacobian", "kipp_residual", "make_orbit",
+    "massless_mode",
     "newton_times", "nonsmooth_mode", "orbit_1ipp", "orbits_kipp", "redistribute_mass", "simulate",
     "simulate_massless",
     "solve_times", "trace", "verify", "VERIFY_RTOL",
