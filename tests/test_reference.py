@@ -84,7 +84,10 @@ def test_massless_study_animates_orbits_that_survive_in_the_reference(tmp_path):
         check = a["reference_check"]
         assert check["survives"] and check["drift"] < SURVIVAL_RTOL and check["contacts"] == 1
         assert 0 < a["contact_time"] < a["T"]
-    assert "in contact for t/T in [0, " in (result.directory / "report.md").read_text()
+        assert a["contact_intervals"] == [[0.0, a["contact_time"]]]
+        assert a["modal_energy"]["top_modes"][0]["mode"] == 1  # near grazing the first mode holds the energy
+    report = (result.directory / "report.md").read_text()
+    assert "in contact for t/T in [0.0000, " in report and "Energy: " in report and "Doubtful" not in report
 
 
 def test_massless_study_keys_go_together():

@@ -121,6 +121,20 @@ class SymmetricOrbit:
         return 2.0 * self.beta
 
     @property
+    def contact_intervals(self) -> list[tuple[float, float]]:
+        """``[(0, 2β)]``: the one contact phase (closing at ``t = 0``)."""
+        return [(0.0, 2.0 * self.beta)]
+
+    @property
+    def mid_open_time(self) -> float:
+        """The middle of the open phase (``v = 0``)."""
+        return 2.0 * self.beta + self.alpha
+
+    def in_contact(self, t) -> np.ndarray:
+        """Whether the contact is closed at times ``t``."""
+        return np.mod(np.atleast_1d(np.asarray(t, float)), self.T) <= 2.0 * self.beta
+
+    @property
     def x_mid_open(self) -> np.ndarray:
         return self.system.open.phi @ self.a
 

@@ -231,6 +231,12 @@ class PhasedOrbit:
         """Total time in contact per period."""
         return float(sum(b - a for a, b in self.contact_intervals))
 
+    @property
+    def mid_open_time(self) -> float:
+        """The middle of the first open phase of the period."""
+        a, b, _ = next(seg for seg in self.segments if seg[2] == 0)
+        return 0.5 * (a + b)
+
     def in_contact(self, t) -> np.ndarray:
         """Whether the contact is closed at times ``t``."""
         t = np.mod(np.atleast_1d(np.asarray(t, float)), self.T)

@@ -68,7 +68,9 @@ def report(summary: dict) -> str:
     lines.append(f"- `{files['mesh']}`: the mesh with its groups; `{files['modes']}`: every family and orbit.")
     for a in files.get("animations", []):
         what = ", ".join(f"`{a[k]}`" for k in ("gif", "mp4", "pvd", "manifold") if k in a)
-        phases = ("in contact for t/T in [0, " + f"{a['contact_time'] / a['T']:.4f}]" if "contact_time" in a else
+        phases = ("in contact for t/T in " + ", ".join(f"[{c0 / a['T']:.4f}, {c1 / a['T']:.4f}]"
+                                                       for c0, c1 in a["contact_intervals"])
+                  if "contact_intervals" in a else
                   "impacts at t/T = " + ", ".join(f"{t / a['T']:.4f}" for t in a["impact_times"]))
         check = a["verification"]
         lines.append(f"- family {a['family']}, {a['ipp']}-ipp orbit T = {a['T']:.8g} s (f = {a['frequency_hz']:.3f} "
@@ -77,6 +79,8 @@ def report(summary: dict) -> str:
                      f"{check['return_error']:.1e}{'' if check['ok'] else ' — CHECK FAILED'}): {what}")
         if "reference_check" in a:
             lines.append(f"  - {_reference_words(a['reference_check'], a['ipp'])}")
+        if "energy_words" in a:
+            lines.append(f"  - {a['energy_words']}")
         if "gif" in a:
             lines.append(f"\n  ![{a['gif']}]({a['gif']})\n")
     lines += ["", "Timings (s): " + ", ".join(f"{k} {v:.2f}" for k, v in summary["timings_s"].items()), ""]

@@ -60,7 +60,7 @@ def check_in_reference(orbit, reduced: ReducedModel, reference: ReducedModel) ->
     from ..nsm.massless import simulate_massless
 
     massless = getattr(orbit, "contact_model", "newton") == "massless"
-    t0 = 2 * orbit.beta + orbit.alpha if massless else 0.5 * float(np.diff(np.r_[0.0, orbit.impact_times]).min())
+    t0 = orbit.mid_open_time if massless else 0.5 * float(np.diff(np.r_[0.0, orbit.impact_times]).min())
     x_r, v_r = (z[:, 0] for z in orbit.state(np.array([t0])))  # in an open phase: no switch at the start
     q0 = _project(reference, reduced.free_dofs(x_r))
     p0 = _project(reference, reduced.free_velocities(x_r, v_r))

@@ -7,8 +7,11 @@ import os
 import shutil
 from pathlib import Path
 
+import numpy as np
+
 from .. import log
 from ..nsm import Branch
+from ..nsm.energy import describe_split, modal_energy_split
 from ..nsm.verify import verify
 from ..post.grid import fe_grid, grid_index, nodal_field
 from ..post.outputs import FORMATS, OrbitScene
@@ -28,8 +31,8 @@ def orbit_scene(study: Study, reduced: ReducedModel, families: list[Branch], cho
     o = study["output"]
     orbit, model = choice.orbit, reduced.model
     times, impact = frame_times(orbit, o["frames"])
-    if hasattr(orbit, "contact_time"):  # the casing is drawn in contact during the whole contact phase
-        impact = impact | (times <= orbit.contact_time)
+    if hasattr(orbit, "in_contact"):  # the massless model: the casing is drawn in contact during contact phases
+        impact = impact | orbit.in_contact(times)
     x, v = orbit.state(times)
     mesh = fe_grid(model)
     u = nodal_field(model, reduced.free_dofs(x))
@@ -56,11 +59,13 @@ def render(study: Study, reduced: ReducedModel, families: list[Branch], choice: 
              "energy_j": orbit.energy, "impact_times": orbit.impact_times.tolist(),
              "impulses": orbit.impulses.tolist(), "scale": scene.scale, "frames": int(scene.times.size),
              "verification": check}
-    if hasattr(orbit, "contact_time"):  # the massless model: a contact phase of finite duration from t = 0
+    if hasattr(orbit, "contact_intervals"):  # the massless model: contact phases of finite duration
         entry["contact_time"] = orbit.contact_time
+        entry["contact_intervals"] = [list(c) for c in orbit.contact_intervals]
     if reference is not None:
         entry["reference_check"] = check_in_reference(orbit, reduced, reference)
         log_check(entry["reference_check"], orbit.k, orbit.T)
+    entry.update(_energy_split(orbit, reference))
     if not check["ok"]:
         log.warning("orbit T = %.8g s failed the independent check (simulation from its post-impact state: "
                     "return error %.2e, %d impacts for %d): animated anyway, flagged in summary.json", orbit.T,
@@ -69,6 +74,24 @@ def render(study: Study, reduced: ReducedModel, families: list[Branch], choice: 
     log.info("animated %d-ipp orbit T = %.8g s (f = %.2f Hz, E = %.3g J; simulator return error %.1e)", orbit.k,
              orbit.T, 1 / orbit.T, orbit.energy, check["return_error"])
     return entry
+
+
+def _band(reference: ReducedModel | None) -> float | None:
+    """Highest linear frequency (Hz) of the reference model: modes above it are beyond what it can check."""
+    if reference is None:
+        return None
+    s = reference.system
+    omega = s.open.omega if hasattr(s, "open") else s.spectrum.omega
+    return float(omega.max() / (2 * np.pi))
+
+
+def _energy_split(orbit, reference: ReducedModel | None) -> dict:
+    """The orbit's modal energy split and its words (a warning when mesh-scale modes hold most of it)."""
+    split = modal_energy_split(orbit)
+    words = describe_split(split, 1 / orbit.T, _band(reference))
+    if "Doubtful" in words:
+        log.info("orbit T = %.8g s: %s", orbit.T, words.replace("**", ""))
+    return {"modal_energy": split.to_dict(), "energy_words": words}
 
 
 def render_all(study: Study, reduced: ReducedModel, families: list[Branch], folder: Path,
