@@ -39,7 +39,7 @@ import bladecase as bc
 from bladecase.nsm import ModalKernel
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
-NAMES = ["fig2_impact_time_map", "fig3_trajectories", "fig4_manifold", "frequency_energy"]
+NAMES = ["fig2_impact_time_map", "fig3_trajectories", "fig4_manifold", "frequency_energy", "fig11_stability"]
 FIVE_T2 = 10 * np.pi / np.sqrt(3 + np.sqrt(5))  # 5 · 2π/ω₂ for chain(2, k=1, m=1/2): ω₂² = 3 + √5
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

@@ -24,6 +24,9 @@ The pipeline inside, one module per step:
   a flight propagator (:class:`ModalFlight`), an impact law (:class:`NewtonImpact`), the event loop
   (:func:`integrate`) and :func:`simulate`;
 - :mod:`~bladecase.nsm.verify` — the independent check of an orbit by simulation (:func:`verify`);
+- :mod:`~bladecase.nsm.floquet` — stability: monodromy with saltation matrices, multipliers, a verdict
+  (:func:`floquet`, :func:`branch_stability`, :func:`stable_arcs`);
+- :mod:`~bladecase.nsm.energy` — where an orbit's energy sits (:func:`~bladecase.nsm.energy.modal_energy_split`);
 - :mod:`~bladecase.nsm.massless`, :mod:`~bladecase.nsm.massless_orbits` (one contact phase),
   :mod:`~bladecase.nsm.massless_phases` (any number: :class:`PhasedOrbit`), :mod:`~bladecase.nsm.massless_follow`
   and :func:`massless_mode` (a mode followed through phase changes), :mod:`~bladecase.nsm.bar` — the massless
@@ -35,6 +38,7 @@ from .branches import Arc, Backbone, Branch, Family, Interval
 from .continuation import Curve, bisect, trace
 from .families import KippCurve
 from .flight import FlightPropagator, ImpactLaw, ModalFlight, NewtonImpact
+from .floquet import FLOQUET_TOL, Floquet, branch_stability, floquet, stable_arcs
 from .kipp import canonical_rotation, orbits_kipp
 from .massless import MASSLESS_DENSE_LIMIT, MasslessSystem, condense, redistribute_mass, simulate_massless
 from .massless_branches import massless_mode
@@ -56,13 +60,11 @@ from .system import LinearSystem, Spectrum, chain
 from .verify import VERIFY_RTOL, verify
 
 __all__ = [
-    "Arc", "Backbone", "Branch", "Curve", "Family", "FlightPropagator", "ImpactLaw", "Interval", "KippCurve",
-    "LinearSystem", "MASSLESS_DENSE_LIMIT", "MasslessSystem", "ModalFlight", "ModalKernel", "NewtonImpact",
-    "PeriodicOrbit", "PhasedOrbit", "Spectrum",
-    "Trajectory", "backbone", "bar", "bar_continuum_energy", "bisect", "canonical_rotation", "chain",
-    "check_period", "condense", "impact_matrices", "integrate", "kipp_jacobian", "kipp_residual", "make_orbit",
-    "massless_mode",
-    "newton_times", "nonsmooth_mode", "orbit_1ipp", "orbits_kipp", "redistribute_mass", "simulate",
-    "simulate_massless",
-    "solve_times", "trace", "verify", "VERIFY_RTOL",
+    "Arc", "Backbone", "Branch", "Curve", "FLOQUET_TOL", "Family", "FlightPropagator", "Floquet", "ImpactLaw",
+    "Interval", "KippCurve", "LinearSystem", "MASSLESS_DENSE_LIMIT", "MasslessSystem", "ModalFlight", "ModalKernel",
+    "NewtonImpact", "PeriodicOrbit", "PhasedOrbit", "Spectrum", "Trajectory", "VERIFY_RTOL",
+    "backbone", "bar", "bar_continuum_energy", "bisect", "branch_stability", "canonical_rotation", "chain",
+    "check_period", "condense", "floquet", "impact_matrices", "integrate", "kipp_jacobian", "kipp_residual",
+    "make_orbit", "massless_mode", "newton_times", "nonsmooth_mode", "orbit_1ipp", "orbits_kipp",
+    "redistribute_mass", "simulate", "simulate_massless", "solve_times", "stable_arcs", "trace", "verify",
 ]

@@ -403,6 +403,19 @@ class Branch:
             lines.append(f"no admissible arc: no admissible {k}-ipp orbit in the {self.source}")
         return "\n".join(lines)
 
+    def stability(self, tol: float | None = None) -> np.ma.MaskedArray:
+        """Floquet verdict of every point: ``True`` (linearly stable) / ``False``, masked where there is no orbit
+        or no verdict (:func:`~bladecase.nsm.floquet.branch_stability`; saltation matrices at impacts).
+
+        >>> from bladecase.nsm import backbone, chain
+        >>> branch = backbone(chain(2, k=1.0, m=0.5, gap=1.0), np.linspace(6.0, 7.0, 5))
+        >>> branch.stability().tolist()
+        [True, True, False, True, True]
+        """
+        from .floquet import FLOQUET_TOL, branch_stability
+
+        return branch_stability(self, FLOQUET_TOL if tol is None else tol)
+
     def plot(self, ax=None, **kwargs):
         """Frequency–energy plot (see :func:`bladecase.post.plots.frequency_energy`)."""
         from ..post.plots import frequency_energy

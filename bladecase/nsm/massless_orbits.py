@@ -120,6 +120,12 @@ class SymmetricOrbit:
         """Duration of the closed phase."""
         return 2.0 * self.beta
 
+    def monodromy(self) -> np.ndarray:
+        """``(2n, 2n)`` monodromy of ``(x, v)`` over one period (see :meth:`PhasedOrbit.monodromy`)."""
+        from .massless_phases import PhasedOrbit
+
+        return PhasedOrbit(self._bound(), "open", [self.alpha, self.beta], self.a).monodromy()
+
     @property
     def contact_intervals(self) -> list[tuple[float, float]]:
         """``[(0, 2β)]``: the one contact phase (closing at ``t = 0``)."""
