@@ -358,3 +358,15 @@ def test_example_picks_a_stable_and_an_unstable_admissible_orbit(fig11, two_dof)
     bx, bv = fig11.energy_bound(two_dof, unstable.energy)
     assert np.abs(vs).max() <= np.abs(bv).max() * (1 + 1e-3)
     assert bx.min() - 1e-6 <= xs.min() and xs.max() <= bx.max() + 1e-6
+
+
+def test_frequency_energy_plot_styles_stable_and_unstable_arcs():
+    from bladecase.nsm import backbone, chain
+    from bladecase.post.plots import frequency_energy
+
+    branch = backbone(chain(2, k=1.0, m=0.5, gap=1.0), np.linspace(6.0, 7.0, 41))
+    labels = frequency_energy([branch], stability=True).axes[0].get_legend_handles_labels()[1]
+    # the flip window [6.487, 6.664] lies inside the admissible arc: both styles are drawn and labelled
+    assert "1 ipp, admissible, stable (Floquet)" in labels and "1 ipp, admissible, unstable (Floquet)" in labels
+    st = branch.stability()
+    assert not st[(branch.T > 6.52) & (branch.T < 6.63)].any() and st[branch.T < 6.45].all()

@@ -60,6 +60,7 @@ def frequency_energy(
     *,
     time_unit: str | None = None,
     energy_unit: str | None = None,
+    stability: bool = False,
 ) -> Figure:
     r"""Energy ``E`` against frequency ``1/T`` for one or several backbones.
 
@@ -83,6 +84,9 @@ def frequency_energy(
         Units of the periods and energies, for the axis labels
         (:func:`axis_labels`): ``None`` (default) for dimensionless chains;
         ``time_unit="s", energy_unit="J"`` for FE models in SI units.
+    stability : bool
+        Style the admissible curves by their Floquet verdict (:meth:`~bladecase.nsm.Branch.stability`):
+        solid where linearly stable, dashed where unstable.
 
     Returns
     -------
@@ -120,8 +124,11 @@ def frequency_energy(
         bad = ok & ~adm
         ax.plot(f[bad], E[bad], ".", ms=2, color=c, alpha=0.2,
                 label=_once(labelled, "non-admissible orbits", bad.any()))
-        Ea = np.where(adm, E, np.nan)  # NaN breaks the curve between admissible arcs
-        ax.plot(f, Ea, "-", lw=1.8, color=c, label=_once(labelled, f"{bb.ipp} ipp (admissible)", adm.any()))
+        if stability:
+            _stability_curves(ax, bb, f, E, adm, c, labelled)
+        else:
+            Ea = np.where(adm, E, np.nan)  # NaN breaks the curve between admissible arcs
+            ax.plot(f, Ea, "-", lw=1.8, color=c, label=_once(labelled, f"{bb.ipp} ipp (admissible)", adm.any()))
         for iv in bb.intervals:
             for T, refined in ((iv.T_lo, iv.refined_lo), (iv.T_hi, iv.refined_hi)):
                 if refined:
@@ -145,6 +152,17 @@ def frequency_energy(
     if ax.get_legend_handles_labels()[0]:
         ax.legend(loc="best", fontsize="small", markerscale=3)
     return fig
+
+
+def _stability_curves(ax, bb, f, E, adm, c, labelled: set) -> None:
+    """Admissible points split by their Floquet verdict; each run keeps its neighbour so the curve is unbroken."""
+    st = bb.stability()
+    stable = adm & ~np.ma.getmaskarray(st) & np.ma.filled(st, False).astype(bool)
+    unstable = adm & ~stable
+    for mask, ls, word in ((stable, "-", "stable"), (unstable, "--", "unstable")):
+        grown = mask | (np.r_[mask[1:], False] & adm) | (np.r_[False, mask[:-1]] & adm)
+        ax.plot(f, np.where(grown, E, np.nan), ls, lw=1.8, color=c,
+                label=_once(labelled, f"{bb.ipp} ipp, admissible, {word} (Floquet)", mask.any()))
 
 
 def _once(labelled: set, label: str, drawn: bool = True) -> str | None:
