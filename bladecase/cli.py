@@ -8,7 +8,9 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-import numpy as np
+from .cli_input import _floats, _ipp, _periods, _positive_int
+from .cli_input import check_outputs as _check_outputs
+from .cli_input import load_system as _load_system
 
 
 class _Parser(argparse.ArgumentParser):
@@ -16,41 +18,6 @@ class _Parser(argparse.ArgumentParser):
 
     def error(self, message: str) -> None:  # noqa: D401 - argparse API
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
-
-
-def _floats(text: str) -> float | list[float]:
-    """A positive number or a comma-separated list of them."""
-    try:
-        values = [float(x) for x in text.split(",")]
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number or comma-separated numbers, got {text!r}") from None
-    return values[0] if len(values) == 1 else values
-
-
-def _periods(text: str) -> np.ndarray:
-    """``START:STOP:COUNT`` → ``linspace(START, STOP, COUNT)``."""
-    parts = text.split(":")
-    if len(parts) != 3:
-        raise argparse.ArgumentTypeError(f"expected START:STOP:COUNT, got {text!r}")
-    try:
-        start, stop, count = float(parts[0]), float(parts[1]), int(parts[2])
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected START:STOP:COUNT with COUNT an integer, got {text!r}") from None
-    if not (np.isfinite(start) and np.isfinite(stop)) or start <= 0 or stop < start:
-        raise argparse.ArgumentTypeError(f"need 0 < START <= STOP, got START={start:g}, STOP={stop:g}")
-    if count < 1:
-        raise argparse.ArgumentTypeError(f"COUNT must be >= 1, got {count}")
-    return np.linspace(start, stop, count)
-
-
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {value}")
-    return value
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -91,8 +58,8 @@ def build_parser() -> argparse.ArgumentParser:
                     help="clearance d > 0 (required with --chain; overrides the file's gap with --matrices)")
     bb.add_argument("--periods", type=_periods, required=True, metavar="START:STOP:COUNT",
                     help="scan COUNT periods evenly from START to STOP (inclusive)")
-    bb.add_argument("--ipp", type=_positive_int, default=1, metavar="K",
-                    help="impacts per period (default 1).  K >= 2: the K-ipp families (nonsmooth modes) "
+    bb.add_argument("--ipp", type=_ipp, default=1, metavar="K",
+                    help="impacts per period, 1 to 8 (default 1).  K >= 2: the K-ipp families (nonsmooth modes) "
                          "are searched at the COUNT scan periods and followed by continuation over "
                          "[START, STOP]; a table per family is printed")
     bb.add_argument("--json", type=Path, metavar="FILE", help="write the scan and intervals as JSON")
@@ -214,15 +181,19 @@ def _study(path: Path, model: bool = True):
 
 
 def _cmd_run(args) -> int:
+    from .io import check_output_dir
     from .study import run
 
     progress = _setup(args)
-    result = run(_study(args.study), out=args.out, progress=progress)
+    study = _study(args.study)
+    check_output_dir(study.output_dir(args.out))
+    result = run(study, out=args.out, progress=progress)
     print(result.directory / "report.md")
     return 0
 
 
 def _cmd_demo(args) -> int:
+    from .io import check_output_dir
     from .study import run
     from .study.schema import demo_study, demo_text
 
@@ -230,7 +201,9 @@ def _cmd_demo(args) -> int:
         print(demo_text(), end="")
         return 0
     progress = _setup(args)
-    result = run(demo_study(), out=args.out, progress=progress)
+    study = demo_study()
+    check_output_dir(study.output_dir(args.out))
+    result = run(study, out=args.out, progress=progress)
     print(result.directory / "report.md")
     return 0
 
@@ -240,6 +213,7 @@ def _cmd_mesh(args) -> int:
     from .study.stages import build_mesh
 
     _setup(args)
+    _check_outputs(args.output)
     study = _study(args.study)
     if study.parametric and args.output.suffix == ".msh":
         mesh = build_mesh(study, path=args.output)
@@ -257,6 +231,7 @@ def _cmd_assemble(args) -> int:
     from .study.stages import build_mesh, build_model
 
     _setup(args)
+    _check_outputs(args.output)
     study = _study(args.study)
     if args.mesh is not None:
         mesh = load_mesh(args.mesh, require=[study["fem"]["clamp"]])
@@ -276,6 +251,7 @@ def _cmd_reduce(args) -> int:
     from .study.stages import build_contact, build_reduced
 
     _setup(args)
+    _check_outputs(args.output)
     study = _study(args.study)
     model = load_model(args.model)
     contact = build_contact(study, model)
@@ -293,6 +269,7 @@ def _cmd_modes(args) -> int:
     from .study.stages import search
 
     progress = _setup(args)
+    _check_outputs(args.output, args.plot)
     study = _study(args.study, model=args.reduced is not None)  # with --matrices: [search] is enough
     if args.reduced is not None:
         from .reduction import load_reduced
@@ -313,12 +290,14 @@ def _cmd_modes(args) -> int:
 
 
 def _cmd_animate(args) -> int:
+    from .io import check_output_dir
     from .reduction import load_reduced
     from .study.documents import load_families
     from .study.render import animate_families
 
     progress = _setup(args)
     study = _study(args.study)
+    check_output_dir(study.output_dir(args.out))
     reduced = load_reduced(args.reduced)
     families = load_families(args.modes, reduced.system)
     written = animate_families(study, reduced, families, out=args.out, progress=progress)
@@ -330,34 +309,11 @@ def _cmd_animate(args) -> int:
     return 0
 
 
-def _load_system(args):
-    from .nsm import LinearSystem, chain
-
-    if (args.chain is None) == (args.matrices is None):
-        raise ValueError("give exactly one of --chain N or --matrices FILE.npz")
-    if args.chain is not None:
-        if args.gap is None:
-            raise ValueError("--gap D is required with --chain")
-        return chain(args.chain, k=args.k, m=args.m, gap=args.gap)
-    try:
-        data = np.load(args.matrices, allow_pickle=False)
-    except (OSError, ValueError) as exc:
-        raise ValueError(f"cannot read {args.matrices}: {exc}") from None
-    missing = [key for key in ("M", "K", "w") if key not in data]
-    if missing:
-        raise ValueError(f"{args.matrices} lacks array(s) {', '.join(missing)} (needs M, K, w and gap)")
-    gap = args.gap if args.gap is not None else (float(data["gap"]) if "gap" in data else None)
-    if gap is None:
-        raise ValueError(f"{args.matrices} has no 'gap' and --gap was not given")
-    w = data["w"]
-    w = int(w) if w.ndim == 0 else w
-    return LinearSystem(data["M"], data["K"], w, gap)
-
-
 def _cmd_backbone(args) -> int:
     from .io import write_json, write_text
     from .nsm import backbone
 
+    _check_outputs(args.table, args.json, args.plot)
     system = _load_system(args)
     progress = not args.no_progress and sys.stderr.isatty()
     if args.ipp == 1:
@@ -408,9 +364,27 @@ def _save_plot(curves, path: Path) -> None:
     save_figure(fig, path, dpi=150)
 
 
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM, raised like Ctrl-C so that every ``finally`` and staging clean-up runs."""
+
+
+def _on_sigterm(signum, frame) -> None:
+    raise _Terminated()
+
+
+def _one_line(exc: BaseException) -> str:
+    return "; ".join(line.strip() for line in str(exc).splitlines() if line.strip()) or type(exc).__name__
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``bladecase`` command; returns the exit code (0 on
-    success, 2 on bad arguments or input, with a one-line reason on stderr)."""
+    """Entry point of the ``bladecase`` command; returns the exit code: 0 on success, 2 on bad arguments
+    or input (a one-line reason on stderr, never a traceback), 1 when a computation fails (e.g. no
+    off-screen rendering, out of memory), 130 on Ctrl-C and 143 on SIGTERM (the shell's convention:
+    128 + signal number, so that scripts see an interruption, not bad input) — an interrupted run removes
+    its staging folder and leaves the previous results untouched."""
+    import signal
+    import threading
+
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
@@ -419,17 +393,37 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command is None:
         parser.print_help()
         return 2
+    main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _on_sigterm) if main_thread else None
+    where = f"bladecase {args.command}"
     try:
         return args.func(args)
     except ValueError as exc:  # includes StudyError: the message names the key
-        print(f"bladecase {args.command}: error: {exc}", file=sys.stderr)
+        print(f"{where}: error: {_one_line(exc)}", file=sys.stderr)
         return 2
-    except RuntimeError as exc:  # e.g. no off-screen rendering
-        print(f"bladecase {args.command}: error: {exc}", file=sys.stderr)
-        return 1
     except BrokenPipeError:  # output piped into e.g. `head`
         sys.stdout = open(os.devnull, "w")
         return 0
+    except OSError as exc:  # a file or folder the command cannot read or write (full disk, permissions…)
+        from .io import os_reason
+
+        name = f" {exc.filename!s}:" if exc.filename else ""
+        print(f"{where}: error:{name} {os_reason(exc)}", file=sys.stderr)
+        return 2
+    except MemoryError:
+        print(f"{where}: error: out of memory (reduce the sizes asked for: [reduction] size, [search] scan, "
+              "[output] frames, manifold_size)", file=sys.stderr)
+        return 1
+    except RuntimeError as exc:  # e.g. no off-screen rendering
+        print(f"{where}: error: {_one_line(exc)}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt as exc:  # Ctrl-C or SIGTERM
+        what = "terminated" if isinstance(exc, _Terminated) else "interrupted"
+        print(f"{where}: {what}, previous results untouched", file=sys.stderr)
+        return 143 if isinstance(exc, _Terminated) else 130
+    finally:
+        if main_thread:
+            signal.signal(signal.SIGTERM, previous if previous is not None else signal.SIG_DFL)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -18,7 +18,7 @@ from io import StringIO
 
 import numpy as np
 
-from ..io import atomic_path
+from ..io import atomic_path, check_output_file
 from .quality import (  # noqa: F401  (the former home of these names)
     _P2_EDGES,
     DEGENERATE_RTOL,
@@ -242,7 +242,8 @@ def from_meshio(m, source: str = "", require: Sequence[str] = ()) -> Mesh:
       triangles that are ALL clockwise are reoriented to counter-clockwise
       (corner and midside nodes); a mix is an error.  Errors name the count
       and the first offending element (its index among the body cells and
-      its nodes).
+      its nodes).  One body: lines or triangles that use nodes no body cell uses (a stray planar
+      part beside a solid) are an error naming the counts.
     """
     if not source:
         source = "<meshio mesh>"
@@ -285,6 +286,7 @@ def from_meshio(m, source: str = "", require: Sequence[str] = ()) -> Mesh:
     body = np.concatenate([d for t, d in blocks if t == btype]).astype(np.int64)
     if body.min() < 0 or body.max() >= len(points):
         raise ValueError(f"mesh {source}: {btype} cells refer to nodes outside 0..{len(points) - 1}")
+    _check_one_body(blocks, body, btype, dim, source)
     body = _check_orientation(points, body, btype, dim, source)
     cells = {btype: body}
     for d in range(dim - 1, -1, -1):  # boundary cells: faces, edges, vertices
@@ -296,6 +298,33 @@ def from_meshio(m, source: str = "", require: Sequence[str] = ()) -> Mesh:
         if len(mesh.group(name)) == 0:
             raise ValueError(f"mesh {source}: group {name!r} is empty")
     return mesh
+
+
+def _check_one_body(blocks, body: np.ndarray, btype: str, dim: int, source: str) -> None:
+    """Refuse lower-dimensional cells off the body (e.g. 988 triangles beside one stray tetrahedron).
+
+    The faces and edges of a mesh (physical groups) lie on its body's nodes; cells that use other nodes
+    are a second body of lower dimension, which the model would silently drop.
+    """
+    on_body = np.zeros(int(body.max()) + 1, dtype=bool)
+    on_body[body.ravel()] = True
+    stray: dict[str, tuple[int, int]] = {}
+    for d in range(1, dim):
+        for t in _SIMPLEX[d]:
+            data = [np.asarray(c, dtype=np.int64) for tt, c in blocks if tt == t and len(c)]
+            if not data:
+                continue
+            cells = np.concatenate(data)
+            inside = cells < on_body.size
+            off = ~(inside & on_body[np.where(inside, cells, 0)])
+            bad = off.any(axis=1)
+            if bad.any():
+                stray[t] = (int(bad.sum()), int(np.unique(cells[off]).size))
+    if stray:
+        what = ", ".join(f"{n} {t} cell(s) ({k} node(s) no {btype} uses)" for t, (n, k) in stray.items())
+        raise ValueError(f"mesh {source} mixes dimensions: {len(body)} {btype} cell(s) form the {dim}-D body, and "
+                         f"{what} lie off it: a model has one body of one dimension; remove the stray cells of "
+                         f"one dimension (e.g. export only the {dim}-D region, or only the planar one)")
 
 
 def _groups(m, blocks, n_points: int, source: str) -> dict[str, np.ndarray]:
@@ -387,7 +416,7 @@ def save_mesh(mesh: Mesh, path: str | os.PathLike) -> None:
     ValueError: save_mesh cannot write '.../square.stl': suffix '.stl', valid: .vtu, .vtk, .inp
     >>> folder.cleanup()
     """
-    path = os.fspath(path)
+    path = os.fspath(check_output_file(path))  # a folder, a device, a path under a file: named first
     suffix = os.path.splitext(path)[1].lower()
     if suffix in (".vtu", ".vtk"):
         import meshio
@@ -442,9 +471,14 @@ def mesh_to_arrays(mesh: Mesh, prefix: str = "mesh/") -> dict[str, np.ndarray]:
     return out
 
 
-def mesh_from_arrays(data, prefix: str = "mesh/") -> Mesh:
-    """Inverse of :func:`mesh_to_arrays` (``data``: a mapping such as an ``NpzFile``)."""
-    cells = {k[len(prefix) + 6:]: np.asarray(data[k]) for k in data if k.startswith(f"{prefix}cells/")}
-    groups = {k[len(prefix) + 7:]: np.asarray(data[k]) for k in data if k.startswith(f"{prefix}groups/")}
-    return Mesh(points=np.asarray(data[f"{prefix}points"], dtype=float), cells=cells,
-                dim=int(data[f"{prefix}dim"]), groups=groups, source=str(data[f"{prefix}source"]))
+def mesh_from_arrays(data, prefix: str = "mesh/", source: str = "data") -> Mesh:
+    """Inverse of :func:`mesh_to_arrays` (``data``: a mapping such as an ``NpzFile``); ``ValueError`` naming
+    ``source`` and the field when a field has the wrong type."""
+    from ..io import npz_array, npz_scalar
+
+    cells = {k[len(prefix) + 6:]: npz_array(data, k, source, 2, "int") for k in data if k.startswith(f"{prefix}cells/")}
+    groups = {k[len(prefix) + 7:]: npz_array(data, k, source, 1, "int") for k in data
+              if k.startswith(f"{prefix}groups/")}
+    points = npz_array(data, f"{prefix}points", source, 2).astype(float)
+    return Mesh(points=points, cells=cells, dim=npz_scalar(data, f"{prefix}dim", source, "int"), groups=groups,
+                source=npz_scalar(data, f"{prefix}source", source, "str"))

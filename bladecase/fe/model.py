@@ -96,6 +96,12 @@ class FEModel:
     volume: float
     rigid_modes: int
 
+    def __post_init__(self):
+        if self.K.shape[0] == 0:
+            n = len(self.mesh.points)
+            raise ValueError(f"the clamp fixes {self.clamped.size} of the mesh's {n} nodes: no degree of freedom "
+                             "is left free; clamp a face (e.g. the root), not the whole body")
+
     @property
     def dim(self) -> int:
         """Spatial dimension (2 or 3)."""

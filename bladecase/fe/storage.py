@@ -12,6 +12,7 @@ import math
 import numpy as np
 import scipy.sparse as sp
 
+from ..io import npz_array, npz_scalar
 from .material import Material
 from .mesh import mesh_from_arrays, mesh_to_arrays
 from .model import DofMap, FEModel
@@ -27,10 +28,18 @@ def sparse_to_arrays(name: str, A) -> dict[str, np.ndarray]:
             f"{name}/shape": np.array(A.shape)}
 
 
-def sparse_from_arrays(data, name: str) -> sp.csr_array:
-    """Inverse of :func:`sparse_to_arrays`."""
-    return sp.csr_array((data[f"{name}/data"], data[f"{name}/indices"], data[f"{name}/indptr"]),
-                        shape=tuple(int(s) for s in data[f"{name}/shape"]))
+def sparse_from_arrays(data, name: str, source: str = "data") -> sp.csr_array:
+    """Inverse of :func:`sparse_to_arrays`; ``ValueError`` naming ``source`` and the field if they do not fit."""
+    shape = npz_array(data, f"{name}/shape", source, ndim=1, kind="int")
+    if shape.shape != (2,) or np.any(shape < 0):
+        raise ValueError(f"{source}: field '{name}/shape' must be 2 sizes >= 0, got {shape.tolist()}")
+    try:
+        return sp.csr_array((npz_array(data, f"{name}/data", source, ndim=1),
+                             npz_array(data, f"{name}/indices", source, ndim=1, kind="int"),
+                             npz_array(data, f"{name}/indptr", source, ndim=1, kind="int")),
+                            shape=tuple(int(s) for s in shape))
+    except (TypeError, ValueError, IndexError) as exc:
+        raise ValueError(f"{source}: the arrays of matrix {name!r} do not form a sparse matrix ({exc})") from None
 
 
 def model_to_arrays(model: FEModel, prefix: str = "") -> dict[str, np.ndarray]:
@@ -53,24 +62,35 @@ def model_to_arrays(model: FEModel, prefix: str = "") -> dict[str, np.ndarray]:
 
 
 def model_from_arrays(data, prefix: str = "", source: str = "") -> FEModel:
-    """Inverse of :func:`model_to_arrays`; ``ValueError`` if ``data`` is not a saved model."""
+    """Inverse of :func:`model_to_arrays`; ``ValueError`` if ``data`` is not a saved model or a field has the
+    wrong type (the message names ``source`` and the field)."""
     key = f"{prefix}format"
+    source = source or "data"
     if key not in data or str(data[key]) != MODEL_FORMAT:
-        raise ValueError(f"{source or 'data'} is not a bladecase FE model file (expected format {MODEL_FORMAT!r}; "
+        raise ValueError(f"{source} is not a bladecase FE model file (expected format {MODEL_FORMAT!r}; "
                          "write one with 'bladecase assemble' or bladecase.fe.save_model)")
-    E, nu, rho = (float(x) for x in data[f"{prefix}material"])
-    thickness = float(data[f"{prefix}thickness"])
-    dofs = DofMap(node=np.asarray(data[f"{prefix}dofs/node"]), direction=np.asarray(data[f"{prefix}dofs/direction"]),
-                  coords=np.asarray(data[f"{prefix}dofs/coords"]), fe_index=np.asarray(data[f"{prefix}dofs/fe_index"]),
-                  n_total=int(data[f"{prefix}dofs/n_total"]))
+
+    def scalar(name: str, kind: str = "real"):
+        return npz_scalar(data, prefix + name, source, kind)
+
+    material = npz_array(data, f"{prefix}material", source, ndim=1)
+    if material.shape != (3,):
+        raise ValueError(f"{source}: field '{prefix}material' must be [E, nu, rho], got shape {material.shape}")
+    E, nu, rho = (float(x) for x in material)
+    thickness = scalar("thickness")
+    dofs = DofMap(node=npz_array(data, f"{prefix}dofs/node", source, 1, "int"),
+                  direction=npz_array(data, f"{prefix}dofs/direction", source, 1, "int"),
+                  coords=npz_array(data, f"{prefix}dofs/coords", source, 2),
+                  fe_index=npz_array(data, f"{prefix}dofs/fe_index", source, 1, "int"),
+                  n_total=scalar("dofs/n_total", "int"))
     return FEModel(
-        K=sparse_from_arrays(data, f"{prefix}K"), M=sparse_from_arrays(data, f"{prefix}M"), dofs=dofs,
-        mesh=mesh_from_arrays(data, f"{prefix}mesh/"),
-        material=Material(E, nu, rho, str(data[f"{prefix}material_name"])),
-        order=int(data[f"{prefix}order"]), mass=str(data[f"{prefix}mass"]),
-        thickness=None if math.isnan(thickness) else thickness, plane=str(data[f"{prefix}plane"]) or None,
-        clamped=np.asarray(data[f"{prefix}clamped"]), volume=float(data[f"{prefix}volume"]),
-        rigid_modes=int(data[f"{prefix}rigid_modes"]),
+        K=sparse_from_arrays(data, f"{prefix}K", source), M=sparse_from_arrays(data, f"{prefix}M", source),
+        dofs=dofs, mesh=mesh_from_arrays(data, f"{prefix}mesh/", source),
+        material=Material(E, nu, rho, scalar("material_name", "str")),
+        order=scalar("order", "int"), mass=scalar("mass", "str"),
+        thickness=None if math.isnan(thickness) else thickness, plane=scalar("plane", "str") or None,
+        clamped=npz_array(data, f"{prefix}clamped", source, 1, "int"), volume=scalar("volume"),
+        rigid_modes=scalar("rigid_modes", "int"),
     )
 
 
@@ -83,9 +103,12 @@ def save_model(model: FEModel, path) -> None:
 
 
 def load_model(path) -> FEModel:
-    """Read an :class:`FEModel` written by :func:`save_model`."""
+    """Read an :class:`FEModel` written by :func:`save_model`; ``ValueError`` naming the file when it is
+    missing, truncated, corrupted, not a model file, or holds a field of the wrong type."""
+    from ..io import read_npz
+
+    data = read_npz(path, "FE model file")
     try:
-        with np.load(path, allow_pickle=False) as data:
-            return model_from_arrays(data, source=str(path))
-    except (OSError, EOFError, KeyError) as exc:
-        raise ValueError(f"cannot read FE model file {str(path)!r}: {exc}") from None
+        return model_from_arrays(data, source=str(path))
+    except KeyError as exc:
+        raise ValueError(f"cannot read FE model file {str(path)!r}: field {exc} is missing") from None

@@ -214,12 +214,17 @@ class PeriodicOrbit:
         mult = data.get("multipliers")
         return cls(
             system=system, T=float(data["T"]), impact_times=np.asarray(data["impact_times"], dtype=float),
-            impulses=np.asarray(data["impulses"], dtype=float), energy=float(data["energy"]),
-            admissible=bool(data["admissible"]), max_violation=float(data["max_violation"]),
-            max_violation_time=float(data.get("max_violation_time", np.nan)), repeats=int(data.get("repeats", 1)),
+            impulses=np.asarray(data["impulses"], dtype=float), energy=_number(data["energy"]),
+            admissible=bool(data["admissible"]), max_violation=_number(data["max_violation"]),
+            max_violation_time=_number(data.get("max_violation_time")), repeats=int(data.get("repeats", 1)),
             stable=None if data.get("stable") is None else bool(data["stable"]),
-            multipliers=None if mult is None else np.array([complex(a, b) for a, b in mult]),
+            multipliers=None if mult is None else np.array([complex(_number(a), _number(b)) for a, b in mult]),
         )
+
+
+def _number(value) -> float:
+    """A stored number; ``None`` (JSON ``null``, how strict JSON writes a non-finite value) is ``NaN``."""
+    return np.nan if value is None else float(value)
 
 
 def _segment_sum(md: ModalKernel, T: float, times: np.ndarray, impulses: np.ndarray, i: int, d: float) -> TrigSum:

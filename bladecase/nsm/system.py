@@ -26,6 +26,11 @@ ArrayLike = np.ndarray | sp.spmatrix | sp.sparray
 #: Relative tolerance of the symmetry check ``max|A - Aᵀ| <= SYMMETRY_RTOL * max|A|``.
 SYMMETRY_RTOL = 1e-10
 
+#: Scales a system may have: ``gap``, ``max|M|``, ``max|K|`` and ``max|w|`` within
+#: ``[1 / SCALE_LIMIT, SCALE_LIMIT]``.  Beyond, energies (``~ K gap²``) and frequencies
+#: (``~ K / M``) overflow or lose precision in double arithmetic: rescale the units instead.
+SCALE_LIMIT = 1e80
+
 #: Largest model whose spectrum is computed densely.  Larger models go
 #: through the reduction layer (Lanczos, modal, Craig–Bampton) first.
 DENSE_LIMIT = 6000
@@ -43,12 +48,18 @@ def _is_sparse(a) -> bool:
 def _as_matrix(name: str, a, n: int | None = None):
     """Return ``a`` as a float dense ndarray or CSR matrix, checking shape and values."""
     if _is_sparse(a):
-        a = sp.csr_array(a, dtype=float)
+        a = sp.csr_array(a)
+        _check_real(name, a.data)
+        a = sp.csr_array(a.real if a.dtype.kind == "c" else a, dtype=float)
         data = a.data
     else:
         try:
-            a = np.array(a, dtype=float)
+            raw = np.asarray(a)
+            _check_real(name, raw)
+            a = np.array(raw.real if raw.dtype.kind == "c" else raw, dtype=float)
         except (TypeError, ValueError) as exc:
+            if "imaginary" in str(exc):
+                raise
             raise ValueError(f"{name} must be a real matrix: {exc}") from None
         data = a
     if a.ndim != 2 or a.shape[0] != a.shape[1]:
@@ -61,6 +72,22 @@ def _as_matrix(name: str, a, n: int | None = None):
     if bad.any():
         raise ValueError(f"{name} contains {int(bad.sum())} non-finite value(s) (NaN or inf)")
     return a
+
+
+def _check_real(name: str, values) -> None:
+    """Refuse complex values with a non-zero imaginary part (numpy would drop it with a mere warning)."""
+    values = np.asarray(values)
+    if values.dtype.kind == "c" and np.any(values.imag != 0):
+        bad = int(np.count_nonzero(values.imag))
+        raise ValueError(f"{name} must be real: {bad} entr{'y has' if bad == 1 else 'ies have'} a non-zero imaginary "
+                         f"part (max |Im| = {np.abs(values.imag).max():.3g}); bladecase models undamped, real "
+                         "structures")
+
+
+def _check_scale(name: str, value: float) -> None:
+    if not 1 / SCALE_LIMIT <= value <= SCALE_LIMIT:
+        raise ValueError(f"{name} = {value:.3g} is out of the range double precision handles here: "
+                         f"[{1 / SCALE_LIMIT:g}, {SCALE_LIMIT:g}]; rescale the units (e.g. of length or time)")
 
 
 def _check_symmetric(name: str, a) -> None:
@@ -238,15 +265,17 @@ class LinearSystem:
         Symmetric positive definite mass and stiffness matrices.
     w : (n,) array_like or int
         Constraint vector; an ``int`` ``c`` means the unit vector on dof ``c``
-        (negative values count from the end, like numpy indices).
+        (negative values count from the end, like numpy indices).  A single
+        float (or 0-d array) is refused when ``n > 1``: it is neither a dof nor a vector.
     gap : float
         Clearance ``d > 0`` between the structure at rest and the obstacle.
 
     Raises
     ------
     ValueError
-        Wrong shapes, non-finite values, asymmetric or non positive-definite
-        matrices, ``w == 0`` or ``gap <= 0``; the message names the problem.
+        Wrong shapes, non-finite or complex values, asymmetric or non positive-definite
+        matrices, ``w == 0``, ``gap <= 0``, or scales (``gap``, ``max|M|``, ``max|K|``,
+        ``max|w|``) outside ``[1e-80, 1e80]`` (:data:`SCALE_LIMIT`); the message names the problem.
 
     Examples
     --------
@@ -269,13 +298,21 @@ class LinearSystem:
         if isinstance(w, (int, np.integer)) and not isinstance(w, bool):
             c = int(w)
             if not -n <= c < n:
-                raise ValueError(f"contact dof w = {c} is out of range for a system of {n} dofs (valid: 0..{n - 1})")
+                raise ValueError(f"contact dof w = {c} is out of range for a system of {n} dofs (valid: 0..{n - 1}, "
+                                 f"or -{n}..-1 counting from the end)")
             wv = np.zeros(n)
             wv[c] = 1.0
         else:
+            if n > 1 and (isinstance(w, (float, np.floating)) or (isinstance(w, np.ndarray) and w.ndim == 0)):
+                raise ValueError(f"w must be an integer contact dof (0..{n - 1}) or a vector of {n} numbers, got the "
+                                 f"single number {w!r}")
             try:
-                wv = np.array(w, dtype=float).reshape(-1)
+                raw = np.asarray(w)
+                _check_real("w", raw)
+                wv = np.array(raw.real if raw.dtype.kind == "c" else raw, dtype=float).reshape(-1)
             except (TypeError, ValueError) as exc:
+                if "imaginary" in str(exc):
+                    raise
                 raise ValueError(f"w must be an int or a real vector: {exc}") from None
             if wv.shape != (n,):
                 raise ValueError(f"w has {wv.size} entries, expected {n} (one per dof)")
@@ -289,6 +326,10 @@ class LinearSystem:
             raise ValueError(f"gap must be a positive number, got {gap!r}") from None
         if not np.isfinite(gap) or gap <= 0:
             raise ValueError(f"gap must be a finite clearance > 0, got {gap!r}")
+        _check_scale("gap", gap)
+        for label, A in (("max|M|", M), ("max|K|", K)):
+            _check_scale(label, float(abs(A).max()) if _is_sparse(A) else float(np.abs(A).max()))
+        _check_scale("max|w|", float(np.abs(wv).max()))
         _check_positive_definite("M", M)
         _check_positive_definite("K", K)
         self._M, self._K, self._w, self._gap = M, K, wv, gap

@@ -138,7 +138,8 @@ def reduce(
     ValueError
         Unknown method (the message lists the valid ones), a bad size, a
         ``"full"`` model above ``FULL_LIMIT`` dofs, a contact node with
-        no free dof, a singular (unclamped) model, a ``factor`` of another matrix.
+        no free dof, an unclamped model (``model.rigid_modes > 0``: refused by every method alike), a
+        ``factor`` of another matrix.
 
     Examples
     --------
@@ -166,6 +167,10 @@ def reduce(
         raise ValueError(
             f"contact must be a bladecase.Contact (node, normal, gap), got {type(contact).__name__}"
         )
+    if model.rigid_modes:
+        raise ValueError(f"the model is not clamped: {model.rigid_modes} rigid-body motion(s) are free, so K is "
+                         f"singular; clamp a face of every part (every reduction, {method!r} included, needs a "
+                         "clamped model)")
     factor = check_factor(factor, model.K, "this model's K", "bladecase.fe.stiffness_factor(model)")
     if entry.sized:
         if size is None:

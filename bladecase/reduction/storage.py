@@ -11,7 +11,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..fe import model_from_arrays, model_to_arrays, sparse_from_arrays, sparse_to_arrays
-from ..io import atomic_path
+from ..io import atomic_path, npz_array, npz_scalar, read_npz
 from ..nsm import LinearSystem
 from .contact import Contact
 from .model import ReducedModel
@@ -47,37 +47,48 @@ def save_reduced(reduced: ReducedModel, path) -> None:
 
 
 def load_reduced(path) -> ReducedModel:
-    """Read a :class:`ReducedModel` written by :func:`save_reduced`."""
+    """Read a :class:`ReducedModel` written by :func:`save_reduced`; ``ValueError`` naming the file when it is
+    missing, truncated, corrupted, not a reduced-model file, or holds a field of the wrong type."""
+    data = read_npz(path, "reduced-model file")
+    if "format" not in data or str(data["format"]) != REDUCED_FORMAT:
+        raise ValueError(
+            f"{str(path)!r} is not a bladecase reduced-model file (expected format {REDUCED_FORMAT!r}; "
+            "write one with 'bladecase reduce' or bladecase.reduction.save_reduced)")
     try:
-        with np.load(path, allow_pickle=False) as data:
-            if "format" not in data or str(data["format"]) != REDUCED_FORMAT:
-                raise ValueError(
-                    f"{str(path)!r} is not a bladecase reduced-model file (expected format {REDUCED_FORMAT!r}; "
-                    "write one with 'bladecase reduce' or bladecase.reduction.save_reduced)")
+        return _reduced_from_arrays(data, str(path))
+    except KeyError as exc:
+        raise ValueError(f"cannot read reduced-model file {str(path)!r}: field {exc} is missing") from None
 
-            def matrix(name):
-                return sparse_from_arrays(data, name) if f"{name}/data" in data else np.asarray(data[name])
 
-            model = model_from_arrays(data, prefix="model/", source=str(path))
-            normal = np.asarray(data["contact/normal"])
-            nodes = tuple(int(k) for k in data["contact/nodes"]) if "contact/nodes" in data else ()
-            weights = tuple(float(x) for x in data["contact/weights"]) if "contact/weights" in data else ()
-            contact = Contact(int(data["contact/node"]), tuple(normal) if normal.size else None,
-                              float(data["contact/gap"]), nodes, weights)
-            size = int(data["size"])
-            if "contact_model" in data and str(data["contact_model"]) == "massless":
-                from ..nsm import MasslessSystem
-                from .massless import MasslessReducedModel
+def _reduced_from_arrays(data: dict, source: str) -> ReducedModel:
+    def matrix(name):
+        return sparse_from_arrays(data, name, source) if f"{name}/data" in data else npz_array(data, name, source, 2)
 
-                system = MasslessSystem(np.asarray(data["Mr"]), np.asarray(data["Sr"]), np.asarray(data["w"]),
-                                        float(data["kc"]), float(data["gap"]))
-                return MasslessReducedModel(method=str(data["method"]), size=None if size < 0 else size,
-                                            system=system,
-                                            basis=matrix("basis"), model=model, contact=contact,
-                                            closed_shape=np.asarray(data["closed_shape"]),
-                                            masses=np.asarray(data["masses"]))
-            system = LinearSystem(matrix("Mr"), matrix("Kr"), np.asarray(data["w"]), float(data["gap"]))
-            return ReducedModel(method=str(data["method"]), size=None if size < 0 else size, system=system,
-                                basis=matrix("basis"), model=model, contact=contact)
-    except (OSError, EOFError, KeyError) as exc:
-        raise ValueError(f"cannot read reduced-model file {str(path)!r}: {exc}") from None
+    def scalar(name, kind="real"):
+        return npz_scalar(data, name, source, kind)
+
+    model = model_from_arrays(data, prefix="model/", source=source)
+    normal = npz_array(data, "contact/normal", source, 1)
+    nodes = tuple(int(k) for k in npz_array(data, "contact/nodes", source, 1, "int")) if "contact/nodes" in data else ()
+    weights = tuple(float(x) for x in npz_array(data, "contact/weights", source, 1)) if "contact/weights" in data \
+        else ()
+    contact = Contact(scalar("contact/node", "int"), tuple(normal) if normal.size else None, scalar("contact/gap"),
+                      nodes, weights)
+    size = scalar("size", "int")
+    w, gap, method = npz_array(data, "w", source, 1), scalar("gap"), scalar("method", "str")
+    try:
+        if "contact_model" in data and scalar("contact_model", "str") == "massless":
+            from ..nsm import MasslessSystem
+            from .massless import MasslessReducedModel
+
+            system = MasslessSystem(npz_array(data, "Mr", source, 2), npz_array(data, "Sr", source, 2), w,
+                                    scalar("kc"), gap)
+            return MasslessReducedModel(method=method, size=None if size < 0 else size, system=system,
+                                        basis=matrix("basis"), model=model, contact=contact,
+                                        closed_shape=npz_array(data, "closed_shape", source),
+                                        masses=npz_array(data, "masses", source))
+        system = LinearSystem(matrix("Mr"), matrix("Kr"), w, gap)
+    except ValueError as exc:
+        raise ValueError(f"{source}: {exc}") from None
+    return ReducedModel(method=method, size=None if size < 0 else size, system=system,
+                        basis=matrix("basis"), model=model, contact=contact)

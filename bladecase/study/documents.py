@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..checks import is_integer
 from ..fe import FEModel, Mesh
 from ..nsm import Branch, LinearSystem
 from ..reduction import Contact, ReducedModel
@@ -23,21 +24,51 @@ def families_document(families: list[Branch], system: LinearSystem) -> dict:
 
 
 def load_families(path: str | os.PathLike, system: LinearSystem) -> list[Branch]:
-    """Branches from a modes JSON file (``bladecase modes``), attached to ``system`` (orbits as stored)."""
+    """Branches from a modes JSON file (``bladecase modes``), attached to ``system`` (orbits as stored).
+
+    ``ValueError`` naming the file for an unreadable or malformed file, a file computed on another system,
+    or arcs that do not point at admissible orbits of their family (a hand-edited or truncated file).
+    """
+    where = f"modes file {str(path)!r}"
     try:
         data = json.loads(Path(path).read_text(encoding="utf-8"))
-        fams = [Branch.from_dict(system, f) for f in data["families"]]
-    except (OSError, ValueError, KeyError, TypeError) as exc:
-        raise ValueError(f"cannot read modes file {str(path)!r}: {exc}") from None
+    except (OSError, ValueError) as exc:
+        raise ValueError(f"cannot read {where}: {exc}") from None
+    if not isinstance(data, dict) or not isinstance(data.get("families"), list):
+        raise ValueError(f"{where} is not a bladecase modes file: expected an object with a list 'families' "
+                         "(write one with 'bladecase modes')")
     n = data.get("system_dofs")
+    if n is not None and not is_integer(n):
+        raise ValueError(f"{where}: 'system_dofs' must be an integer number of dofs, got {n!r}")
     if n is not None and n != system.n:
-        raise ValueError(f"modes file {str(path)!r} was computed on a system of {n} dofs, this one has {system.n}")
+        raise ValueError(f"{where} was computed on a system of {n} dofs, this one has {system.n}")
+    try:
+        fams = [Branch.from_dict(system, f) for f in data["families"]]
+    except KeyError as exc:
+        raise ValueError(f"cannot read {where}: field {exc} is missing") from None
+    except (ValueError, TypeError, AttributeError, IndexError) as exc:
+        raise ValueError(f"cannot read {where}: {exc}") from None
+    for i, fam in enumerate(fams):
+        _check_arcs(fam, i, where)
     return fams
 
 
-def _range(values: np.ndarray) -> list[float]:
+def _check_arcs(fam: Branch, i: int, where: str) -> None:
+    """Every arc of family ``i`` spans existing, admissible orbits."""
+    for j, arc in enumerate(fam.arcs):
+        if not 0 <= arc.start <= arc.stop < len(fam.orbits):
+            raise ValueError(f"{where}: family {i}, arc {j} spans orbits {arc.start}..{arc.stop}, but the family has "
+                             f"{len(fam.orbits)} orbit(s) (valid: 0 <= start <= stop <= {len(fam.orbits) - 1})")
+        bad = [k for k in range(arc.start, arc.stop + 1) if fam.orbits[k] is None or not fam.orbits[k].admissible]
+        if bad:
+            raise ValueError(f"{where}: family {i}, arc {j} (orbits {arc.start}..{arc.stop}) includes orbit {bad[0]}, "
+                             "which is not admissible: an arc spans admissible orbits only")
+
+
+def _range(values: np.ndarray) -> list[float | None]:
+    """``[min, max]`` of the finite values; ``[None, None]`` (JSON ``null``: no value) when there is none."""
     values = values[np.isfinite(values)]
-    return [float(values.min()), float(values.max())] if values.size else [float("nan")] * 2
+    return [float(values.min()), float(values.max())] if values.size else [None, None]
 
 
 def family_summary(fam: Branch) -> dict:
@@ -62,7 +93,7 @@ def reduced_summary(reduced: ReducedModel, reference_hz: np.ndarray) -> dict:
     """A reduced model's frequencies and contact weights, with the nearest-frequency error vs ``reference_hz``."""
     sp = reduced.system.spectrum
     f = sp.frequencies[sp.active]
-    nearest = [float(np.min(np.abs(f - fr)) / fr) if f.size else float("nan") for fr in reference_hz]
+    nearest = [float(np.min(np.abs(f - fr)) / fr) if f.size else None for fr in reference_hz]
     return {"method": reduced.method, "size": reduced.size, "reduced_dofs": reduced.n,
             "frequencies_hz": f.tolist(), "contact_weights_b2": (sp.b[sp.active] ** 2).tolist(),
             "relative_error_vs_fe": nearest}

@@ -24,7 +24,7 @@ from ..post.report import report
 from ..progress import progress_counter
 from .documents import contact_summary, families_document, family_summary, model_summary, reduced_summary
 from .executor import Executor, SerialExecutor
-from .publish import RUN_RESULTS, publish, staging_dir
+from .publish import RUN_RESULTS, check_inputs, publish, release, staging_dir
 from .reference import reference_model
 from .render import render_all
 from .schema import Study
@@ -104,6 +104,8 @@ def run(study: Study, out: str | os.PathLike | None = None, progress: bool = Tru
     """
     out = study.output_dir(out)
     t_start = time.perf_counter()
+    if not study.parametric:
+        check_inputs(out, [study.mesh_path()])
     staging = staging_dir(out)
     stages = _Stages(progress)
     try:
@@ -119,6 +121,7 @@ def run(study: Study, out: str | os.PathLike | None = None, progress: bool = Tru
         publish(staging, out, RUN_RESULTS, whole=True)
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
+        release(out)
         raise
     finally:
         stages.bar.close()

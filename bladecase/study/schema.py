@@ -27,6 +27,27 @@ from typing import Any
 from ..fe import BladeGeometry, PlateGeometry
 from ..post.outputs import FORMATS as OUTPUT_FORMATS
 from ..reduction import METHODS
+from .values import (  # noqa: F401  (RANGES, LIMITS: part of the schema's documented surface)
+    LIMITS,
+    RANGES,
+    _direction,
+    _formats,
+    _in_range,
+    _int_at_least,
+    _int_between,
+    _ipp,
+    _manifold_size,
+    _num,
+    _one_of,
+    _orbit_list,
+    _period_unit,
+    _periods,
+    _positive,
+    _reduction_list,
+    _scale,
+    _vector,
+    _window,
+)
 
 REQUIRED = object()  #: marks a key without a default
 
@@ -43,92 +64,6 @@ class Key:
     default: Any
     doc: str
     check: Any = None  # callable(value) -> str | None (an error message)
-
-
-def _num(x) -> bool:
-    return isinstance(x, (int, float)) and not isinstance(x, bool)
-
-
-def _positive(v) -> str | None:
-    return None if math.isfinite(v) and v > 0 else "must be a finite number > 0"
-
-
-def _int_at_least(n):
-    return lambda v: None if v >= n else f"must be >= {n}"
-
-
-def _one_of(*choices):
-    return lambda v: None if v in choices else f"must be one of {', '.join(repr(c) for c in choices)}"
-
-
-def _vector(v) -> str | None:
-    if len(v) not in (2, 3) or not all(_num(x) and math.isfinite(x) for x in v):
-        return "must be a list of 2 or 3 finite numbers"
-    return None
-
-
-def _period_unit(v) -> str | None:
-    return None if v == "s" or re.fullmatch(r"T[1-9][0-9]*", v) else (
-        "must be 's' (seconds) or 'T<j>' (the period of the j-th linear mode seen by the contact, e.g. 'T1')")
-
-
-def _periods(v) -> str | None:
-    if len(v) != 2 or not all(_num(x) and math.isfinite(x) for x in v) or not 0 < v[0] < v[1]:
-        return "must be [lower, upper] with 0 < lower < upper"
-    return None
-
-
-def _ipp(v) -> str | None:
-    if not v or not all(isinstance(k, int) and not isinstance(k, bool) and 1 <= k <= 8 for k in v):
-        return "must be a non-empty list of integers between 1 and 8 (impacts per period)"
-    if len(set(v)) != len(v):
-        return "must not repeat a value"
-    return None
-
-
-def _formats(v) -> str | None:
-    bad = [f for f in v if f not in FORMATS]
-    return f"unknown format(s) {bad} (valid: {', '.join(FORMATS)})" if bad else None
-
-
-def _window(v) -> str | None:
-    if len(v) != 2 or not all(isinstance(x, int) and not isinstance(x, bool) and 64 <= x <= 4096 for x in v):
-        return "must be [width, height] in pixels, integers between 64 and 4096"
-    return None
-
-
-def _scale(v) -> str | None:
-    if v == "auto":
-        return None
-    if _num(v):
-        return _positive(v)
-    return "must be 'auto' or a number > 0"
-
-
-def _reduction_list(v) -> str | None:
-    for i, item in enumerate(v):
-        if not isinstance(item, dict):
-            return f"item {i} must be a table {{method = ..., size = ...}}"
-        extra = set(item) - {"method", "size"}
-        if extra:
-            return f"item {i}: unknown key(s) {sorted(extra)} (valid: method, size)"
-        if item.get("method") not in METHODS:
-            return f"item {i}: method must be one of {', '.join(METHODS)}, got {item.get('method')!r}"
-        size = item.get("size")
-        if item["method"] != "full" and (not isinstance(size, int) or isinstance(size, bool) or size < 1):
-            return f"item {i}: size must be an integer >= 1, got {size!r}"
-    return None
-
-
-def _orbit_list(v) -> str | None:
-    for i, item in enumerate(v):
-        if not isinstance(item, dict) or set(item) - {"ipp", "T"} or not {"ipp", "T"} <= set(item):
-            return f"item {i} must be a table {{ipp = K, T = period}} (T in search.period_unit)"
-        if not isinstance(item["ipp"], int) or isinstance(item["ipp"], bool) or item["ipp"] < 1:
-            return f"item {i}: ipp must be an integer >= 1, got {item['ipp']!r}"
-        if not _num(item["T"]) or not math.isfinite(item["T"]) or item["T"] <= 0:
-            return f"item {i}: T must be a number > 0, got {item['T']!r}"
-    return None
 
 
 #: The registry of output formats (:mod:`bladecase.post.outputs`): GIF/MP4 animations, VTK time series
@@ -159,9 +94,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
     "material": {
         "preset": Key(_STR, "Ti-6Al-4V", "Material preset (Ti-6Al-4V, steel, Inconel 718, Al 6061-T6); "
                       "ignored when E, nu and rho are given."),
-        "E": Key(_NUM, None, "Young's modulus (Pa).", _positive),
+        "E": Key(_NUM, None, "Young's modulus (Pa).", _in_range("E")),
         "nu": Key(_NUM, None, "Poisson's ratio.", lambda v: None if -1 < v < 0.5 else "must be in (-1, 0.5)"),
-        "rho": Key(_NUM, None, "Density (kg/m³).", _positive),
+        "rho": Key(_NUM, None, "Density (kg/m³).", _in_range("rho")),
     },
     "fem": {
         "order": Key(_INT, 2, "Polynomial order of the elements (1 or 2).", _one_of(1, 2)),
@@ -170,22 +105,22 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "thickness": Key(_NUM, None, "Out-of-plane thickness of a 2-D model (m); required in 2-D.", _positive),
         "plane": Key(_STR, "stress", "'stress' or 'strain' (2-D models).", _one_of("stress", "strain")),
         "frequencies": Key(_INT, 6, "Linear frequencies of the full FE model to compute and report.",
-                           _int_at_least(1)),
+                           _int_between(1, LIMITS["frequencies"])),
     },
     "contact": {
         "clearance": Key(_NUM, REQUIRED, "Clearance d between the contact node at rest and the casing (m).",
-                         lambda v: None if math.isfinite(v) and v > 0 else "must be > 0 (metres)"),
+                         lambda v: "must be > 0 (metres)" if not v > 0 else _in_range("clearance")(v)),
         "group": Key(_STR, None, "Mesh group of the contact node: alone, a one-node group (default "
                      "'contact'); with 'farthest', the group searched (default 'tip'); with 'nearest', the group "
                      "searched (default: every free node)."),
         "node": Key(_INT, None, "Mesh node index of the contact (overrides group).", _int_at_least(0)),
         "farthest": Key(_LIST, None, "Pick the free node of 'group' (default 'tip') farthest along this "
-                        "direction, e.g. [-1, 0, 0].", _vector),
+                        "direction, e.g. [-1, 0, 0].", _direction),
         "nearest": Key(_LIST, None, "Pick the free node nearest this point (within 'group' if given).", _vector),
         "face": Key(_STR, None, "Contact on a whole face instead of one node: the mean normal displacement of "
                     "the free nodes of this mesh group (e.g. 'tip'), one constraint all the same."),
         "normal": Key(_LIST, None, "Casing normal, from the blade towards the casing; default: radial "
-                      "(+z in 3-D, +y in 2-D).", _vector),
+                      "(+z in 3-D, +y in 2-D).", _direction),
         "model": Key(_STR, "newton", "Contact model: 'newton' (the node keeps its mass; Newton's impact law, "
                      "the seed paper's formulation) or 'massless' (the contact dofs carry no inertia, their lumped "
                      "mass is moved to the neighbours; Signorini without an impact law; needs [fem] mass = "
@@ -205,13 +140,14 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "period_unit": Key(_STR, "T1", "'s', or 'T<j>': the period 2π/ω_j of the j-th linear mode of the "
                            "reduced model that sees the contact.", _period_unit),
         "scan": Key(_INT, 24, "Starting periods scanned for k >= 2 (1 ipp scans max(scan, 200)).",
-                    _int_at_least(2)),
+                    _int_between(2, LIMITS["scan"])),
         "resolution": Key(_INT, None, "Grid points per impact time of the k >= 3 start search at each scanned "
                           "period; default: 4 per period of the highest mode, clipped to [16, 48].",
-                          _int_at_least(4)),
-        "step": Key(_NUM, 0.01, "Initial continuation step (scaled arclength).", _positive),
+                          _int_between(4, LIMITS["resolution"])),
+        "step": Key(_NUM, 0.01, "Initial continuation step (scaled arclength).",
+                    lambda v: None if 1e-6 <= v <= 1 else "must be in [1e-06, 1] (scaled arclength: impact times / T)"),
         "max_points": Key(_INT, 400, "Cap on continuation points per direction of each family.",
-                          _int_at_least(2)),
+                          _int_between(2, LIMITS["max_points"])),
     },
     "output": {
         "directory": Key(_STR, None, "Output directory, relative to the current directory; default "
@@ -223,7 +159,8 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "reference": Key(_BOOL, True, "Check each chosen orbit in a reference model (another reduction method, "
                          "4 times the size): an orbit that does not survive there is not animated (unless named "
                          "in 'orbits', then it is flagged), and the report says so."),
-        "frames": Key(_INT, 40, "Frames per period of the animations and VTK time series.", _int_at_least(2)),
+        "frames": Key(_INT, 40, "Frames per period of the animations and VTK time series.",
+                      _int_between(2, LIMITS["frames"])),
         "scale": Key((str, int, float), "auto", "Amplitude scale of the animations, or 'auto' (largest "
                      "displacement drawn at 'auto_fraction' of the blade's bounding-box diagonal).", _scale),
         "auto_fraction": Key(_NUM, 0.1, "Drawn size of the largest displacement with scale = 'auto'.",
@@ -231,12 +168,10 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "formats": Key(_LIST, ["gif", "mp4", "vtu", "png"], f"Outputs among {', '.join(FORMATS)} (mp4 needs "
                        "imageio-ffmpeg: skipped with a note without it).", _formats),
         "manifold": Key(_BOOL, True, "Export the invariant-manifold samples of each animated family (VTK)."),
-        "manifold_size": Key(_LIST, [40, 100], "[orbits, phases] sampled on the manifold.",
-                             lambda v: None if len(v) == 2 and all(isinstance(x, int) and not isinstance(x, bool)
-                                                                   and x >= 2 for x in v)
-                             else "must be [orbits, phases], integers >= 2"),
+        "manifold_size": Key(_LIST, [40, 100], "[orbits, phases] sampled on the manifold.", _manifold_size),
         "window": Key(_LIST, [800, 600], "Animation size [width, height] in pixels.", _window),
-        "fps": Key(_NUM, 20, "Frames per second of the animations.", _positive),
+        "fps": Key(_NUM, 20, "Frames per second of the animations.",
+                   lambda v: None if 0 < v <= LIMITS["fps"] else f"must be a number in (0, {LIMITS['fps']}]"),
     },
 }
 
@@ -420,15 +355,38 @@ def _cross_checks(c: dict) -> None:
     pickers = [k for k in ("node", "farthest", "nearest", "face") if ct[k] is not None]
     if len(pickers) > 1:
         raise StudyError(f"[contact] {pickers[1]}: give at most one of node, farthest, nearest, face (got {pickers})")
+    for key in ("normal", "farthest"):  # directions: scaled to a largest component of 1 (no overflow later)
+        v = ct[key]
+        if v is not None:
+            top = max(abs(x) for x in v)
+            ct[key] = [x / top for x in v]
     r = c["reduction"]
     if r["method"] == "full":
         r["size"] = None
     _contact_model_checks(c)
+    _work_checks(c["search"])
     o, s = c["output"], c["search"]
     for i, item in enumerate(o["orbits"]):
         if item["ipp"] not in s["ipp"]:
             raise StudyError(f"[output] orbits: item {i} asks for ipp = {item['ipp']}, which [search] ipp = "
                              f"{s['ipp']} does not look for")
+
+
+def _work_checks(s: dict) -> None:
+    """Searches that would not end: periods of very many linear periods, too fine a k-ipp start grid."""
+    top = LIMITS["period_multiple"]
+    if s["period_unit"] != "s" and s["periods"][1] > top:
+        raise StudyError(f"[search] periods: the upper period must be <= {top} × {s['period_unit']} (the work grows "
+                         f"with the number of linear periods per orbit), got {s['periods']}")
+    k = max(s["ipp"])
+    if s["resolution"] is not None and k >= 3:
+        cells = math.comb(s["resolution"] - 1, k - 1)
+        cap = LIMITS["grid_cells"]
+        if cells > cap:
+            fit = max((r for r in range(4, s["resolution"]) if math.comb(r - 1, k - 1) <= cap), default=4)
+            raise StudyError(f"[search] resolution: {s['resolution']} points per impact time make "
+                             f"{cells:.3g} start cells for ipp = {k} at each scanned period (at most {cap}): "
+                             f"resolution <= {fit} for ipp = {k}, got {s['resolution']}")
 
 
 def _contact_model_checks(c: dict) -> None:
