@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..checks import integer
 from .flight import CONTACT_RTOL, FlightPropagator, ImpactLaw, ModalFlight, NewtonImpact
 from .signals import first_upcrossing
 from .system import LinearSystem
@@ -145,6 +146,7 @@ def integrate(flight: FlightPropagator, impact: ImpactLaw, x0, v0, t_end: float,
     t_end = float(t_end)
     if not np.isfinite(t_end) or t_end <= 0:
         raise ValueError(f"t_end must be finite and > 0, got {t_end!r}")
+    max_impacts = integer("max_impacts", max_impacts, 1)
     d = system.gap
     q0, p0 = flight.encode(x0, v0)
     tol0 = flight.contact_tol(q0)

@@ -297,9 +297,8 @@ class LinearSystem:
         _check_symmetric("K", K)
         if isinstance(w, (int, np.integer)) and not isinstance(w, bool):
             c = int(w)
-            if not -n <= c < n:
-                raise ValueError(f"contact dof w = {c} is out of range for a system of {n} dofs (valid: 0..{n - 1}, "
-                                 f"or -{n}..-1 counting from the end)")
+            if not 0 <= c < n:  # a negative index would silently pick a dof from the end
+                raise ValueError(f"contact dof w = {c} is out of range for a system of {n} dofs (valid: 0..{n - 1})")
             wv = np.zeros(n)
             wv[c] = 1.0
         else:

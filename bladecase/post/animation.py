@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import log
 from ..fe import Mesh
 from ..io import atomic_path
 from .grid import VTK_CELL_TYPES
@@ -372,8 +373,8 @@ def _write_gif(path: Path, frames: list[np.ndarray], impact: np.ndarray, fps: fl
     ims[0].save(path, format="GIF", save_all=True, append_images=ims[1:], duration=1000.0 / fps, loop=0)
     with Image.open(path) as im:
         written = im.n_frames
-    if written != len(frames):  # Pillow merges identical consecutive frames; the frame counter prevents it
-        raise RuntimeError(f"GIF writer kept {written} of {len(frames)} frames (identical frames merged)")
+    if written != len(frames):  # Pillow merges identical consecutive frames and adds their durations
+        log.info("GIF %s: %d identical consecutive frame(s) merged (timing kept)", path.name, len(frames) - written)
 
 
 def _write_mp4(path: Path, frames: list[np.ndarray], fps: float) -> None:

@@ -62,10 +62,11 @@ def _unit(name: str, value, sizes: Sequence[int] = (2, 3)) -> tuple[float, ...]:
         raise ValueError(f"{name} must have {' or '.join(map(str, sizes))} components, got {v.size} ({value!r})")
     if not np.all(np.isfinite(v)):
         raise ValueError(f"{name} must be finite, got {value!r}")
-    norm = float(np.linalg.norm(v))
-    if norm == 0.0:
+    top = float(np.abs(v).max())  # scale first: the norm of [1e300, 1e300] overflows
+    if top == 0.0:
         raise ValueError(f"{name} must be a non-zero vector, got {value!r}")
-    return tuple(float(c) for c in v / norm)
+    v = v / top
+    return tuple(float(c) for c in v / np.linalg.norm(v))
 
 
 def _gap(gap) -> float:

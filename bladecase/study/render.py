@@ -18,7 +18,7 @@ from ..post.outputs import FORMATS, OrbitScene
 from ..progress import progress_bar
 from ..reduction import ReducedModel
 from .choose import Choice, choose_orbits, frame_times
-from .publish import publish, staging_dir
+from .publish import publish, release, staging_dir
 from .reference import check_in_reference, log_check, reference_model
 from .schema import Study
 from .stages import period_unit
@@ -112,7 +112,7 @@ def render_all(study: Study, reduced: ReducedModel, families: list[Branch], fold
         log.warning("%d admissible orbit(s) of the %s model were not animated: they do not survive in the "
                     "reference model %s (%d dofs) — artefacts of the reduced model", len(rejected),
                     reduced.method, reference.method, reference.n)
-    if not chosen:
+    if not chosen and (study["output"]["animate"] > 0 or study["output"]["orbits"]):
         log.warning("no admissible orbit to animate%s: widen [search] periods or add ipp values%s",
                     " that survives in the reference model" if reference is not None else "",
                     "; with Newton's impact law the orbits depend on the reduced model ([contact] model = "
@@ -129,12 +129,13 @@ def animate_families(study: Study, reduced: ReducedModel, families: list[Branch]
     names relative to the output directory); files are published together.
     """
     out = study.output_dir(out)
-    staging = staging_dir(out)
+    staging = staging_dir(out, ("animations", "vtk"))
     try:
         reference = reference_model(reduced.model, reduced.contact, reduced) if study["output"]["reference"] else None
         entries = render_all(study, reduced, families, staging, progress, reference)
         publish(staging, out, ("animations", "vtk"))
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
+        release(out)
         raise
     return entries

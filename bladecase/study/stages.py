@@ -148,6 +148,10 @@ def period_unit(study: Study, system: LinearSystem) -> tuple[float, str]:
     return float(2 * np.pi / omega[j - 1]), unit
 
 
+def _lowest_omega(system) -> float:
+    return float(system.open.omega[0] if hasattr(system, "open") else system.spectrum.omega[0])
+
+
 def search(study: Study, system: LinearSystem, progress: bool = False, unit: float | None = None,
            label: str = "") -> list[Branch]:
     """Every family of every ``[search] ipp`` in the study's period range.
@@ -159,6 +163,10 @@ def search(study: Study, system: LinearSystem, progress: bool = False, unit: flo
     s = study["search"]
     scale = period_unit(study, system)[0] if unit is None else unit
     T_range = (s["periods"][0] * scale, s["periods"][1] * scale)
+    T_top = float(2 * np.pi / _lowest_omega(system))
+    if T_range[1] > 100 * T_top:
+        raise StudyError(f"[search] periods: up to {T_range[1]:.6g} s, more than 100 × the longest linear period "
+                         f"{T_top:.6g} s; valid: at most {100 * T_top:.6g} s")
     families: list[Branch] = []
     for k in s["ipp"]:
         t0 = time.perf_counter()
