@@ -346,7 +346,9 @@ def test_rerun_replaces_results_and_drops_stale_ones(plate_study, tmp_path):
     raw["mesh"]["path"] = str(st.mesh_path())
     pipeline.run(validate(raw), out=out, progress=False)
     names = sorted(p.name for p in out.iterdir())
-    assert names == ["animations", "mesh.vtu", "modes.json", "notes.txt", "report.md", "run.log", "summary.json"]
+    # no png in formats: the comparison keeps its table only (comparison.csv), no figures
+    assert names == ["animations", "comparison.csv", "mesh.vtu", "modes.json", "notes.txt", "report.md", "run.log",
+                     "summary.json"]
     assert (out / "notes.txt").read_text() == "mine"
 
 

@@ -19,9 +19,11 @@ import numpy as np
 from .. import log
 from ..fe import natural_frequencies, save_mesh, stiffness_factor
 from ..io import write_json, write_text
+from ..post.compare import ModelResult
 from ..post.outputs import FORMATS, PlotScene
 from ..post.report import report
 from ..progress import progress_counter
+from .comparison import compare_models
 from .documents import contact_summary, families_document, family_summary, model_summary, reduced_summary
 from .executor import Executor, SerialExecutor
 from .publish import RUN_RESULTS, check_inputs, publish, release, staging_dir
@@ -38,6 +40,9 @@ class RunResult:
     directory: Path
     summary: dict = field(repr=False)
     families: list = field(repr=False, default_factory=list)
+    #: Every model of the run by name (the main one first, then ``compare`` and the methods × sizes grid):
+    #: :class:`~bladecase.post.compare.ModelResult` with the reduced model, its families and timings.
+    models: dict = field(repr=False, default_factory=dict)
 
 
 class _Stages:
@@ -111,7 +116,7 @@ def run(study: Study, out: str | os.PathLike | None = None, progress: bool = Tru
     try:
         with log.transcript() as lines:
             log.info("study %s (%s) → %s", study.name, study.source, out)
-            summary, families = _compute(study, staging, stages, progress, executor or SerialExecutor())
+            summary, families, models = _compute(study, staging, stages, progress, executor or SerialExecutor())
             summary["timings_s"] = dict(stages.timings, total=round(time.perf_counter() - t_start, 3))
             log.info("results in %s (%.1f s)", out, summary["timings_s"]["total"])
         write_text(staging / "run.log", "\n".join(lines) + "\n")
@@ -125,10 +130,11 @@ def run(study: Study, out: str | os.PathLike | None = None, progress: bool = Tru
         raise
     finally:
         stages.bar.close()
-    return RunResult(directory=out, summary=summary, families=families)
+    return RunResult(directory=out, summary=summary, families=families, models=models)
 
 
-def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, executor: Executor) -> tuple[dict, list]:
+def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, executor: Executor
+             ) -> tuple[dict, list, dict]:
     """Every stage of :func:`run`, writing into ``staging``; returns the summary (without timings) and families."""
     o = study["output"]
     files: dict[str, object] = {}
@@ -145,9 +151,15 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         log.info("FE model: %s; first frequencies %s Hz", model, ", ".join(f"{x:.1f}" for x in f_fe[:6]))
     with stage("reduce"):
         contact = build_contact(study, model)
+        build_s = []
+        t0 = time.perf_counter()
         reduced = build_reduced(study, model, contact, factor=factor)
-        compares = [build_reduced(study, model, contact, c["method"], c.get("size"), factor=factor)
-                    for c in study["reduction"]["compare"]]
+        build_s.append(time.perf_counter() - t0)
+        compares = []
+        for c in study["reduction"]["compare"]:
+            t0 = time.perf_counter()
+            compares.append(build_reduced(study, model, contact, c["method"], c.get("size"), factor=factor))
+            build_s.append(time.perf_counter() - t0)
         log.info("contact: node %d at %s, normal %s, clearance %g m", contact.node,
                  np.round(mesh.points[contact.node], 6).tolist(), np.round(contact.normal_for(model), 6).tolist(),
                  contact.gap)
@@ -157,16 +169,28 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
             log.info("reference model for the orbits' check: %s", reference)
     with stage("search"):
         unit, _ = period_unit(study, reduced.system)
-        found = executor.map(lambda r: search(study, r.system, progress=progress, unit=unit,
+        timed = executor.map(lambda r: _timed(search, study, r.system, progress=progress, unit=unit,
                                               label=f"{r.method} {r.size} ({r.n} dofs)"), [reduced, *compares],
                              desc="models", progress=progress)
+        found = [f for f, _ in timed]
         families, compare_families = found[0], found[1:]
-        write_json(staging / "modes.json", families_document(families, reduced.system))
+        models = [ModelResult(r, fams, b, t) for r, fams, b, (_, t) in zip([reduced, *compares], found, build_s, timed)]
+        document = families_document(families, reduced.system)
+        if compares:  # every model's families are kept
+            document["compare"] = [dict(model=m.name, **families_document(m.branches, m.reduced.system))
+                                   for m in models[1:]]
+        write_json(staging / "modes.json", document)
         files["modes"] = "modes.json"
     with stage("plots"):
         scene = PlotScene(study.name, [(f"{r.method} ({r.n} dofs)", fams) for r, fams in
                                        zip([reduced, *compares], found)], f_fe)
         files.update(FORMATS.write(o["formats"], "run", scene, staging))
+        comparison = None
+        if compares:
+            comparison = compare_models(model, contact, models, staging, factor=factor, title=study.name,
+                                        figures="png" in o["formats"])
+            files["comparison"] = comparison["csv"]
+            files["comparison_figures"] = comparison["figures"]
     with stage("render"):
         files["animations"] = render_all(study, reduced, families, staging, progress, reference)
     files["log"] = "run.log"
@@ -183,6 +207,13 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
                     for r, fams in zip(compares, compare_families)],
         "search": {**study["search"], "period_unit_s": unit},
         "families": [family_summary(f) for f in families],
+        "comparison": None if comparison is None else {k: comparison[k] for k in ("rows", "diagnostics", "figures")},
         "files": files,
     }
-    return summary, families
+    return summary, families, {m.name: m for m in models}
+
+
+def _timed(fn, *args, **kwargs):
+    t0 = time.perf_counter()
+    out = fn(*args, **kwargs)
+    return out, time.perf_counter() - t0

@@ -37,6 +37,7 @@ from .values import (  # noqa: F401  (RANGES, LIMITS: part of the schema's docum
     _int_between,
     _ipp,
     _manifold_size,
+    _method_names,
     _num,
     _one_of,
     _orbit_list,
@@ -45,6 +46,7 @@ from .values import (  # noqa: F401  (RANGES, LIMITS: part of the schema's docum
     _positive,
     _reduction_list,
     _scale,
+    _size_list,
     _vector,
     _window,
 )
@@ -121,6 +123,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
                     "the free nodes of this mesh group (e.g. 'tip'), one constraint all the same."),
         "normal": Key(_LIST, None, "Casing normal, from the blade towards the casing; default: radial "
                       "(+z in 3-D, +y in 2-D).", _direction),
+        "weights": Key(_STR, None, "With 'face': how the face's nodes are weighted in the mean normal "
+                       "displacement: 'equal' (default) or 'area' (each node's share of the face area, which "
+                       "converges under mesh refinement).", _one_of("equal", "area")),
         "model": Key(_STR, "newton", "Contact model: 'newton' (the node keeps its mass; Newton's impact law, "
                      "the seed paper's formulation) or 'massless' (the contact dofs carry no inertia, their lumped "
                      "mass is moved to the neighbours; Signorini without an impact law; needs [fem] mass = "
@@ -133,6 +138,10 @@ SCHEMA: dict[str, dict[str, Key]] = {
                     _int_at_least(1)),
         "compare": Key(_LIST, [], "Other reduced models run through the same search for comparison: "
                        "[{method = 'modal', size = 20}, …].", _reduction_list),
+        "methods": Key(_LIST, [], "A comparison grid: these methods × 'sizes' (default: [method]), each run "
+                       "through the same search, compared in comparison.csv and the report.", _method_names),
+        "sizes": Key(_LIST, [], "Sizes of the comparison grid (default: [size]), e.g. [8, 16, 32, 64].",
+                     _size_list),
     },
     "search": {
         "ipp": Key(_LIST, [1, 2], "Impacts per period of the families to look for.", _ipp),
@@ -360,9 +369,13 @@ def _cross_checks(c: dict) -> None:
         if v is not None:
             top = max(abs(x) for x in v)
             ct[key] = [x / top for x in v]
+    if ct["weights"] is not None and ct["face"] is None:
+        raise StudyError(f"[contact] weights: only with [contact] face (the weights of its nodes), got "
+                         f"{ct['weights']!r} without a face")
     r = c["reduction"]
     if r["method"] == "full":
         r["size"] = None
+    _expand_grid(r)
     _contact_model_checks(c)
     _work_checks(c["search"])
     o, s = c["output"], c["search"]
@@ -387,6 +400,23 @@ def _work_checks(s: dict) -> None:
             raise StudyError(f"[search] resolution: {s['resolution']} points per impact time make "
                              f"{cells:.3g} start cells for ipp = {k} at each scanned period (at most {cap}): "
                              f"resolution <= {fit} for ipp = {k}, got {s['resolution']}")
+
+
+def _expand_grid(r: dict) -> None:
+    """``methods`` × ``sizes`` appended to ``compare`` (the main model and repeats left out)."""
+    if not (r["methods"] or r["sizes"]):
+        return
+    methods = r["methods"] or [r["method"]]
+    sizes = r["sizes"] or [r["size"]]
+    seen = {(r["method"], r["size"])} | {(x["method"], x.get("size")) for x in r["compare"]}
+    for m in methods:
+        for n in ([None] if m == "full" else sizes):
+            if (m, n) not in seen:
+                seen.add((m, n))
+                r["compare"].append({"method": m, "size": n})
+    if len(r["compare"]) > LIMITS["models"]:
+        raise StudyError(f"[reduction] methods × sizes: {len(r['compare']) + 1} models, at most "
+                         f"{LIMITS['models'] + 1}")
 
 
 def _contact_model_checks(c: dict) -> None:

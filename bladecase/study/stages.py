@@ -101,7 +101,7 @@ def build_contact(study: Study, model: FEModel) -> Contact:
     group = contact_group(study)
     try:
         if c["face"] is not None:
-            return Contact.face(model, c["face"], normal, gap)
+            return Contact.face(model, c["face"], normal, gap, weights=c["weights"] or "equal")
         if c["node"] is not None:
             return Contact.at(model, c["node"], normal, gap)
         if c["farthest"] is not None:

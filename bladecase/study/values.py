@@ -37,7 +37,8 @@ RANGES = {"clearance": (1e-9, 10.0, "m"), "E": (1e3, 1e13, "Pa"), "rho": (1e-2, 
 #: Caps on the work a study may ask for (each is far above any useful value; beyond, a run would not end
 #: or not fit in memory).
 LIMITS = {"frames": 1000, "scan": 2000, "resolution": 1000, "max_points": 100_000, "fps": 1000, "frequencies": 100,
-          "manifold_axis": 1000, "manifold_samples": 100_000, "period_multiple": 100, "grid_cells": 1_000_000}
+          "manifold_axis": 1000, "manifold_samples": 100_000, "period_multiple": 100, "grid_cells": 1_000_000,
+          "models": 32}
 
 
 def _in_range(name: str):
@@ -123,6 +124,20 @@ def _reduction_list(v) -> str | None:
         if item["method"] != "full" and (not isinstance(size, int) or isinstance(size, bool) or size < 1):
             return f"item {i}: size must be an integer >= 1, got {size!r}"
     return None
+
+
+def _method_names(v) -> str | None:
+    bad = [m for m in v if m not in METHODS]
+    if bad:
+        return f"unknown method {bad[0]!r} (valid: {', '.join(METHODS)})"
+    return None if len(set(v)) == len(v) else f"methods repeat: {v}"
+
+
+def _size_list(v) -> str | None:
+    bad = [x for x in v if not isinstance(x, int) or isinstance(x, bool) or x < 1]
+    if bad:
+        return f"sizes must be integers >= 1, got {bad[0]!r}"
+    return None if len(set(v)) == len(v) else f"sizes repeat: {v}"
 
 
 def _orbit_list(v) -> str | None:

@@ -1,0 +1,67 @@
+"""A comparison study: [reduction] methods × sizes through the same search, compared against the FE model
+(bladecase/study/comparison.py, bladecase/post/compare*.py)."""
+
+import json
+
+import pytest
+from _studies import PLATE, ROOT
+
+from bladecase.post.compare_table import read_comparison_csv
+from bladecase.study import run
+from bladecase.study.schema import StudyError, loads
+
+GRID = PLATE.replace('method = "modal"\nsize = 10\n', 'method = "modal"\nsize = 10\nmethods = ["modal", '
+                     '"craig-bampton", "lanczos-si"]\nsizes = [6, 12]\n') + \
+    '\n[output]\nreference = false\nformats = ["png"]\nanimate = 0\n'
+
+
+@pytest.fixture(scope="module")
+def result(tmp_path_factory):
+    return run(loads(GRID, base=ROOT), out=tmp_path_factory.mktemp("cmp") / "out", progress=False)
+
+
+def test_grid_expands_to_every_model(result):
+    names = list(result.models)
+    assert names == ["modal-10", "modal-6", "modal-12", "craig-bampton-6", "craig-bampton-12", "lanczos-si-6",
+                     "lanczos-si-12"]
+    for m in result.models.values():
+        assert m.build_s >= 0 and m.search_s >= 0 and m.reduced.n >= 6
+    doc = json.loads((result.directory / "modes.json").read_text())
+    assert [c["model"] for c in doc["compare"]] == names[1:]  # every model's families are kept
+
+
+def test_comparison_table_figures_and_words(result):
+    rows = read_comparison_csv(result.directory / "comparison.csv")
+    assert [r["model"] for r in rows] == ["FE", *result.models]
+    by = {r["model"]: r for r in rows}
+    # modal models are the FE modes: every checked mode matched by shape; Lanczos-SI 6 has an artefact mode
+    assert by["modal-12"]["modes_matched"] == by["modal-12"]["modes_checked"] and not by["modal-12"]["artefacts"]
+    assert by["lanczos-si-6"]["artefacts"] >= 1
+    # shift-invert Lanczos keeps the static compliance exactly; a truncated modal basis does not
+    assert by["lanczos-si-12"]["static_compliance_kept"] == pytest.approx(1.0, rel=1e-8)
+    assert by["modal-6"]["static_compliance_kept"] < 0.9
+    words = result.summary["comparison"]["diagnostics"]
+    assert any("impact mass differs" in w for w in words) and any("no FE counterpart" in w for w in words)
+    for name in result.summary["files"]["comparison_figures"].values():
+        assert (result.directory / name).stat().st_size > 10_000
+    report = (result.directory / "report.md").read_text()
+    assert "## Model comparison" in report and "| lanczos-si-6 | 6 |" in report and "nearest-frequency" not in report
+
+
+@pytest.mark.parametrize("edit, match", [
+    ('methods = ["modal", "magic"]', r"\[reduction\] methods: unknown method 'magic'"),
+    ("sizes = [8, 8]", r"\[reduction\] sizes: sizes repeat"),
+    ("sizes = [0]", r"\[reduction\] sizes: sizes must be integers >= 1"),
+])
+def test_grid_keys_are_checked(edit, match):
+    with pytest.raises(StudyError, match=match):
+        loads(PLATE.replace("[search]", edit + "\n[search]"), base=ROOT)  # the last keys of [reduction]
+
+
+def test_face_weights_key():
+    with pytest.raises(StudyError, match=r"\[contact\] weights: only with \[contact\] face"):
+        loads(PLATE.replace("clearance = 1e-4", 'clearance = 1e-4\nweights = "area"'), base=ROOT)
+    with pytest.raises(StudyError, match=r"\[contact\] weights"):
+        loads(PLATE.replace("clearance = 1e-4", 'clearance = 1e-4\nface = "tip"\nweights = "mass"'), base=ROOT)
+    study = loads(PLATE.replace("clearance = 1e-4", 'clearance = 1e-4\nface = "tip"\nweights = "area"'), base=ROOT)
+    assert study["contact"]["weights"] == "area"
