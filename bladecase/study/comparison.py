@@ -8,11 +8,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from .. import log
-from ..fe import FEModel
-from ..post.compare import ModelResult, fe_reference
+from ..post.compare import FEReference, ModelResult
 from ..post.compare_plots import convergence_plot, overlay_plot, spectral_plot
 from ..post.compare_table import comparison_rows, diagnose, write_comparison_csv
-from ..reduction import Contact
 
 #: Lowest FE modes computed for the MAC matching (more when the study asks for more frequencies).
 FE_MODES = 12
@@ -22,12 +20,11 @@ FIGURES = {"overlay": "comparison_frequency_energy.png", "convergence": "compari
            "spectrum": "comparison_contact_spectrum.png"}
 
 
-def compare_models(model: FEModel, contact: Contact, entries: list[ModelResult], folder: Path, *,
-                   fe_modes: int = FE_MODES, factor=None, title: str = "", figures: bool = True) -> dict:
-    """Write ``comparison.csv`` and (``figures``: PNG) the comparison figures of ``entries`` into ``folder``;
-    return the summary section: ``{"csv", "figures", "rows", "diagnostics"}`` (diagnostics: sentences, empty
-    when the models agree)."""
-    fe = fe_reference(model, contact, min(fe_modes, model.n_dofs - 1), factor=factor)
+def compare_models(fe: FEReference, entries: list[ModelResult], folder: Path, *, title: str = "",
+                   figures: bool = True) -> dict:
+    """Write ``comparison.csv`` and (``figures``: PNG) the comparison figures of ``entries`` against the FE
+    model ``fe`` (:func:`~bladecase.post.compare.fe_reference`) into ``folder``; return the summary section:
+    ``{"csv", "figures", "rows", "diagnostics"}`` (diagnostics: sentences, empty when the models agree)."""
     rows = comparison_rows(entries, fe)
     write_comparison_csv(rows, folder / "comparison.csv")
     words = diagnose(rows, fe)

@@ -89,14 +89,29 @@ def family_summary(fam: Branch) -> dict:
     }
 
 
-def reduced_summary(reduced: ReducedModel, reference_hz: np.ndarray) -> dict:
-    """A reduced model's frequencies and contact weights, with the nearest-frequency error vs ``reference_hz``."""
+def reduced_summary(reduced: ReducedModel, reference_hz: np.ndarray, fe=None) -> dict:
+    """A reduced model's frequencies and contact weights, with the nearest-frequency error vs ``reference_hz``;
+    with ``fe`` (:func:`~bladecase.post.compare.fe_reference`) each mode's FE counterpart by mode shape (MAC):
+    ``fe_match`` per listed mode, ``None`` when it has none (an artefact) or lies above the FE modes computed."""
     sp = reduced.system.spectrum
     f = sp.frequencies[sp.active]
     nearest = [float(np.min(np.abs(f - fr)) / fr) if f.size else None for fr in reference_hz]
-    return {"method": reduced.method, "size": reduced.size, "reduced_dofs": reduced.n,
-            "frequencies_hz": f.tolist(), "contact_weights_b2": (sp.b[sp.active] ** 2).tolist(),
-            "relative_error_vs_fe": nearest}
+    out = {"method": reduced.method, "size": reduced.size, "reduced_dofs": reduced.n,
+           "frequencies_hz": f.tolist(), "contact_weights_b2": (sp.b[sp.active] ** 2).tolist(),
+           "relative_error_vs_fe": nearest}
+    if fe is not None:
+        from ..post.compare import model_matches
+
+        found = {m.index: m for m in model_matches(reduced, fe, modes=12)}
+        out["fe_match"] = [_match(found.get(int(j))) for j in np.flatnonzero(sp.active)]
+    return out
+
+
+def _match(m) -> dict | None:
+    if m is None:
+        return None
+    return {"fe_mode": None if m.fe_index is None else m.fe_index + 1, "mac": m.mac, "best_fe": m.best_fe + 1,
+            "relative_error": m.relative_error, "beyond_fe": m.beyond_fe}
 
 
 def model_summary(mesh: Mesh, model: FEModel, f_fe: np.ndarray, source: str) -> dict:

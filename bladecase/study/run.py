@@ -17,13 +17,13 @@ from pathlib import Path
 import numpy as np
 
 from .. import log
-from ..fe import natural_frequencies, save_mesh, stiffness_factor
+from ..fe import save_mesh, stiffness_factor
 from ..io import write_json, write_text
-from ..post.compare import ModelResult
+from ..post.compare import ModelResult, fe_reference
 from ..post.outputs import FORMATS, PlotScene
 from ..post.report import report
 from ..progress import progress_counter
-from .comparison import compare_models
+from .comparison import FE_MODES, compare_models
 from .documents import contact_summary, families_document, family_summary, model_summary, reduced_summary
 from .executor import Executor, SerialExecutor
 from .publish import RUN_RESULTS, check_inputs, publish, release, staging_dir
@@ -147,10 +147,12 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
     with stage("assemble"):
         model = build_model(study, mesh)
         factor = stiffness_factor(model)
-        f_fe = natural_frequencies(model, min(study["fem"]["frequencies"], model.n_dofs - 1), factor=factor)
+        contact = build_contact(study, model)
+        count = min(study["fem"]["frequencies"], model.n_dofs - 1)
+        fe = fe_reference(model, contact, min(max(count, FE_MODES), model.n_dofs - 1), factor=factor)
+        f_fe = fe.frequencies[:count]
         log.info("FE model: %s; first frequencies %s Hz", model, ", ".join(f"{x:.1f}" for x in f_fe[:6]))
     with stage("reduce"):
-        contact = build_contact(study, model)
         build_s = []
         t0 = time.perf_counter()
         reduced = build_reduced(study, model, contact, factor=factor)
@@ -187,8 +189,7 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         files.update(FORMATS.write(o["formats"], "run", scene, staging))
         comparison = None
         if compares:
-            comparison = compare_models(model, contact, models, staging, factor=factor, title=study.name,
-                                        figures="png" in o["formats"])
+            comparison = compare_models(fe, models, staging, title=study.name, figures="png" in o["formats"])
             files["comparison"] = comparison["csv"]
             files["comparison_figures"] = comparison["figures"]
     with stage("render"):
@@ -201,7 +202,7 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         "model": model_summary(mesh, model, f_fe, "gmsh (parametric [geometry])" if study.parametric
                                else str(study.mesh_path())),
         "contact": contact_summary(contact, model),
-        "reduction": reduced_summary(reduced, f_fe),
+        "reduction": reduced_summary(reduced, f_fe, fe),
         "reference": None if reference is None else reduced_summary(reference, f_fe),
         "compare": [dict(reduced_summary(r, f_fe), families=[family_summary(f) for f in fams])
                     for r, fams in zip(compares, compare_families)],
