@@ -39,7 +39,8 @@ import bladecase as bc
 from bladecase.nsm import ModalKernel
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
-NAMES = ["fig2_impact_time_map", "fig3_trajectories", "fig4_manifold", "frequency_energy", "fig11_stability"]
+NAMES = ["fig2_impact_time_map", "fig3_trajectories", "fig4_manifold", "frequency_energy", "fig11_stability",
+         "fig9_forced_response", "fig10_forced_response"]
 FIVE_T2 = 10 * np.pi / np.sqrt(3 + np.sqrt(5))  # 5 · 2π/ω₂ for chain(2, k=1, m=1/2): ω₂² = 3 + √5
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
@@ -235,3 +236,14 @@ def test_frequency_energy_numbers(ex, paper, sys2):
     E_graze = 0.5 * (omega[1] * sys2.gap / abs(b[1])) ** 2
     assert E_graze == pytest.approx(4.736, abs=1e-3)
     assert mode.orbits[-2].energy < o2.energy <= E_graze and o2.energy == pytest.approx(E_graze, rel=1e-5)
+
+
+def test_fig9_forced_one_impact_per_period(ex):
+    """The n = 5 chain forced at T = 5.5 and 5.4 (F₀ = 1, C = 0.01 K) settles on one impact per forcing period,
+    periodic to 1e-9, with energies above 100 rising towards the 1-ipp backbone's resonance at T = 5.231."""
+    f9 = ex["fig9_forced_response"]
+    res, _ = f9.sweeps(f9.system(), [(1.0, 0.01)], [5.5, 5.4], 500, progress=False)
+    pts = {p.T: p for p in res[1.0, 0.01]}
+    for T in (5.5, 5.4):
+        assert pts[T].label == "1/1" and pts[T].residual < 1e-9
+    assert pts[5.4].energy > pts[5.5].energy > 100

@@ -23,6 +23,9 @@ The pipeline inside, one module per step:
 - :mod:`~bladecase.nsm.flight` and :mod:`~bladecase.nsm.simulation` — the event-driven simulator:
   a flight propagator (:class:`ModalFlight`), an impact law (:class:`NewtonImpact`), the event loop
   (:func:`integrate`) and :func:`simulate`;
+- :mod:`~bladecase.nsm.forced` (+ :mod:`~bladecase.nsm.damped_signals`) — forced–damped exact flight and
+  simulation (:func:`simulate_forced`, :class:`Damping`); :mod:`~bladecase.nsm.sweep` — forcing-period sweeps
+  with steady-state detection and classification (:func:`forced_sweep`);
 - :mod:`~bladecase.nsm.verify` — the independent check of an orbit by simulation (:func:`verify`);
 - :mod:`~bladecase.nsm.floquet` — stability: monodromy with saltation matrices, multipliers, a verdict
   (:func:`floquet`, :func:`branch_stability`, :func:`stable_arcs`);
@@ -39,6 +42,7 @@ from .continuation import Curve, bisect, trace
 from .families import KippCurve
 from .flight import FlightPropagator, ImpactLaw, ModalFlight, NewtonImpact
 from .floquet import FLOQUET_TOL, Floquet, branch_stability, floquet, stable_arcs
+from .forced import Damping, EnergyBalance, ForcedFlight, ForcedTrajectory, simulate_forced
 from .kipp import canonical_rotation, orbits_kipp
 from .massless import MASSLESS_DENSE_LIMIT, MasslessSystem, condense, redistribute_mass, simulate_massless
 from .massless_branches import massless_mode
@@ -56,11 +60,14 @@ from .modes import nonsmooth_mode
 from .orbits import PeriodicOrbit, make_orbit, orbit_1ipp
 from .scan import backbone
 from .simulation import Trajectory, integrate, simulate
+from .sweep import SweepPoint, forced_point, forced_sweep, settles_linear
 from .system import LinearSystem, Spectrum, chain
 from .verify import VERIFY_RTOL, verify
 
 __all__ = [
-    "Arc", "Backbone", "Branch", "Curve", "FLOQUET_TOL", "Family", "FlightPropagator", "Floquet", "ImpactLaw",
+    "Arc", "Backbone", "Branch", "Curve", "Damping", "EnergyBalance", "FLOQUET_TOL", "Family", "FlightPropagator",
+    "Floquet", "ForcedFlight", "ForcedTrajectory", "ImpactLaw", "SweepPoint", "forced_point", "forced_sweep",
+    "settles_linear", "simulate_forced",
     "Interval", "KippCurve", "LinearSystem", "MASSLESS_DENSE_LIMIT", "MasslessSystem", "ModalFlight", "ModalKernel",
     "NewtonImpact", "PeriodicOrbit", "PhasedOrbit", "Spectrum", "Trajectory", "VERIFY_RTOL",
     "backbone", "bar", "bar_continuum_energy", "bisect", "branch_stability", "canonical_rotation", "chain",

@@ -138,7 +138,8 @@ def integrate(flight: FlightPropagator, impact: ImpactLaw, x0, v0, t_end: float,
     """The event loop: fly with ``flight`` to the first contact, apply ``impact``, repeat until ``t_end``.
 
     ``(x0, v0)`` at ``t = 0`` must satisfy ``wᵀx0 <= d`` (up to the propagator's contact tolerance).
-    Stops early (``complete = False``, with a ``RuntimeWarning``) after ``max_impacts`` impacts or when
+    Stops early (``complete = False``, with a ``RuntimeWarning``) when the state comes to rest on the obstacle
+    (where chattering with ``e < 1`` ends; the sticking phase is not modelled), after ``max_impacts`` impacts or when
     impacts accumulate (more than 50 flights shorter than ``1e-12`` of the time in a row).
     """
     system = flight.system
@@ -159,7 +160,13 @@ def integrate(flight: FlightPropagator, impact: ImpactLaw, x0, v0, t_end: float,
     complete = True
     tiny_flights = 0
     while True:
-        tau = _next_impact(flight, q, p, t, t_end)
+        try:
+            tau = _next_impact(flight, q, p, t, t_end)
+        except RuntimeError as exc:  # at rest on the obstacle: where chattering (e < 1) ends
+            complete = False
+            warnings.warn(f"simulate stopped at t = {t:.6g} after {len(times)} impacts: {exc}", RuntimeWarning,
+                          stacklevel=_stacklevel)
+            break
         if tau is None:
             q, p = flight.advance(q, p, t_end - t, t)
             t = t_end
