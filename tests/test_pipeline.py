@@ -41,7 +41,8 @@ WINDOW = (320, 240)
 
 
 def tiny_demo():
-    c = copy.deepcopy(demo_study().config)
+    """The demo blade with the seed paper's Newton contact on its tip node (the demo itself is massless)."""
+    c = copy.deepcopy(demo_study("newton").config)
     c["geometry"].update(size=0.01, tip_size=0.005)
     c["reduction"]["size"] = 6
     c["search"]["scan"] = 4

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
+#: Admissible arcs narrower than this (relative, in frequency) are called narrow in words.
+NARROW_RTOL = 1e-3
+
 
 def report(summary: dict) -> str:
     """A human-readable Markdown report of a run's :data:`summary`."""
@@ -20,7 +23,9 @@ def report(summary: dict) -> str:
              f"{m['clamped_nodes']} clamped nodes.",
              "- Linear frequencies (full FE model, Hz): " + ", ".join(f"{f:.2f}" for f in m["linear_frequencies_hz"]),
              "", "## Contact", "",
-             f"- Node {c['node']} at ({', '.join(f'{x:.5g}' for x in c['position'])}) m, casing normal "
+             (f"- Face of {len(c['face_nodes'])} nodes ({c.get('face_weights', 'equal')} weights; mean normal "
+              f"displacement), centre node {c['node']}" if len(c.get("face_nodes", [])) > 1 else f"- Node {c['node']}")
+             + f" at ({', '.join(f'{x:.5g}' for x in c['position'])}) m, casing normal "
              f"({', '.join(f'{x:.4g}' for x in c['normal'])}), clearance {c['clearance_m'] * 1e3:.4g} mm.",
              "", "## Reduced model", "",
              f"- {r['method']} (size {r['size']}): {r['reduced_dofs']} reduced dofs.", "",
@@ -54,6 +59,12 @@ def report(summary: dict) -> str:
             lines.append(f"| {i} | {f['ipp']} | {f['orbits']} | {f['frequency_range_hz'][0]:.3f} – "
                          f"{f['frequency_range_hz'][1]:.3f} | {a['f_lo']:.4f} – {a['f_hi']:.4f} | "
                          f"{a['energy_range_j'][0]:.3e} – {a['energy_range_j'][1]:.3e} |")
+    widths = [(a["f_hi"] - a["f_lo"]) / a["f_hi"] for _, f in with_arcs for a in f["admissible_arcs"] if a["f_hi"] > 0]
+    if widths and max(widths) < NARROW_RTOL:
+        lines += ["", f"**Narrow:** the widest admissible arc spans {max(widths):.1e} of its frequency — in this model "
+                  "the mode exists only next to where it grows from a linear mode (grazing); beyond, its orbits are "
+                  "not admissible (for the massless model the contact splits into several phases, "
+                  "docs/massless.md). Read its energies as those of a barely touching linear mode."]
     files = summary["files"]
     if summary.get("reference") and not files.get("animations"):
         ref = summary["reference"]
@@ -102,7 +113,7 @@ def _counterpart(mt: dict | None) -> str:
 def _reference_words(check: dict, k: int) -> str:
     where = f"in the reference model {check['reference']}"
     if check["survives"]:
-        return f"Survives {where}: one period later it is back within {check['drift']:.1%} (energy norm)."
+        return f"Survives {where}: one period later it is back within {check['drift']:.2g} (relative, energy norm)."
     return (f"**Does not survive** {where}: after one period it has drifted by {check['drift']:.1%} (energy norm), "
             f"with {check['contacts']} contact(s) for {k} — an artefact of the reduced model, animated only because "
             "it was asked for in [output] orbits.")

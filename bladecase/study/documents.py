@@ -130,5 +130,6 @@ def model_summary(mesh: Mesh, model: FEModel, f_fe: np.ndarray, source: str) -> 
 def contact_summary(contact: Contact, model: FEModel) -> dict:
     """Contact node, its position, the casing normal and the clearance."""
     return {"node": contact.node, "face_nodes": list(contact.nodes),
+            "face_weights": "area" if contact.weights else "equal",
             "position": model.mesh.points[contact.node].tolist(),
             "normal": contact.normal_for(model).tolist(), "clearance_m": contact.gap}
