@@ -73,20 +73,15 @@ def resimulate(system: bc.LinearSystem, orbit: bc.PeriodicOrbit, periods: int):
     return tr, z0, errors
 
 
-def floquet_multipliers(system: bc.LinearSystem, orbit: bc.PeriodicOrbit, eps: float = 1e-6) -> np.ndarray:
-    """Eigenvalues of the one-period flow map, by central differences of :func:`bladecase.simulate`.
-
-    The map starts at mid-flight ``t = T/2`` (away from the obstacle, so every
-    perturbation is admissible) and runs for one period (one impact).
-    """
-    n, T = system.n, orbit.T
-    x, v = orbit.state(T / 2)
-    z = stacked(x, v)
+def fd_flow_map(system: bc.LinearSystem, z: np.ndarray, T: float, impacts: int, eps: float = 1e-6) -> np.ndarray:
+    """Central-difference Jacobian of the time-``T`` map of :func:`bladecase.simulate` at the state ``z = (x, v)``
+    (every perturbed run must make ``impacts`` impacts)."""
+    n = system.n
     h = eps * np.abs(z).max()
 
     def period_map(z):
         tr = bc.simulate(system, z[:n], z[n:], T)
-        assert tr.impact_times.size == 1
+        assert tr.impact_times.size == impacts
         return stacked(tr.x_end, tr.v_end)
 
     J = np.empty((2 * n, 2 * n))
@@ -94,4 +89,14 @@ def floquet_multipliers(system: bc.LinearSystem, orbit: bc.PeriodicOrbit, eps: f
         dz = np.zeros(2 * n)
         dz[i] = h
         J[:, i] = (period_map(z + dz) - period_map(z - dz)) / (2 * h)
-    return np.linalg.eigvals(J)
+    return J
+
+
+def floquet_multipliers(system: bc.LinearSystem, orbit: bc.PeriodicOrbit, eps: float = 1e-6) -> np.ndarray:
+    """Eigenvalues of the one-period flow map, by central differences of :func:`bladecase.simulate`.
+
+    The map starts at mid-flight ``t = T/2`` (away from the obstacle, so every
+    perturbation is admissible) and runs for one period (one impact).
+    """
+    x, v = orbit.state(orbit.T / 2)
+    return np.linalg.eigvals(fd_flow_map(system, stacked(x, v), orbit.T, 1, eps))

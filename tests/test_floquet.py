@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import scipy.linalg as sla
-from _util import dense, stacked
+from _util import dense, fd_flow_map, stacked
 
 import bladecase as bc
 from bladecase.nsm import Branch
@@ -52,22 +52,8 @@ def _state_matrix(system) -> np.ndarray:
 
 def _fd_map(system, orbit, eps: float = 1e-6) -> tuple[np.ndarray, float]:
     """Central-difference Jacobian of ``z(τ₀) ↦ z(τ₀ + T)`` by simulation (module docstring)."""
-    n, T = system.n, orbit.T
     tau0 = 0.5 * float(orbit.impact_times[0])
-    z = stacked(*orbit.state(tau0))
-    h = eps * np.abs(z).max()
-
-    def period_map(z):
-        tr = bc.simulate(system, z[:n], z[n:], T)
-        assert tr.impact_times.size == orbit.k
-        return stacked(tr.x_end, tr.v_end)
-
-    J = np.empty((2 * n, 2 * n))
-    for i in range(2 * n):
-        dz = np.zeros(2 * n)
-        dz[i] = h
-        J[:, i] = (period_map(z + dz) - period_map(z - dz)) / (2 * h)
-    return J, tau0
+    return fd_flow_map(system, stacked(*orbit.state(tau0)), orbit.T, orbit.k, eps), tau0
 
 
 # (system fixture, k, T, t₁ of the 2-ipp orbit, stable?) — admissible orbits, measured verdicts in the comments

@@ -78,15 +78,9 @@ class SymmetricOrbit:
     @cached_property
     def impulses(self) -> np.ndarray:
         """``[∫λ dt]`` over the closed phase (exact: ``λ = k_c (y - d)`` is a trigonometric sum)."""
-        s = self._bound()
-        x1, v1 = self.closing_state()
-        y = s.closed.contact(x1, v1)
-        tau, om = 2 * self.beta, y.omega
-        safe = np.where(om > 0, om, 1.0)
-        integral = (y.const - s.gap) * tau + np.sum(np.where(om > 0, (y.alpha * np.sin(om * tau)
-                                                                      + y.beta * (1 - np.cos(om * tau))) / safe,
-                                                             y.alpha * tau))
-        return np.array([s.kc * float(integral)])
+        from .massless_phases import PhasedOrbit
+
+        return PhasedOrbit(self._bound(), "open", [self.alpha, self.beta], self.a).impulses
 
     @property
     def max_violation(self) -> float:
