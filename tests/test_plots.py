@@ -82,3 +82,22 @@ def test_draws_into_given_axes(two_dof_backbone):
     assert frequency_energy([two_dof_backbone], ax=ax, linear=False) is fig
     assert r"linear frequencies $\omega_j/2\pi$" not in ax.get_legend_handles_labels()[1]
     assert ax.get_yscale() == "log"
+
+
+def test_frequency_energy_readability_options():
+    """Arcs narrower than a pixel become markers; non-admissible dots are optional; linear frequencies labelled."""
+    import numpy as np
+
+    from bladecase.nsm import Arc, Branch, backbone, chain
+    from bladecase.post.plots import frequency_energy
+
+    system = chain(2, k=1.0, m=0.5, gap=1.0)
+    bb = backbone(system, np.linspace(2.0, 8.0, 61))
+    i = int(np.flatnonzero(bb.admissible)[3])
+    narrow = Branch(system, 1, bb.orbits, [Arc(i, i, bb.T[i], bb.T[i] * (1 + 1e-9))], periods=bb.periods)
+    ax = frequency_energy([bb, narrow], nonadmissible=False).axes[0]
+    labels = ax.get_legend_handles_labels()[1]
+    assert "1 ipp (admissible arc narrower than a pixel)" in labels and "non-admissible orbits" not in labels
+    texts = [t.get_text() for t in ax.texts]
+    assert texts == ["1", "2"]  # both linear frequencies (0.139, 0.364) lie in 1/8 … 1/2
+    assert "non-admissible orbits" in frequency_energy([bb]).axes[0].get_legend_handles_labels()[1]

@@ -61,6 +61,7 @@ def frequency_energy(
     time_unit: str | None = None,
     energy_unit: str | None = None,
     stability: bool = False,
+    nonadmissible: bool = True,
 ) -> Figure:
     r"""Energy ``E`` against frequency ``1/T`` for one or several backbones.
 
@@ -87,6 +88,11 @@ def frequency_energy(
     stability : bool
         Style the admissible curves by their Floquet verdict (:meth:`~bladecase.nsm.Branch.stability`):
         solid where linearly stable, dashed where unstable.
+    nonadmissible : bool
+        Draw the non-admissible orbits (faint dots).
+
+    Admissible arcs narrower than a pixel are drawn as a marker at their middle (else they would vanish), and the
+    linear frequencies are labelled with their mode number.
 
     Returns
     -------
@@ -122,8 +128,9 @@ def frequency_energy(
         fmin, fmax = min(fmin, f.min()), max(fmax, f.max())
         ok = np.isfinite(E) & (E > 0)
         bad = ok & ~adm
-        ax.plot(f[bad], E[bad], ".", ms=2, color=c, alpha=0.2,
-                label=_once(labelled, "non-admissible orbits", bad.any()))
+        if nonadmissible:
+            ax.plot(f[bad], E[bad], ".", ms=2, color=c, alpha=0.2,
+                    label=_once(labelled, "non-admissible orbits", bad.any()))
         if stability:
             _stability_curves(ax, bb, f, E, adm, c, labelled)
         else:
@@ -134,11 +141,14 @@ def frequency_energy(
                 if refined:
                     ax.axvline(1 / T, color=c, lw=0.5, ls=":", alpha=0.6,
                                label=_once(labelled, "ends of admissible arcs"))
+    _narrow_arcs(ax, backbones, fmin, fmax, labelled)
     if linear and backbones:
         lf = backbones[0].linear_frequencies
-        for fj in lf[(lf >= fmin) & (lf <= fmax)]:
+        for j in np.flatnonzero((lf >= fmin) & (lf <= fmax)):
             label = _once(labelled, r"linear frequencies $\omega_j/2\pi$")
-            ax.axvline(fj, color="k", ls="--", lw=0.8, label=label)
+            ax.axvline(lf[j], color="k", ls="--", lw=0.8, label=label)
+            ax.annotate(f"{j + 1}", (lf[j], 1.0), xycoords=("data", "axes fraction"), xytext=(2, -10),
+                        textcoords="offset points", fontsize="small")
     ax.set_yscale("log")
     # Non-admissible energies diverge at resonances: frame the admissible curves.
     adm_E = np.concatenate([bb.energy[bb.admissible] for bb in backbones]) if backbones else np.array([])
@@ -152,6 +162,21 @@ def frequency_energy(
     if ax.get_legend_handles_labels()[0]:
         ax.legend(loc="best", fontsize="small", markerscale=3)
     return fig
+
+
+def _narrow_arcs(ax, backbones, fmin: float, fmax: float, labelled: set) -> None:
+    """A marker at the middle of every admissible arc narrower than a pixel (a curve that thin is invisible)."""
+    width_px = ax.get_position().width * ax.figure.get_figwidth() * ax.figure.dpi
+    span = max(fmax - fmin, np.finfo(float).tiny)
+    for bb in backbones:
+        c = COLORS[(bb.ipp - 1) % len(COLORS)]
+        f, E = bb.frequencies, bb.energy
+        for arc in bb.arcs:
+            if (1 / arc.T_lo - 1 / arc.T_hi) / span * width_px >= 1:
+                continue
+            i = (arc.start + arc.stop) // 2
+            ax.plot([f[i]], [E[i]], "o", ms=5, mfc="none", color=c,
+                    label=_once(labelled, f"{bb.ipp} ipp (admissible arc narrower than a pixel)"))
 
 
 def _stability_curves(ax, bb, f, E, adm, c, labelled: set) -> None:
