@@ -25,7 +25,9 @@ def test_grid_expands_to_every_model(result):
     assert names == ["modal-10", "modal-6", "modal-12", "craig-bampton-6", "craig-bampton-12", "lanczos-si-6",
                      "lanczos-si-12"]
     for m in result.models.values():
-        assert m.build_s >= 0 and m.search_s >= 0 and m.reduced.n >= 6
+        assert m.build_s >= 0 and m.search_s >= 0 and m.reduced.n >= 6 and m.reduced.model is result.fe_model
+    table = result.comparison  # a dict of columns for a notebook (no pandas needed)
+    assert table["model"] == ["FE", *names] and len(table["impact_mass"]) == len(names) + 1
     doc = json.loads((result.directory / "modes.json").read_text())
     assert [c["model"] for c in doc["compare"]] == names[1:]  # every model's families are kept
 

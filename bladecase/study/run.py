@@ -44,6 +44,21 @@ class RunResult:
     #: :class:`~bladecase.post.compare.ModelResult` with the reduced model, its families and timings.
     models: dict = field(repr=False, default_factory=dict)
 
+    @property
+    def fe_model(self):
+        """The FE model every reduced model came from (``None`` for a result without models)."""
+        return next((m.reduced.model for m in self.models.values()), None)
+
+    @property
+    def comparison(self) -> dict | None:
+        """The comparison table as a dict of columns (column name → list, one entry per row: the FE model, then
+        every model), or ``None`` when the run compared nothing."""
+        section = self.summary.get("comparison")
+        if not section:
+            return None
+        rows = section["rows"]
+        return {key: [r.get(key) for r in rows] for key in rows[0]}
+
 
 class _Stages:
     """Times each stage and advances the run's progress bar."""
