@@ -86,8 +86,12 @@ def test_massless_study_animates_orbits_that_survive_in_the_reference(tmp_path):
         assert 0 < a["contact_time"] < a["T"]
         assert a["contact_intervals"] == [[0.0, a["contact_time"]]]
         assert a["modal_energy"]["top_modes"][0]["mode"] == 1  # near grazing the first mode holds the energy
+        assert a["stability"].startswith(("linearly stable", "unstable"))  # the Floquet verdict in words
+    fractions = [arc["stable_fraction"] for f in result.summary["families"] for arc in f["admissible_arcs"]]
+    assert fractions and all(x is None or 0.0 <= x <= 1.0 for x in fractions)
     report = (result.directory / "report.md").read_text()
     assert "in contact for t/T in [0.0000, " in report and "Energy: " in report and "Doubtful" not in report
+    assert "Stability (Floquet multipliers" in report and "linearly stable (Floquet)" in report
 
 
 def test_massless_study_keys_go_together():

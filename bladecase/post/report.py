@@ -52,13 +52,15 @@ def report(summary: dict) -> str:
     with_arcs = [(i, f) for i, f in enumerate(fams) if f["admissible_arcs"]]
     lines.append(f"{len(fams)} families found, {len(with_arcs)} with admissible arcs "
                  f"(families without any are listed in `summary.json`).")
-    lines += ["", "| family | ipp | orbits | f range (Hz) | admissible arc f (Hz) | energy on arc (J) |",
-              "|---:|---:|---:|---|---|---|"]
+    lines += ["", "| family | ipp | orbits | f range (Hz) | admissible arc f (Hz) | energy on arc (J) | "
+              "linearly stable (Floquet) |", "|---:|---:|---:|---|---|---|---|"]
     for i, f in with_arcs:
         for a in f["admissible_arcs"]:
+            stable = a.get("stable_fraction")
             lines.append(f"| {i} | {f['ipp']} | {f['orbits']} | {f['frequency_range_hz'][0]:.3f} – "
                          f"{f['frequency_range_hz'][1]:.3f} | {a['f_lo']:.4f} – {a['f_hi']:.4f} | "
-                         f"{a['energy_range_j'][0]:.3e} – {a['energy_range_j'][1]:.3e} |")
+                         f"{a['energy_range_j'][0]:.3e} – {a['energy_range_j'][1]:.3e} | "
+                         f"{'—' if stable is None else f'{stable:.0%} of its orbits'} |")
     widths = [(a["f_hi"] - a["f_lo"]) / a["f_hi"] for _, f in with_arcs for a in f["admissible_arcs"] if a["f_hi"] > 0]
     if widths and max(widths) < NARROW_RTOL:
         lines += ["", f"**Narrow:** the widest admissible arc spans {max(widths):.1e} of its frequency — in this model "
@@ -92,6 +94,8 @@ def report(summary: dict) -> str:
             lines.append(f"  - {_reference_words(a['reference_check'], a['ipp'])}")
         if "energy_words" in a:
             lines.append(f"  - {a['energy_words']}")
+        if "stability" in a:
+            lines.append(f"  - Stability (Floquet multipliers with saltation matrices): {a['stability']}.")
         if "gif" in a:
             lines.append(f"\n  ![{a['gif']}]({a['gif']})\n")
     lines += ["", "Timings (s): " + ", ".join(f"{k} {v:.2f}" for k, v in summary["timings_s"].items()), ""]

@@ -84,9 +84,30 @@ def family_summary(fam: Branch) -> dict:
         "admissible_arcs": [
             {"T_lo": a.T_lo, "T_hi": a.T_hi, "f_lo": 1 / a.T_hi, "f_hi": 1 / a.T_lo,
              "energy_range_j": _range(E[a.start:a.stop + 1][fam.admissible[a.start:a.stop + 1]]),
-             "refined_lo": bool(a.refined_lo), "refined_hi": bool(a.refined_hi)} for a in fam.arcs
+             "refined_lo": bool(a.refined_lo), "refined_hi": bool(a.refined_hi),
+             "stable_fraction": _stable_fraction(fam.orbits[a.start:a.stop + 1])} for a in fam.arcs
         ],
     }
+
+
+#: Most orbits of an arc whose Floquet multipliers are computed for the summary (evenly sampled beyond).
+STABILITY_SAMPLES = 50
+
+
+def _stable_fraction(orbits: list) -> float | None:
+    """Share of the arc's admissible orbits that are linearly stable (Floquet), ``None`` when none has a verdict."""
+    from ..nsm.floquet import floquet
+
+    pool = [o for o in orbits if o is not None and o.admissible]
+    if len(pool) > STABILITY_SAMPLES:
+        pool = [pool[i] for i in np.linspace(0, len(pool) - 1, STABILITY_SAMPLES).astype(int)]
+    verdicts = []
+    for o in pool:
+        try:
+            verdicts.append(floquet(o).stable)
+        except ValueError:  # grazing impact or no verdict: left out
+            continue
+    return float(np.mean(verdicts)) if verdicts else None
 
 
 def reduced_summary(reduced: ReducedModel, reference_hz: np.ndarray, fe=None) -> dict:

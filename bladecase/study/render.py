@@ -12,6 +12,7 @@ import numpy as np
 from .. import log
 from ..nsm import Branch
 from ..nsm.energy import describe_split, modal_energy_split
+from ..nsm.floquet import floquet
 from ..nsm.verify import verify
 from ..post.grid import fe_grid, grid_index, nodal_field
 from ..post.outputs import FORMATS, OrbitScene
@@ -66,6 +67,10 @@ def render(study: Study, reduced: ReducedModel, families: list[Branch], choice: 
         entry["reference_check"] = check_in_reference(orbit, reduced, reference)
         log_check(entry["reference_check"], orbit.k, orbit.T)
     entry.update(_energy_split(orbit, reference))
+    try:
+        entry["stability"] = floquet(orbit).verdict
+    except ValueError as exc:  # e.g. a grazing impact: no verdict, said so
+        entry["stability"] = f"no verdict ({exc})"
     if not check["ok"]:
         log.warning("orbit T = %.8g s failed the independent check (simulation from its post-impact state: "
                     "return error %.2e, %d impacts for %d): animated anyway, flagged in summary.json", orbit.T,
