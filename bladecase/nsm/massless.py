@@ -157,6 +157,34 @@ class MasslessSystem:
         return f"MasslessSystem(n={self.n}, gap={self.gap:g}, kc={self.kc:.4g})"
 
 
+class BoundOrbit:
+    """What the massless orbit records share: they pickle without their system (``system`` and cached values
+    dropped; :meth:`bind` re-attaches one)."""
+
+    def __getstate__(self) -> dict:
+        import dataclasses
+
+        state = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        state["system"] = None
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+
+    def _bound(self) -> MasslessSystem:
+        if self.system is None:
+            raise ValueError("this orbit is not bound to a system (it was unpickled): call orbit.bind(system)")
+        return self.system
+
+    def bind(self, system: MasslessSystem):
+        """This orbit attached to ``system`` (a copy)."""
+        import dataclasses
+
+        if not isinstance(system, MasslessSystem):
+            raise ValueError(f"bind needs a MasslessSystem, got {type(system).__name__}")
+        return dataclasses.replace(self, system=system)
+
+
 def condense(M, K, w, gap: float) -> MasslessSystem:
     """The massless model of a full system ``(M, K, w, d)`` whose mass is zero on the contact dofs.
 

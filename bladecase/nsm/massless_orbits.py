@@ -22,7 +22,7 @@ from functools import cached_property
 import numpy as np
 import scipy.linalg as sla
 
-from .massless import MasslessSystem
+from .massless import BoundOrbit, MasslessSystem
 from .signals import TrigSum, certified_max
 
 #: Relative tolerance (of the clearance) of the admissibility proofs.
@@ -30,7 +30,7 @@ ADMISSIBILITY_RTOL = 1e-9
 
 
 @dataclass(frozen=True, eq=False)
-class SymmetricOrbit:
+class SymmetricOrbit(BoundOrbit):
     """A symmetric periodic orbit with one contact phase: open ``2α``, closed ``2β``, mid-open state ``(Φ_o a, 0)``.
 
     Time origin: the contact closes at ``t = 0`` (``≡ T``) and opens at ``t = 2β``. The record reads like a
@@ -51,24 +51,6 @@ class SymmetricOrbit:
     multipliers = None
     contact_model = "massless"
 
-    def __getstate__(self) -> dict:
-        state = dict(self.__dict__)
-        state["system"] = None
-        return state
-
-    def __setstate__(self, state: dict) -> None:
-        self.__dict__.update(state)
-
-    def _bound(self) -> MasslessSystem:
-        if self.system is None:
-            raise ValueError("this orbit is not bound to a system (it was unpickled): call orbit.bind(system)")
-        return self.system
-
-    def bind(self, system: MasslessSystem) -> SymmetricOrbit:
-        """This orbit attached to ``system`` (a copy)."""
-        if not isinstance(system, MasslessSystem):
-            raise ValueError(f"bind needs a MasslessSystem, got {type(system).__name__}")
-        return SymmetricOrbit(system, self.alpha, self.beta, self.a)
 
     @property
     def impact_times(self) -> np.ndarray:

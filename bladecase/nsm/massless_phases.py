@@ -34,7 +34,7 @@ from functools import cached_property
 import numpy as np
 import scipy.linalg as sla
 
-from .massless import MasslessSystem, Phase
+from .massless import BoundOrbit, MasslessSystem, Phase
 from .signals import TrigSum, certified_max
 
 __all__ = ["PHASES", "PhasedOrbit", "solve_half", "split_at", "violation"]
@@ -138,7 +138,7 @@ def _integral(y: TrigSum, tau: float, d: float) -> float:
 
 
 @dataclass(frozen=True, eq=False)
-class PhasedOrbit:
+class PhasedOrbit(BoundOrbit):
     """A symmetric periodic orbit of the massless model with ``m = len(durations) - 1`` contact phases.
 
     Time origin: the middle of phase 0 (``v = 0``); the orbit is even in time about ``t = 0`` and ``t = T/2``.
@@ -163,26 +163,6 @@ class PhasedOrbit:
         if self.durations.size < 2:
             raise ValueError(f"a phased orbit needs at least 2 half-phase durations, got {self.durations.size}")
 
-    def __getstate__(self) -> dict:
-        state = dict(self.__dict__)
-        state["system"] = None
-        for key in [k for k in state if k not in ("first", "durations", "a", "system")]:
-            del state[key]  # cached values are recomputed after bind
-        return state
-
-    def __setstate__(self, state: dict) -> None:
-        self.__dict__.update(state)
-
-    def _bound(self) -> MasslessSystem:
-        if self.system is None:
-            raise ValueError("this orbit is not bound to a system (it was unpickled): call orbit.bind(system)")
-        return self.system
-
-    def bind(self, system: MasslessSystem) -> PhasedOrbit:
-        """This orbit attached to ``system`` (a copy)."""
-        if not isinstance(system, MasslessSystem):
-            raise ValueError(f"bind needs a MasslessSystem, got {type(system).__name__}")
-        return PhasedOrbit(system, self.first, self.durations, self.a)
 
     # -- shape of the orbit -----------------------------------------------------------------------------------
 
