@@ -11,7 +11,11 @@ a piecewise-linear contact model (switching instants and period) plug in the sam
 * :func:`follow` — points from ``z₀`` in one direction, adaptive step, until ``stop`` says so, the curve
   closes, or the corrector fails at the smallest step;
 * :func:`trace` — both directions, joined into one polyline;
-* :func:`bisect` — the point where a predicate on the curve (e.g. admissibility) changes, between two points.
+* :func:`bisect` — the point where a predicate on the curve (e.g. admissibility) changes, between two points;
+* :class:`BatchCurve`, :class:`Followers`, :func:`follow_stack`, :func:`trace_stack` — the same algorithm on many
+  curves at once (curves that evaluate many points in one call): every member makes one attempt per step, the
+  residuals, exact Jacobians and least-squares steps of all of them computed together (:func:`lstsq_stack`,
+  :func:`pinv_stack`, :func:`tangent_stack`, :func:`correct_stack`).
 
 >>> import numpy as np
 >>> circle = Curve(residual=lambda z: np.array([z @ z - 1.0]), jacobian=lambda z: 2 * z[None, :])
@@ -32,6 +36,10 @@ from dataclasses import dataclass
 import numpy as np
 
 Vector = np.ndarray
+
+#: numpy's own least-squares driver (the LAPACK call of ``np.linalg.lstsq``), vectorised over a stack; private,
+#: hence looked up defensively (:func:`lstsq_stack` falls back to one ``np.linalg.lstsq`` per matrix).
+_LSTSQ = getattr(getattr(np.linalg, "_umath_linalg", None), "lstsq", None)
 
 
 def _always(z) -> bool:
@@ -186,3 +194,259 @@ def bisect(curve: Curve, z_in: Vector, z_out: Vector, inside: Callable[[Vector],
         else:
             z_out = zm
     return z_in, z_out, converged(z_in, z_out)
+
+
+# -- many curves at once ------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class BatchCurve:
+    """Many curves of one kind, evaluated together: the same algorithm as :func:`follow` on each, with the
+    numerical work of all of them done in one vectorised call per iteration.
+
+    Member ``i`` of a batch is curve ``idx[i]`` (e.g. the family it belongs to); every callable gets the
+    points stacked as rows and the ``idx`` of each row.
+
+    Attributes
+    ----------
+    evaluate : callable ``(Z, idx, jacobian: bool) -> (R, J or None)``
+        Residuals ``(B, m)`` and, when asked, exact Jacobians ``(B, m, n)``; non-finite residuals mark
+        points where the residual is undefined.
+    valid : callable ``(Z, idx) -> (B,) bool``
+    crossing : callable ``(Z_a, Z_b, idx) -> (B,) bool``
+    tol, step_tol : float
+        As in :class:`Curve`.
+    """
+
+    evaluate: Callable[[np.ndarray, np.ndarray, bool], tuple[np.ndarray, np.ndarray | None]]
+    valid: Callable[[np.ndarray, np.ndarray], np.ndarray]
+    crossing: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+    tol: float = 1e-10
+    step_tol: float = 1e-11
+
+    @classmethod
+    def of(cls, curves: list[Curve]) -> BatchCurve:
+        """A batch of scalar :class:`Curve` s (member ``idx`` is ``curves[idx]``), evaluated one by one."""
+        c0 = curves[0]
+
+        def evaluate(Z, idx, jacobian):
+            R = np.array([curves[i].residual(z) for z, i in zip(Z, idx)])
+            return R, (np.array([curves[i].jacobian(z) for z, i in zip(Z, idx)]) if jacobian else None)
+
+        return cls(evaluate, lambda Z, idx: np.array([curves[i].valid(z) for z, i in zip(Z, idx)], dtype=bool),
+                   lambda A, B, idx: np.array([curves[i].crossing(a, b) for a, b, i in zip(A, B, idx)], dtype=bool),
+                   c0.tol, c0.step_tol)
+
+
+def lstsq_stack(A: np.ndarray, b: np.ndarray, rcond: float | None = None) -> np.ndarray:
+    """``np.linalg.lstsq(A[i], b[i], rcond)[0]`` for every ``i`` of the float stacks ``A`` ``(B, M, N)``, ``b``
+    ``(B, M)``: one call of numpy's own LAPACK driver over the whole stack when numpy exposes it (the same
+    results), else one call per matrix.  Rows that LAPACK cannot solve (non-finite input) come back NaN.
+
+    >>> A = np.array([[[1.0, 0.0], [0.0, 2.0], [0.0, 0.0]]] * 2)
+    >>> lstsq_stack(A, np.array([[1.0, 2.0, 3.0], [2.0, 4.0, 0.0]])).tolist()
+    [[1.0, 1.0], [2.0, 2.0]]
+    """
+    count, M, N = A.shape
+    rcond = np.finfo(float).eps * max(M, N) if rcond is None else rcond
+    if _LSTSQ is not None and count:
+        try:
+            with np.errstate(all="ignore"):
+                return _LSTSQ(A, b[..., None], rcond, signature="ddd->ddid")[0][..., 0]
+        except (TypeError, ValueError):
+            pass  # another numpy's private signature: one call per matrix
+    out = np.full((count, N), np.nan)
+    for i in range(count):
+        if np.all(np.isfinite(A[i])) and np.all(np.isfinite(b[i])):
+            out[i] = np.linalg.lstsq(A[i], b[i], rcond=rcond)[0]
+    return out
+
+
+def tangent_stack(J: np.ndarray, previous: np.ndarray | None = None) -> np.ndarray:
+    """:func:`tangent` of each matrix of the stack ``J`` ``(B, m, n)``, oriented along ``previous[i]``."""
+    t = np.linalg.svd(J)[2][:, -1, :]
+    if previous is not None:
+        t = np.where(np.einsum("ij,ij->i", t, previous)[:, None] < 0, -t, t)
+    return t
+
+
+def pinv_stack(A: np.ndarray) -> np.ndarray:
+    """Pseudo-inverses of the stack ``A`` ``(B, M, N)`` with the rank cut-off of :func:`lstsq_stack` (singular
+    values at most ``ε·max(M, N)`` times the largest count as zero): ``pinv_stack(A)[i] @ b`` is
+    ``lstsq_stack(A, b)[i]`` up to round-off.
+
+    >>> A = np.array([[[1.0, 0.0], [0.0, 2.0], [0.0, 0.0]]])
+    >>> (pinv_stack(A)[0] @ np.array([1.0, 2.0, 3.0])).tolist()
+    [1.0, 1.0]
+    """
+    U, sv, Vt = np.linalg.svd(A, full_matrices=False)
+    cut = np.finfo(float).eps * max(A.shape[1:]) * sv[:, :1]
+    inv = np.divide(1.0, sv, out=np.zeros_like(sv), where=sv > cut)
+    return np.swapaxes(Vt, 1, 2) @ (inv[:, :, None] * np.swapaxes(U, 1, 2))
+
+
+def correct_stack(curve: BatchCurve, ZP: np.ndarray, D: np.ndarray, idx: np.ndarray, J: np.ndarray | None = None,
+                  maxiter: int = 10) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`correct` of every row of ``ZP`` (directions ``D``, chord Jacobians ``J`` or ``None`` for full
+    Newton) at once.  Returns ``(Z, converged, iterations)``; rows that did not converge are left at ``ZP``
+    with ``converged`` false.  The chord method's least-squares step uses the pseudo-inverse of its fixed
+    matrix, computed once."""
+    count = len(ZP)
+    out, ok, iters = ZP.copy(), np.zeros(count, dtype=bool), np.full(count, maxiter)
+    rows, Z, zp, d, ix = np.arange(count), ZP.copy(), ZP, D, idx
+    P = None if J is None else pinv_stack(np.concatenate([J, D[:, None, :]], axis=1))
+    checking = np.zeros(count, dtype=bool)
+    for it in range(maxiter + 1):
+        R, Jz = curve.evaluate(Z, ix, P is None and it < maxiter)
+        keep = ~checking
+        if checking.any():  # moved less than step_tol at the last iteration: the residual test
+            done = rows[checking]
+            ok[done] = np.abs(R[checking]).max(axis=1) < curve.tol
+            iters[done] = it
+            out[done] = Z[checking]
+        r = np.concatenate([R, np.einsum("ij,ij->i", d, Z - zp)[:, None]], axis=1)
+        keep &= np.isfinite(r).all(axis=1)  # undefined residual: no solution along this direction
+        iters[rows[~(keep | checking)]] = it
+        if it == maxiter or not keep.any():
+            break
+        if not keep.all():
+            rows, Z, zp, d, ix, r = rows[keep], Z[keep], zp[keep], d[keep], ix[keep], r[keep]
+            P = None if P is None else P[keep]
+            Jz = None if Jz is None else Jz[keep]
+        if P is not None:
+            dz = -(P @ r[:, :, None])[:, :, 0]
+        else:
+            dz = lstsq_stack(np.concatenate([Jz, d[:, None, :]], axis=1), -r)
+        Z = Z + dz
+        checking = np.abs(dz).max(axis=1) < curve.step_tol
+        checking[~np.isfinite(dz).all(axis=1)] = False  # a failed solve: maxiter iterations, no convergence
+    return out, ok, iters
+
+
+class Followers:
+    """:func:`follow` on many curves at once, members joining and leaving between steps.
+
+    Each member (a start point and a direction on curve ``idx``) runs the algorithm of :func:`follow` — the
+    same predictor, corrector, acceptance and step control; its points do not depend on the other members.
+    One :meth:`step` makes one attempt (predictor + corrector, then acceptance) for every running member,
+    with the numerical work of all of them done together.
+
+    >>> circles = BatchCurve.of([Curve(residual=lambda z, r=r: np.array([z @ z - r * r]),
+    ...                                jacobian=lambda z: 2 * z[None, :]) for r in (1.0, 2.0)])
+    >>> run = Followers(circles, ds=0.1, max_points=10)
+    >>> ids = run.add(np.array([[1.0, 0.0], [2.0, 0.0]]), np.array([[0.0, 1.0], [0.0, 1.0]]), np.array([0, 1]))
+    >>> while run.running.size:
+    ...     run.step()
+    >>> [len(p) for p in run.points], [round(float(np.hypot(*p[-1])), 12) for p in run.points]
+    ([10, 10], [1.0, 2.0])
+    """
+
+    def __init__(self, curve: BatchCurve, *, ds: float, ds_min: float | None = None, ds_max: float | None = None,
+                 max_points: int = 400, stop: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None,
+                 max_offset: float = 0.3):
+        self.curve, self.ds, self.max_points = curve, float(ds), max_points
+        self.stop, self.max_offset = stop, max_offset
+        self.ds_min = ds / 1000 if ds_min is None else ds_min
+        self.ds_max = 2 * ds if ds_max is None else ds_max
+        self.points: list[list[Vector]] = []
+        self._state: dict[str, np.ndarray] = {}
+
+    def __len__(self) -> int:
+        return len(self.points)
+
+    @property
+    def running(self) -> np.ndarray:
+        """Ids of the members still being followed."""
+        return np.flatnonzero(self._state["live"]) if self._state else np.zeros(0, dtype=int)
+
+    def add(self, Z0: np.ndarray, directions: np.ndarray, idx: np.ndarray) -> np.ndarray:
+        """New members from the rows of ``Z0`` along ``directions`` (curve ``idx`` each); their ids."""
+        Z0 = np.asarray(Z0, dtype=float)
+        count = len(Z0)
+        if count == 0:
+            return np.zeros(0, dtype=int)
+        J = self.curve.evaluate(Z0, idx, True)[1]
+        new = {"Z0": Z0, "Z": Z0.copy(), "tan": tangent_stack(J, directions), "J": J, "idx": np.asarray(idx),
+               "travelled": np.zeros(count), "h": np.full(count, self.ds), "step": np.full(count, self.ds),
+               "live": np.ones(count, dtype=bool)}
+        first = len(self.points)
+        self._state = new if not self._state else {k: np.concatenate([self._state[k], v]) for k, v in new.items()}
+        self.points.extend([] for _ in range(count))
+        return np.arange(first, first + count)
+
+    def add_traces(self, Z0: np.ndarray, orientation: np.ndarray, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Members for :func:`trace` through each row of ``Z0``: ids of the forward and of the backward ones."""
+        Z0 = np.asarray(Z0, dtype=float)
+        if len(Z0) == 0:
+            return np.zeros(0, dtype=int), np.zeros(0, dtype=int)
+        t0 = tangent_stack(self.curve.evaluate(Z0, idx, True)[1], np.broadcast_to(orientation, Z0.shape))
+        ids = self.add(np.concatenate([Z0, Z0]), np.concatenate([t0, -t0]), np.concatenate([idx, idx]))
+        return ids[: len(Z0)], ids[len(Z0):]
+
+    def cancel(self, ids) -> None:
+        """Stop following these members."""
+        if self._state:
+            self._state["live"][np.asarray(ids, dtype=int)] = False
+
+    def step(self) -> None:
+        """One attempt of every running member: a point accepted, or the step halved."""
+        st, curve = self._state, self.curve
+        rows = self.running
+        if rows.size == 0:
+            return
+        Z, tan, step, idx = st["Z"], st["tan"], st["step"], st["idx"]
+        ZP = Z[rows] + step[rows, None] * tan[rows]
+        ZC, ok, iters = correct_stack(curve, ZP, tan[rows], idx[rows], st["J"][rows])
+        retry = np.flatnonzero(~ok)  # chord method failed: full Newton
+        if retry.size:
+            ZC[retry], ok[retry], iters[retry] = correct_stack(curve, ZP[retry], tan[rows[retry]], idx[rows[retry]])
+        good = ok.copy()
+        if good.any():
+            good[good] = curve.valid(ZC[good], idx[rows[good]])
+        with np.errstate(invalid="ignore"):
+            good &= np.linalg.norm(ZC - ZP, axis=1) < self.max_offset * step[rows]
+        if good.any():
+            good[good] = ~curve.crossing(Z[rows[good]], ZC[good], idx[rows[good]])
+        bad = rows[~good]
+        step[bad] /= 2
+        st["live"][bad[step[bad] < self.ds_min]] = False
+        acc, ZC, iters = rows[good], ZC[good], iters[good]
+        if acc.size == 0:
+            return
+        st["travelled"][acc] += np.linalg.norm(ZC - Z[acc], axis=1)
+        st["J"][acc] = curve.evaluate(ZC, idx[acc], True)[1]
+        tan[acc] = tangent_stack(st["J"][acc], tan[acc])
+        Z[acc] = ZC
+        for i, z in zip(acc, ZC):
+            self.points[i].append(z.copy())
+        closed = (st["travelled"][acc] > 4 * self.ds_max) & (np.linalg.norm(ZC - st["Z0"][acc], axis=1) < step[acc])
+        factor = np.where(iters <= 6, 1.5, np.where(iters >= 9, 0.7, 1.0))
+        st["h"][acc] = np.minimum(self.ds_max, step[acc] * factor)
+        ended = closed | (np.array([len(self.points[i]) for i in acc]) >= self.max_points)
+        if self.stop is not None:
+            ended |= self.stop(ZC, idx[acc])
+        st["live"][acc[ended]] = False
+        step[acc] = st["h"][acc]
+
+
+def follow_stack(curve: BatchCurve, Z0: np.ndarray, directions: np.ndarray, idx: np.ndarray, **options
+                 ) -> list[list[Vector]]:
+    """:func:`follow` from every row of ``Z0`` along ``directions`` at once (:class:`Followers`; ``stop(Z, idx)``
+    vectorised): one list of points per row."""
+    run = Followers(curve, **options)
+    run.add(Z0, directions, idx)
+    while run.running.size:
+        run.step()
+    return run.points
+
+
+def trace_stack(curve: BatchCurve, Z0: np.ndarray, orientation: np.ndarray, idx: np.ndarray,
+                **options) -> list[tuple[list[Vector], int]]:
+    """:func:`trace` through every row of ``Z0`` (forwards along ``orientation``, one vector for all) at once;
+    ``options`` go to :class:`Followers`."""
+    run = Followers(curve, **options)
+    fwd, bwd = run.add_traces(Z0, orientation, idx)
+    while run.running.size:
+        run.step()
+    return [(run.points[b][::-1] + [np.asarray(Z0[i], dtype=float)] + run.points[f], len(run.points[b]))
+            for i, (f, b) in enumerate(zip(fwd, bwd))]

@@ -5,19 +5,23 @@ A k-ipp orbit is a zero of ``[ΠΛ ; ΣΛ - d·1]`` (theory §4): ``2k`` equatio
 modes.  :class:`KippCurve` eliminates the impulses (``Λ = d Σ⁻¹ 1``) and gives the remaining impact-law
 condition ``Π n``, ``n = Σ⁻¹1/|Σ⁻¹1|``, with its exact Jacobian (derivatives of the modal kernel in the impact
 times and in ``T``, :meth:`bladecase.nsm.modal.ModalKernel.dT`); :mod:`bladecase.nsm.continuation` follows it.
-:func:`follow_family` returns the family's certified orbits and its admissible arcs, whose ends are refined by
-bisection along the curve.
+:class:`KippCurves` evaluates many such curves at once, so that :class:`FamilyTracer` and :func:`trace_families`
+follow many families together (the same algorithm on each, its numerical work vectorised over the families).
+:func:`follow_family` and :func:`complete_families` give the families' certified orbits
+(:func:`polished_orbits`: the fixed-period Newton polish vectorised) and admissible arcs, whose ends are refined
+by bisection along the curve.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from . import continuation
-from .modal import ModalKernel, check_period, solve_times
-from .orbits import REPEAT_RTOL, PeriodicOrbit, make_orbit
+from .modal import ModalKernel, check_period, impact_kernels, solve_stack, solve_times, solve_times_stack
+from .orbits import PeriodicOrbit, make_orbit
 from .system import LinearSystem
 
 #: Relative precision in ``T`` of the refined ends of admissible arcs.
@@ -27,10 +31,135 @@ ARC_RTOL = 1e-9
 #: (it then tends to an orbit with fewer impacts).
 MERGE_RTOL = 1e-4
 
-#: A start orbit is only re-solved from a crossing segment of a followed curve
-#: when the interpolated impact times lie within ``PASS_GATE·T`` of its own
-#: (under every re-anchoring); farther crossings are other orbits of that period.
-PASS_GATE = 0.05
+
+class KippCurves:
+    """Many k-ipp curves of one system, evaluated together: member ``i`` is the curve of
+    :class:`KippCurve` with scales ``T0[i]``, ``lam0[i]`` (rows of a stack carry their member index).
+    For k = 2 the residual and its Jacobian are in closed form (``Σ⁻¹1 ∝ (1, 1)``).
+
+    >>> from bladecase.nsm import chain, orbits_kipp
+    >>> system = chain(2, k=1.0, m=0.5, gap=1.0)
+    >>> o = orbits_kipp(system, 13.5, 2)[1]
+    >>> curves = KippCurves(system, 2, [13.5, 13.5], [1.0, 1.0])
+    >>> R, J = curves.evaluate(np.array([o.impact_times / 13.5, [0.3, 1.0]]), np.array([0, 1]), jacobian=True)
+    >>> bool(np.abs(R[0]).max() < 1e-12), bool(np.abs(R[1]).max() > 1e-3), J.shape
+    (True, True, (2, 2, 2))
+    """
+
+    def __init__(self, system: LinearSystem, k: int, T0, lam0):
+        self.system, self.k, self.d = system, k, system.gap
+        self.T0, self.lam0 = np.atleast_1d(np.asarray(T0, dtype=float)), np.atleast_1d(np.asarray(lam0, dtype=float))
+        self.omega, self.b, _ = system.spectrum.contact_modes
+        self.scale = float(self.b @ self.b) / 2
+
+    def extend(self, T0, lam0) -> np.ndarray:
+        """Add members (scales ``T0``, ``lam0``); their indices."""
+        first = self.T0.size
+        self.T0 = np.concatenate([self.T0, np.asarray(T0, dtype=float)])
+        self.lam0 = np.concatenate([self.lam0, np.asarray(lam0, dtype=float)])
+        return np.arange(first, self.T0.size)
+
+    def times(self, Z, idx) -> np.ndarray:
+        """Impact times ``(t₁, …, t_k = T)`` of the rows of ``Z``."""
+        return Z * self.T0[idx][:, None]
+
+    def _pair(self, Z, idx, sines: bool = True):
+        """k = 2: ``(T0, T, D, c, sin, cos of ωT/2, cos, sin of ω(D - T/2))`` at the one delay
+        ``D = (t₁ - T) mod T`` (``Σ = -[[g(0), g(D)], [g(D), g(0)]]``, ``Π = [[0, s(D)], [-s(D), 0]]``)."""
+        T0 = self.T0[idx]
+        T = Z[:, 1] * T0
+        D = np.mod(Z[:, 0] * T0 - T, T)
+        half = np.multiply.outer(T / 2, self.omega)
+        sh = np.sin(half)
+        ph = np.multiply.outer(D - T / 2, self.omega)
+        return T0, T, D, self.b**2 / (2 * sh), sh, np.cos(half), np.cos(ph), (np.sin(ph) if sines else None)
+
+    def _evaluate2(self, Z, idx, jacobian: bool):
+        """:meth:`evaluate` for k = 2 in closed form: ``n = Σ⁻¹1 ∝ (1, 1)``, so ``R = ∓s(D) (1, -1)/(√2 S)``."""
+        T0, _, _, c, sh, ch, cp, sp = self._pair(Z, idx)
+        w = c / self.omega
+        sigma = np.einsum("bm,bm->b", ch + cp, w)  # g(0) + g(D): Σ is singular where it vanishes
+        s_d = -np.einsum("bm,bm->b", sp, c)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            f = np.where(sigma == 0, np.nan, -np.sign(sigma)) / (np.sqrt(2) * self.scale)  # u = -sign(σ)(1, 1)/√2
+        R = np.stack([f * s_d, -f * s_d], axis=1)
+        if not jacobian:
+            return R, None
+        cw = c * self.omega
+        ds = -np.einsum("bm,bm->b", cp, cw)  # s'(D)
+        b1, b2 = -ds / 2, np.einsum("bm,bm->b", sp, cw * ch / sh) / 2  # ∂s/∂T at D and T - D: b1 ± b2
+        g = f * T0
+        J = np.stack([np.stack([g * ds, g * (b1 + b2)], axis=1), np.stack([-g * ds, g * (ds + b1 - b2)], axis=1)],
+                     axis=1)
+        return R, J
+
+    def evaluate(self, Z, idx, jacobian: bool = False):
+        """Residuals ``(B, k)`` and, with ``jacobian``, exact Jacobians ``(B, k, k)`` (see :meth:`KippCurve.jacobian`);
+        NaN rows where ``Σ`` is singular."""
+        return self._evaluate2(Z, idx, jacobian) if self.k == 2 else self._evaluate(Z, idx, jacobian)
+
+    def _evaluate(self, Z, idx, jacobian: bool):
+        """:meth:`evaluate` for any ``k``."""
+        k = self.k
+        times = self.times(Z, idx)
+        T = times[:, -1]
+        sums = impact_kernels(self.omega, self.b, times, derivatives=jacobian)
+        off = ~np.eye(k, dtype=bool)
+        Sigma, s0 = -sums[0], np.where(off, sums[1], 0.0)
+        n = solve_stack(Sigma, np.ones((len(T), k)))
+        nn = np.linalg.norm(n, axis=1)
+        u = n / nn[:, None]
+        R = np.einsum("bij,bj->bi", s0, u) / self.scale
+        if not jacobian:
+            return R, None
+        dsD, gT, sT = sums[2:]
+        ds0, eye = np.where(off, dsD, 0.0), np.eye(k)
+        # Impact times t_l (l < k): dD_ij/dt_l = δ_il - δ_jl, so column l of dX·v is
+        # δ_il Σ_j X'(D_ij) v_j - X'(D_il) v_l (X = s for Π, -g for Σ).
+        dPi_u = np.einsum("bij,bj->bi", ds0, u)[:, :, None] * eye - ds0 * u[:, None, :]
+        dSig_n = -(np.einsum("bij,bj->bi", s0, n)[:, :, None] * eye - s0 * n[:, None, :])
+        # Period (t_k = T too): D_ij = t_i - t_j + T[i < j], so dD_ij/dT = δ_ik - δ_jk + [i < j],
+        # plus the kernel's own dependence on T at fixed D.
+        i = np.arange(k)
+        E = (i[:, None] == k - 1).astype(float) - (i[None, :] == k - 1) + (i[:, None] < i[None, :])
+        dPi_u[:, :, k - 1] = np.einsum("bij,bj->bi", np.where(off, dsD * E + sT, 0.0), u)
+        dSig_n[:, :, k - 1] = -np.einsum("bij,bj->bi", s0 * E + gT, n)
+        dn = -solve_stack(Sigma, dSig_n)
+        du = (dn - u[:, :, None] * np.einsum("bi,bij->bj", u, dn)[:, None, :]) / nn[:, None, None]
+        return R, (dPi_u + s0 @ du) * (self.T0[idx] / self.scale)[:, None, None]
+
+    def valid(self, Z, idx) -> np.ndarray:
+        """:meth:`KippCurve.valid` of every row."""
+        times = self.times(Z, idx)
+        T = times[:, -1]
+        with np.errstate(invalid="ignore"):
+            gaps = np.diff(np.concatenate([np.zeros((len(T), 1)), times], axis=1), axis=1)
+            ok = np.all(np.isfinite(Z), axis=1) & (T > 0) & (gaps.min(axis=1) > MERGE_RTOL * T)
+        rows = np.flatnonzero(ok)
+        if rows.size == 0:
+            return ok
+        t, T = times[rows], T[rows]
+        if self.k == 2:  # Σ⁻¹1 = -(1, 1)/(g(0) + g(D))
+            _, _, _, c, _, ch, cp, _ = self._pair(Z[rows], idx[rows], sines=False)
+            with np.errstate(divide="ignore"):
+                lam = np.repeat((-self.d / np.einsum("bm,bm->b", ch + cp, c / self.omega))[:, None], 2, axis=1)
+        else:
+            lam = self.d * solve_stack(-impact_kernels(self.omega, self.b, t)[0], np.ones(t.shape))
+        with np.errstate(invalid="ignore"):
+            fine = np.all(np.isfinite(lam), axis=1) & (np.abs(lam).max(axis=1) <= 1e8 * self.lam0[idx[rows]])
+            ok[rows] = fine & (_distance_to_repetition(t, lam, T) > MERGE_RTOL)
+        return ok
+
+    def crossing(self, ZA, ZB, idx) -> np.ndarray:
+        """:meth:`KippCurve.crossing` of every pair of rows."""
+        out = np.zeros(len(ZA), dtype=bool)
+        for da, db in zip(_repetition_offsets(self.times(ZA, idx)), _repetition_offsets(self.times(ZB, idx))):
+            out |= np.all(np.sign(da) * np.sign(db) < 0, axis=1)
+        return out
+
+    def batch(self) -> continuation.BatchCurve:
+        """These curves as the continuation driver's :class:`~bladecase.nsm.continuation.BatchCurve`."""
+        return continuation.BatchCurve(self.evaluate, self.valid, self.crossing)
 
 
 class KippCurve:
@@ -42,13 +171,21 @@ class KippCurve:
     scaled by ``wᵀM⁻¹w / 2`` (``k`` equations, one redundant since
     ``nᵀΠn ≡ 0``).  For k = 2 this is the paper's Eq. 15, ``s(t₁) = 0``, and
     the curve lives in the ``(t₁, T)`` plane of its Fig. 2.
+
+    >>> from bladecase.nsm import chain, orbits_kipp
+    >>> system = chain(2, k=1.0, m=0.5, gap=1.0)
+    >>> orbit = orbits_kipp(system, 13.5, 2)[1]         # on the curve: the residual vanishes
+    >>> curve = KippCurve(system, 2, 13.5, 1.0)
+    >>> z = curve.join(orbit.impact_times)
+    >>> bool(np.abs(curve.residual(z)).max() < 1e-12), curve.jacobian(z).shape, curve.valid(z)
+    (True, (2, 2), True)
     """
 
     def __init__(self, system: LinearSystem, k: int, T0: float, lam0: float):
         self.system, self.k, self.T0, self.lam0 = system, k, T0, lam0
         self.d = system.gap
-        b = system.spectrum.contact_modes[1]
-        self.scale = float(b @ b) / 2
+        self.curves = KippCurves(system, k, [T0], [lam0])
+        self.scale = self.curves.scale
 
     def times(self, z) -> tuple[float, np.ndarray]:
         """``(T, impact times)`` at ``z``."""
@@ -70,94 +207,51 @@ class KippCurve:
         return times / self.T0
 
     def residual(self, z) -> np.ndarray:
-        T, times = self.times(z)
-        Pi, Sigma = ModalKernel.of(self.system, T).matrices(times)
-        try:
-            n = np.linalg.solve(Sigma, np.ones(self.k))
-        except np.linalg.LinAlgError:
-            return np.full(self.k, np.nan)
-        return Pi @ (n / np.linalg.norm(n)) / self.scale
+        return self.curves.evaluate(np.asarray(z, dtype=float)[None, :], np.zeros(1, dtype=int))[0][0]
 
     def jacobian(self, z) -> np.ndarray:
         """Exact ``∂R/∂z`` (``k × k``): ``R = Π u / S``, ``u = n/|n|``, ``n = Σ⁻¹1``, so
         ``dR = (dΠ u + Π du)/S``, ``du = (I - uuᵀ) dn/|n|``, ``dn = -Σ⁻¹ dΣ n``."""
-        k = self.k
-        T, times = self.times(z)
-        md = ModalKernel.of(self.system, T)
-        D = np.mod(times[:, None] - times[None, :], T)
-        g, s = md.g_s(D)
-        dsD = md.ds(D)
-        gT, sT = md.dT(D)
-        off = ~np.eye(k, dtype=bool)
-        s0, ds0 = np.where(off, s, 0.0), np.where(off, dsD, 0.0)
-        Sigma = -g
-        try:
-            n = np.linalg.solve(Sigma, np.ones(k))
-        except np.linalg.LinAlgError:
-            return np.full((k, k), np.nan)
-        nn = np.linalg.norm(n)
-        u = n / nn
-        # Impact times t_l (l < k): dD_ij/dt_l = δ_il - δ_jl, so column l of dX·v is
-        # δ_il Σ_j X'(D_ij) v_j - X'(D_il) v_l (X = s for Π, -g for Σ).
-        dPi_u = np.diag(ds0 @ u) - ds0 * u[None, :]
-        dSig_n = -(np.diag(s0 @ n) - s0 * n[None, :])
-        # Period (t_k = T too): D_ij = t_i - t_j + T[i < j], so dD_ij/dT = δ_ik - δ_jk + [i < j],
-        # plus the kernel's own dependence on T at fixed D.
-        idx = np.arange(k)
-        E = (idx[:, None] == k - 1).astype(float) - (idx[None, :] == k - 1) + (idx[:, None] < idx[None, :])
-        dPi_u[:, k - 1] = np.where(off, dsD * E + sT, 0.0) @ u
-        dSig_n[:, k - 1] = -(s0 * E + gT) @ n
-        dn = -np.linalg.solve(Sigma, dSig_n)
-        du = (dn - np.outer(u, u @ dn)) / nn
-        return (dPi_u + s0 @ du) * (self.T0 / self.scale)
+        return self.curves.evaluate(np.asarray(z, dtype=float)[None, :], np.zeros(1, dtype=int), True)[1][0]
 
     def valid(self, z) -> bool:
         """Ordered impacts, no two closer than ``MERGE_RTOL·T``, finite impulses,
         and not within ``MERGE_RTOL`` of a repeated orbit (period ``T/j``)."""
-        T, times = self.times(z)
-        gaps = np.diff(np.concatenate([[0.0], times]))
-        if not (np.all(np.isfinite(z)) and T > 0 and gaps.min() > MERGE_RTOL * T):
-            return False
-        try:
-            T, times, lam = self.split(z)
-        except np.linalg.LinAlgError:
-            return False
-        if not np.all(np.isfinite(lam)) or np.abs(lam).max() > 1e8 * self.lam0:
-            return False
-        return _distance_to_repetition(times, lam, T) > MERGE_RTOL
+        return bool(self.curves.valid(np.asarray(z, dtype=float)[None, :], np.zeros(1, dtype=int))[0])
 
     def crossing(self, z_a, z_b) -> bool:
         """Does the segment ``z_a → z_b`` cross a repeated orbit (all offsets flip sign)?  That is a
         branch point with the family of period-``T/j`` orbits: the family ends there."""
-        for da, db in zip(_repetition_offsets(*self.times(z_a)[::-1]), _repetition_offsets(*self.times(z_b)[::-1])):
-            if np.all(np.sign(da) * np.sign(db) < 0):
-                return True
-        return False
+        one = np.zeros(1, dtype=int)
+        return bool(self.curves.crossing(np.asarray(z_a, dtype=float)[None, :], np.asarray(z_b, dtype=float)[None, :],
+                                         one)[0])
 
     def curve(self) -> continuation.Curve:
         """This problem as the continuation driver's :class:`~bladecase.nsm.continuation.Curve`."""
         return continuation.Curve(self.residual, self.jacobian, self.valid, self.crossing)
 
 
-def _repetition_offsets(times, T) -> list[np.ndarray]:
-    """For each ``j > 1`` dividing ``k``: the offsets of the impact pattern from
-    one repeating every ``T/j`` (all zero at a repeated orbit)."""
-    k = times.size
-    return [np.mod(np.roll(times, -(k // j)) - times, T) - T / j for j in range(2, k + 1) if k % j == 0]
+def _repetition_offsets(times) -> list[np.ndarray]:
+    """For each ``j > 1`` dividing ``k``: the offsets ``(B, k)`` of the impact patterns (rows of ``times``, the
+    last one ``T``) from one repeating every ``T/j`` (all zero at a repeated orbit)."""
+    k = times.shape[1]
+    T = times[:, -1:]
+    return [np.mod(np.roll(times, -(k // j), axis=1) - times, T) - T / j for j in range(2, k + 1) if k % j == 0]
 
 
-def _distance_to_repetition(times, lam, T) -> float:
-    """How far (relative) the impact pattern is from repeating every ``T/j``, ``j | k``."""
-    k = times.size
-    scale = max(np.abs(lam).max(), np.finfo(float).tiny)
-    best = np.inf
+def _distance_to_repetition(times, lam, T) -> np.ndarray:
+    """How far (relative) each impact pattern (rows) is from repeating every ``T/j``, ``j | k``."""
+    k = times.shape[1]
+    scale = np.maximum(np.abs(lam).max(axis=1), np.finfo(float).tiny)
+    best = np.full(len(T), np.inf)
     for j in range(2, k + 1):
         if k % j:
             continue
         shift = k // j
-        dt = np.mod(np.roll(times, -shift) - times, T)
-        dist = max(np.abs(dt - T / j).max() / T, np.abs(np.roll(lam, -shift) - lam).max() / scale)
-        best = min(best, dist)
+        dt = np.mod(np.roll(times, -shift, axis=1) - times, T[:, None])
+        dist = np.maximum(np.abs(dt - T[:, None] / j).max(axis=1) / T,
+                          np.abs(np.roll(lam, -shift, axis=1) - lam).max(axis=1) / scale)
+        best = np.minimum(best, dist)
     return best
 
 
@@ -179,24 +273,108 @@ def follow_family(system: LinearSystem, k: int, start: PeriodicOrbit, T_range: t
     period-``T/j`` orbits), the impulses blow up (resonance), the curve closes on itself, or the
     corrector fails at the smallest step.  The points run from the end with the smaller period to
     the end with the larger one.  Orbits are certified; admissible arcs refined (``refine``)."""
+    traced = trace_families(system, k, [start], T_range, step, max_points)
+    return complete_families(traced, T_range, refine)[0][0]
+
+
+class FamilyTracer:
+    """The curves of the families through start orbits, traced together; starts join and leave at any step.
+
+    Each start is traced as :func:`follow_family` does (both directions, until the curve leaves ``T_range``,
+    impacts merge, it reaches a repeated orbit, the impulses blow up, it closes or the corrector fails); the
+    numerical work of all running traces is done together (:class:`~bladecase.nsm.continuation.Followers`).
+    """
+
+    def __init__(self, system: LinearSystem, k: int, T_range: tuple[float, float], step: float, max_points: int):
+        self.system, self.k = system, k
+        self.T_lo, self.T_hi = T_range
+        self.curves = KippCurves(system, k, [], [])
+        self.run = continuation.Followers(self.curves.batch(), ds=step, ds_min=step / 1000, ds_max=2 * step,
+                                          max_points=max_points, stop=self._stop)
+        self.members: dict = {}
+
+    def _stop(self, Z, idx):
+        T = Z[:, -1] * self.curves.T0[idx]
+        return ~((self.T_lo <= T) & (T <= self.T_hi))
+
+    def add(self, keys: list, starts: list[PeriodicOrbit]) -> None:
+        """Start tracing the family through each orbit of ``starts``, known by its key."""
+        if not starts:
+            return
+        lam0 = [max(np.abs(o.impulses).max(), self.system.gap) for o in starts]
+        idx = self.curves.extend([o.T for o in starts], lam0)
+        Z0 = np.array([o.impact_times / o.T for o in starts])
+        fwd, bwd = self.run.add_traces(Z0, np.eye(self.k)[-1], idx)
+        for key, i, f, b, z0 in zip(keys, idx, fwd, bwd, Z0):
+            self.members[key] = (i, f, b, z0)
+
+    def step(self) -> None:
+        """One continuation step of every running trace."""
+        self.run.step()
+
+    def done(self, key) -> bool:
+        _, f, b, _ = self.members[key]
+        return not self.run._state["live"][[f, b]].any()
+
+    def cancel(self, key) -> None:
+        """Stop tracing this family (its points are dropped)."""
+        _, f, b, _ = self.members.pop(key)
+        self.run.cancel([f, b])
+
+    def result(self, key) -> tuple[KippCurve, list]:
+        """``(problem, points)`` of a finished trace, the points from the smaller period to the larger."""
+        i, f, b, z0 = self.members.pop(key)
+        problem = KippCurve(self.system, self.k, self.curves.T0[i], self.curves.lam0[i])
+        zs = self.run.points[b][::-1] + [z0] + self.run.points[f]
+        if problem.period(zs[0]) > problem.period(zs[-1]):
+            zs = zs[::-1]  # one orientation whatever the start: the end with the smaller period first
+        return problem, zs
+
+
+def trace_families(system: LinearSystem, k: int, starts: list[PeriodicOrbit], T_range: tuple[float, float],
+                   step: float, max_points: int) -> list[tuple[KippCurve, list]]:
+    """The curves of the families through each orbit of ``starts``, traced together (the curve part of
+    :func:`follow_family`): ``(problem, points)`` per start, the points from the smaller period to the larger.
+
+    >>> from bladecase.nsm import chain, orbits_kipp
+    >>> system = chain(2, k=1.0, m=0.5, gap=1.0)
+    >>> starts = [o for o in orbits_kipp(system, 13.5, 2) if o.repeats == 1]
+    >>> traced = trace_families(system, 2, starts, (13.2, 13.75), 0.01, 400)
+    >>> [(round(p.period(zs[0]), 3), round(p.period(zs[-1]), 3)) for p, zs in traced]  # to the step out of range
+    [(13.038, 13.762), (13.329, 13.779)]
+    """
+    tracer = FamilyTracer(system, k, T_range, step, max_points)
+    tracer.add(list(range(len(starts))), starts)
+    while tracer.run.running.size:
+        tracer.step()
+    return [tracer.result(i) for i in range(len(starts))]
+
+
+def complete_families(traced: list[tuple[KippCurve, list]], T_range: tuple[float, float], refine: bool,
+                      runs: Callable[[list[PeriodicOrbit]], list[list[int]]] | None = None
+                      ) -> list[list[FollowedFamily]]:
+    """The certified orbits (:func:`polished_orbit`, the fixed-``T`` solves of all families vectorised) and the
+    admissible arcs of traced families (:func:`trace_families`).
+
+    ``runs(orbits)``: the stretches (index runs into the orbits, in curve order) each family is to be cut into,
+    e.g. to leave out what its curve traces twice; default: one stretch.  Returns, per traced family, one
+    :class:`FollowedFamily` per stretch (the problem and the curve points shared).
+    """
     T_lo, T_hi = T_range
-    lam0 = max(np.abs(start.impulses).max(), system.gap)
-    problem = KippCurve(system, k, start.T, lam0)
-    z0 = problem.join(start.impact_times)
-    zs, _ = continuation.trace(problem.curve(), z0, np.eye(k)[-1], ds=step, ds_min=step / 1000, ds_max=2 * step,
-                               max_points=max_points, stop=lambda z: not T_lo <= problem.period(z) <= T_hi)
-    if problem.period(zs[0]) > problem.period(zs[-1]):
-        zs = zs[::-1]  # one orientation whatever the start: the end with the smaller period first
-    orbits = []
-    for z in zs:
-        if not T_lo <= problem.period(z) <= T_hi:
-            continue  # the step that left the period range: not part of the family
-        try:
-            orbits.append(polished_orbit(problem, z))
-        except (ValueError, np.linalg.LinAlgError):
-            continue
-    arcs = _arcs(problem, [problem.join(o.impact_times) for o in orbits], orbits, refine)
-    return FollowedFamily(problem, zs, orbits, arcs)
+    todo = [(f, z) for f, (problem, zs) in enumerate(traced) for z in zs if T_lo <= problem.period(z) <= T_hi]
+    orbits: list[list[PeriodicOrbit]] = [[] for _ in traced]
+    for (f, _), orbit in zip(todo, polished_orbits([(traced[f][0], z) for f, z in todo])):
+        if orbit is not None:
+            orbits[f].append(orbit)
+    out = []
+    for (problem, zs), found in zip(traced, orbits):
+        pieces = []
+        for run in (runs(found) if runs is not None else [list(range(len(found)))]):
+            part = [found[i] for i in run]
+            arcs = _arcs(problem, [problem.join(o.impact_times) for o in part], part, refine)
+            pieces.append(FollowedFamily(problem, zs, part, arcs))
+        out.append(pieces)
+    return out
 
 
 def polished_orbit(problem: KippCurve, z) -> PeriodicOrbit:
@@ -211,44 +389,33 @@ def polished_orbit(problem: KippCurve, z) -> PeriodicOrbit:
     return make_orbit(problem.system, T, times, lam, polish=False)
 
 
-def phase_distance(times: np.ndarray, reference: np.ndarray, T: float) -> float:
-    """``min`` over re-anchorings of ``times`` (shift by each ``t_r``) of the largest
-    distance to ``reference`` (both sets of ``k`` impact times in ``(0, T]``)."""
-    shifted = np.mod(times[None, :] - times[:, None], T)  # row r: re-anchored at impact r
-    shifted[shifted == 0] = T
-    shifted.sort(axis=1)
-    return float(np.abs(shifted - np.sort(reference)[None, :]).max(axis=1).min())
-
-
-def passes(problem: KippCurve, zs, start: tuple[float, PeriodicOrbit]) -> bool:
-    """Does the polyline ``zs`` cross the start orbit (same period, same impacts)?"""
-    from .kipp import canonical_rotation
-
-    T_s, o = start
-    Ts = np.array([problem.period(z) for z in zs])
-    lo, hi = np.minimum(Ts[:-1], Ts[1:]), np.maximum(Ts[:-1], Ts[1:])
-    segments = np.flatnonzero((lo <= T_s) & (T_s <= hi) & (hi > lo))
-    if segments.size == 0:
-        return False
-    md = ModalKernel.of(problem.system, T_s)
-    for i in segments:
-        a = (T_s - Ts[i]) / (Ts[i + 1] - Ts[i])
-        ta, tb = problem.times(zs[i])[1], problem.times(zs[i + 1])[1]
-        guess = ((1 - a) * ta / Ts[i] + a * tb / Ts[i + 1]) * T_s
-        if phase_distance(guess, o.impact_times, T_s) > PASS_GATE * T_s:
-            continue  # the interpolated impacts are far from the start's: no need to solve
-        sol = solve_times(md, guess, problem.d)
-        if sol is None:
-            continue
-        times, _ = canonical_rotation(sol[0], sol[1], T_s)
-        if np.abs(times - o.impact_times).max() <= 1e3 * REPEAT_RTOL * T_s:
-            return True
-    return False
+def polished_orbits(points: list[tuple[KippCurve, np.ndarray]]) -> list[PeriodicOrbit | None]:
+    """:func:`polished_orbit` of many ``(problem, z)`` pairs of one system and ``k``, the impulses and the
+    fixed-``T`` Newton solves vectorised; ``None`` where the orbit is undefined (singular ``Σ``)."""
+    out: list[PeriodicOrbit | None] = [None] * len(points)
+    if not points:
+        return out
+    problem = points[0][0]
+    system, d = problem.system, problem.d
+    omega, b, _ = system.spectrum.contact_modes
+    times = np.array([problem.times(z)[1] for problem, z in points])
+    T = times[:, -1]
+    lam = d * solve_stack(-impact_kernels(omega, b, times)[0], np.ones(times.shape))  # Λ = d Σ⁻¹1: NaN if singular
+    rows = np.flatnonzero(np.all(np.isfinite(lam), axis=1))
+    for i, sol in zip(rows, solve_times_stack(system, T[rows], times[rows], d)):
+        t, lam_i = times[i], lam[i]
+        if sol is not None and np.abs(sol[0] - t).max() < 1e-6 * T[i]:
+            t, lam_i = sol
+        try:
+            out[i] = make_orbit(system, T[i], t, lam_i, polish=False)
+        except ValueError:
+            pass
+    return out
 
 
 def _arcs(problem: KippCurve, zs, orbits, refine: bool) -> list[tuple]:
     """``(start, stop, T_lo, T_hi, refined_lo, refined_hi)`` of every maximal admissible run of ``orbits``."""
-    return admissible_arcs(orbits, lambda i, out: _bisect_end(problem, zs[i], zs[out]) if refine else None)
+    return admissible_arcs(orbits, lambda i, out: _bisect_end(problem, zs[i], zs[out], orbits[out]) if refine else None)
 
 
 def admissible_arcs(orbits, refine_end) -> list[tuple]:
@@ -281,18 +448,21 @@ def admissible_arcs(orbits, refine_end) -> list[tuple]:
     return arcs
 
 
-def _bisect_end(problem: KippCurve, z_in, z_out) -> tuple[float, bool]:
+def _bisect_end(problem: KippCurve, z_in, z_out, orbit_out: PeriodicOrbit | None = None) -> tuple[float, bool]:
     """Period where admissibility is lost between curve points ``z_in``
-    (admissible) and ``z_out``: bisection along the curve.
+    (admissible) and ``z_out`` (the orbit ``orbit_out``): bisection along the curve.
 
     The midpoint is solved at fixed ``T = (T_in + T_out)/2`` by Newton from
     the interpolated impact times (robust near resonances, where the
     eliminated-impulse residual is stiff), else by the arclength corrector
     orthogonal to the chord (turning points); a midpoint that leaves the
-    bracket is rejected.  Returns the admissible end and whether the bracket
-    was narrowed to ``ARC_RTOL``.
+    bracket is rejected.  A midpoint's admissibility is checked first where
+    the last non-admissible orbit of the bracket violated the constraint (the
+    same verdict, found sooner).  Returns the admissible end and whether the
+    bracket was narrowed to ``ARC_RTOL``.
     """
     system = problem.system
+    probe = [None if orbit_out is None else _violation_phase(orbit_out)]
 
     def midpoint(z_a, z_b):
         T_a, T_b = problem.period(z_a), problem.period(z_b)
@@ -310,9 +480,13 @@ def _bisect_end(problem: KippCurve, z_in, z_out) -> tuple[float, bool]:
     def admissible(z) -> bool:
         try:
             Tm, times, lam = problem.split(z)
-            return make_orbit(system, Tm, times, lam, polish=False).admissible
+            where = None if probe[0] is None else probe[0] * Tm
+            orbit = make_orbit(system, Tm, times, lam, polish=False, probe=where)
         except (ValueError, np.linalg.LinAlgError):
             return False
+        if not orbit.admissible and _violation_phase(orbit) is not None:
+            probe[0] = _violation_phase(orbit)
+        return orbit.admissible
 
     def converged(z_a, z_b) -> bool:
         T_a = problem.period(z_a)
@@ -321,3 +495,9 @@ def _bisect_end(problem: KippCurve, z_in, z_out) -> tuple[float, bool]:
     z_in, _, done = continuation.bisect(problem.curve(), z_in, z_out, admissible, converged=converged,
                                         midpoint=midpoint)
     return problem.period(z_in), done
+
+
+def _violation_phase(orbit: PeriodicOrbit) -> float | None:
+    """Where (as a fraction of the period) a non-admissible orbit was seen to violate the constraint."""
+    phase = orbit.max_violation_time / orbit.T
+    return float(phase) if np.isfinite(phase) and orbit.max_violation > 0 else None

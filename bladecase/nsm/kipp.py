@@ -27,7 +27,8 @@ def check_k(k) -> int:
     return int(k)
 
 
-def orbits_kipp(system: LinearSystem, T: float, k: int, resolution: int | None = None) -> list[PeriodicOrbit]:
+def orbits_kipp(system: LinearSystem, T: float, k: int, resolution: int | None = None,
+                certify: bool = True) -> list[PeriodicOrbit]:
     """Every periodic orbit of period ``T`` with ``k`` impacts per period.
 
     Solves ``Π(t)Λ = 0``, ``Σ(t)Λ = d·1`` for ``0 < t₁ < … < t_k = T``
@@ -46,10 +47,12 @@ def orbits_kipp(system: LinearSystem, T: float, k: int, resolution: int | None =
     shift) are the same orbit and are returned once
     (:func:`canonical_rotation`).
 
-    Each solution is a :class:`PeriodicOrbit` with certified admissibility;
-    orbits with a negative impulse are never admissible.  Solutions that are
-    an orbit of period ``T/j`` counted ``j`` times (e.g. k = 2 with
-    ``t₁ = T/2``, a 1-ipp orbit of period ``T/2``) have ``repeats = j``.
+    Each solution is a :class:`PeriodicOrbit` with certified admissibility
+    (``certify=False``: not checked, the orbits marked non-admissible — for
+    starting points, the bulk of the cost saved); orbits with a negative
+    impulse are never admissible.  Solutions that are an orbit of period
+    ``T/j`` counted ``j`` times (e.g. k = 2 with ``t₁ = T/2``, a 1-ipp orbit
+    of period ``T/2``) have ``repeats = j``.
 
     Returns
     -------
@@ -64,7 +67,7 @@ def orbits_kipp(system: LinearSystem, T: float, k: int, resolution: int | None =
     """
     k = check_k(k)
     if k == 1:
-        return [orbit_1ipp(system, T)]
+        return [orbit_1ipp(system, T, certify=certify)]
     T = check_period(system, T)
     md = ModalKernel.of(system, T)
     d = system.gap
@@ -78,11 +81,13 @@ def orbits_kipp(system: LinearSystem, T: float, k: int, resolution: int | None =
     else:
         solutions = _multistart(md, k, d, resolution)
     unique: list[tuple[np.ndarray, np.ndarray]] = []
+    seen = np.empty((len(solutions), k))  # the impact times kept so far, one row each
     for times, lam in solutions:
         times, lam = canonical_rotation(times, lam, T)
-        if not any(np.abs(times - t).max() <= REPEAT_RTOL * T for t, _ in unique):
+        if not np.any(np.abs(seen[: len(unique)] - times).max(axis=1, initial=0.0) <= REPEAT_RTOL * T):
+            seen[len(unique)] = times
             unique.append((times, lam))
-    orbits = [make_orbit(system, T, times, lam, md) for times, lam in unique]
+    orbits = [make_orbit(system, T, times, lam, md, certify=certify) for times, lam in unique]
     return sorted(orbits, key=lambda o: tuple(o.impact_times))
 
 

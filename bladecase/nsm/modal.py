@@ -23,9 +23,11 @@ True
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
+from .continuation import lstsq_stack
 from .system import LinearSystem
 
 #: ``T`` is resonant when ``|ω_j T - 2πm| <= RESONANCE_RTOL · ω_j T`` for an
@@ -102,19 +104,28 @@ class ModalKernel:
     def _phase(self, u) -> np.ndarray:
         return np.multiply.outer(np.asarray(u, dtype=float) - self.T / 2, self.omega)
 
-    @property
+    @cached_property
     def _c(self) -> np.ndarray:
         return self.b**2 / (2 * self.sin_half)
+
+    @cached_property
+    def _weights(self) -> tuple[np.ndarray, np.ndarray]:
+        return self._c / self.omega, self.b**2 * self.omega / (2 * self.sin_half)
 
     def g_s(self, u) -> tuple[np.ndarray, np.ndarray]:
         """``g(u) = wᵀG(u)`` and ``s(u) = wᵀG'(u)`` for ``u`` in ``[0, T]`` (any shape)."""
         ph = self._phase(u)
-        c = self._c
-        return np.cos(ph) @ (c / self.omega), -(np.sin(ph) @ c)
+        return np.cos(ph) @ self._weights[0], -(np.sin(ph) @ self._c)
 
     def ds(self, u) -> np.ndarray:
         """``s'(u) = wᵀG''(u)`` for ``u`` in ``(0, T)``."""
-        return -(np.cos(self._phase(u)) @ (self.b**2 * self.omega / (2 * self.sin_half)))
+        return -(np.cos(self._phase(u)) @ self._weights[1])
+
+    def g_s_ds(self, u) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`g_s` and :meth:`ds` together (one evaluation of the trigonometric terms)."""
+        ph = self._phase(u)
+        cs = np.cos(ph)
+        return cs @ self._weights[0], -(np.sin(ph) @ self._c), -(cs @ self._weights[1])
 
     def dT(self, u) -> tuple[np.ndarray, np.ndarray]:
         """``∂g/∂T`` and ``∂s/∂T`` at fixed ``u`` (the kernel depends on ``T`` through ``T/2`` and ``sin(ωT/2)``)."""
@@ -183,22 +194,22 @@ def _residual_jacobian(kernel: ModalKernel, times, lam, d: float) -> tuple[np.nd
     """:func:`kipp_residual` and :func:`kipp_jacobian` from one evaluation of the kernel."""
     k = times.size
     D = np.mod(times[:, None] - times[None, :], kernel.T)
-    g, s = kernel.g_s(D)
+    g, s, dsD = kernel.g_s_ds(D)
     np.fill_diagonal(s, 0.0)
-    dsD = kernel.ds(D)
     np.fill_diagonal(dsD, 0.0)
     r = np.concatenate([s @ lam, -g @ lam - d])
     # d/dt_l of Σ_j X(D_ij) Λ_j, with dD_ij/dt_l = δ_il - δ_jl:
     #   row i: δ_il Σ_j X'(D_ij)Λ_j - X'(D_il)Λ_l
     A_pi = np.diag(dsD @ lam) - dsD * lam[None, :]
     A_sg = -(np.diag(s @ lam) - s * lam[None, :])
-    return r, np.block([[A_pi[:, : k - 1], s], [A_sg[:, : k - 1], -g]])
+    return r, np.concatenate([np.concatenate([A_pi[:, : k - 1], s], axis=1),
+                              np.concatenate([A_sg[:, : k - 1], -g], axis=1)])
 
 
 def impulses_for(kernel: ModalKernel, times: np.ndarray, d: float) -> np.ndarray | None:
     """``Λ`` from ``ΣΛ = d·1`` (least squares), or ``None`` if ``Σ`` is singular."""
     _, Sigma = kernel.matrices(times)
-    lam, *_ = np.linalg.lstsq(Sigma, np.full(times.size, d), rcond=1e-12)
+    lam = lstsq_stack(Sigma[None], np.full((1, times.size), d), rcond=1e-12)[0]
     return lam if np.all(np.isfinite(lam)) else None
 
 
@@ -215,7 +226,7 @@ def newton_times(kernel: ModalKernel, times: np.ndarray, lam: np.ndarray, d: flo
     prev = np.inf
     for _ in range(maxiter):
         r, J = _residual_jacobian(kernel, times, lam, d)
-        step, *_ = np.linalg.lstsq(J, -r, rcond=None)
+        step = lstsq_stack(J[None], -r[None])[0]
         times[: k - 1] += step[: k - 1]
         lam += step[k - 1:]
         size = np.abs(step[: k - 1]).max(initial=0.0) / T + np.abs(step[k - 1:]).max() / max(np.abs(lam).max(), d)
@@ -236,24 +247,192 @@ def newton_times(kernel: ModalKernel, times: np.ndarray, lam: np.ndarray, d: flo
 def solve_times(kernel: ModalKernel, times0: np.ndarray, d: float) -> tuple[np.ndarray, np.ndarray] | None:
     """Solve for ``(t₁…t_{k-1}, Λ)`` at fixed ``T`` from impact times ``times0``: Newton with the exact
     Jacobian, else Levenberg–Marquardt (wider basin); ``None`` if neither converges."""
-    from scipy.optimize import least_squares
-
-    T, k = kernel.T, times0.size
     lam0 = impulses_for(kernel, times0, d)
     if lam0 is None:
         return None
     sol = newton_times(kernel, times0, lam0, d)
     if sol is not None:
         return sol
+    return _levenberg_marquardt(kernel, times0, lam0, d)
+
+
+def _levenberg_marquardt(kernel: ModalKernel, times0: np.ndarray, lam0: np.ndarray, d: float):
+    """The wide-basin fallback of :func:`solve_times`: Levenberg–Marquardt on the scaled residual."""
+    from scipy.optimize import least_squares
+
+    T, k = kernel.T, times0.size
     lscale = max(np.abs(lam0).max(), d)
+    scale = np.concatenate([np.ones(k - 1), np.full(k, lscale)]) / d
+    last: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
 
-    def fun(u):
-        return kipp_residual(kernel, np.append(u[: k - 1], T), u[k - 1:] * lscale, d) / d
+    def both(u):  # residual and its exact Jacobian in u = (t₁…t_{k-1}, Λ/lscale), from one kernel evaluation
+        key = u.tobytes()
+        if key not in last:
+            last.clear()
+            r, J = _residual_jacobian(kernel, np.append(u[: k - 1], T), u[k - 1:] * lscale, d)
+            last[key] = (r / d, J * scale)
+        return last[key]
 
-    res = least_squares(fun, np.concatenate([times0[:-1], lam0 / lscale]), method="lm", xtol=1e-15, ftol=1e-15,
-                        gtol=1e-15, max_nfev=200 * k)
+    res = least_squares(lambda u: both(u)[0], np.concatenate([times0[:-1], lam0 / lscale]),
+                        jac=lambda u: both(u)[1], method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=200 * k)
     times = np.append(res.x[: k - 1], T)
     lam = res.x[k - 1:] * lscale
     if not np.all(np.isfinite(res.x)) or np.abs(res.fun).max() > 1e-9 or not _distinct(times, T):
         return None
     return times, lam
+
+
+# -- many periods at once ----------------------------------------------------------------------------------
+
+
+def impact_kernels(omega: np.ndarray, b: np.ndarray, times: np.ndarray, derivatives: bool = False,
+                   T: np.ndarray | None = None):
+    """The kernel sums at the delays ``D_ij = (t_i - t_j) mod T`` of many impact patterns at once.
+
+    ``times`` ``(B, k)``: rows ``0 < t₁ < … < t_k = T`` (periods ``T`` ``(B,)``: default the last column).
+    Returns ``(g, s)`` at ``D`` — with ``derivatives``
+    also ``(s', ∂g/∂T, ∂s/∂T)`` — each ``(B, k, k)`` (the sums of :meth:`ModalKernel.g_s`, :meth:`ModalKernel.ds`,
+    :meth:`ModalKernel.dT`; ``s`` with its diagonal ``s(0)``, not zeroed).  The trigonometric terms are evaluated
+    at the ``k(k-1)/2`` delays ``i < j`` only: ``D_ji = T - D_ij`` and ``D_ii = 0`` follow by symmetry about
+    ``T/2`` (``g``, ``s'`` even, ``s`` odd).
+
+    >>> from bladecase.nsm import chain
+    >>> s2 = chain(2, k=1.0, m=0.5, gap=1.0)
+    >>> omega, b, _ = s2.spectrum.contact_modes
+    >>> g, s = impact_kernels(omega, b, np.array([[2.1, 7.0], [3.3, 6.0]]))
+    >>> Pi, Sigma = ModalKernel.of(s2, 6.0).matrices(np.array([3.3, 6.0]))
+    >>> bool(np.allclose(-g[1], Sigma, rtol=1e-13)), bool(np.allclose(s[1] - np.diag(np.diag(s[1])), Pi, rtol=1e-13))
+    (True, True)
+    """
+    count, k = times.shape
+    T = times[:, -1] if T is None else T
+    half = np.multiply.outer(T / 2, omega)
+    sh, ch = np.sin(half), np.cos(half)
+    c = b**2 / (2 * sh)  # (B, m)
+    iu, ju = np.triu_indices(k, 1)
+    D = np.mod(times[:, iu] - times[:, ju], T[:, None])  # (B, P): the delays above the diagonal
+    ph = (D - (T / 2)[:, None])[:, :, None] * omega
+    cp, sp = np.cos(ph), np.sin(ph)
+    dg = np.arange(k)
+
+    def dot(x, w):
+        return (x @ w[:, :, None])[..., 0]
+
+    def full(upper, lower, diag):
+        out = np.empty((count, k, k))
+        out[:, iu, ju], out[:, ju, iu], out[:, dg, dg] = upper, lower, diag[:, None]
+        return out
+
+    w = c / omega
+    g_p, s_p = dot(cp, w), -dot(sp, c)
+    g, s = full(g_p, g_p, np.einsum("bm,bm->b", ch, w)), full(s_p, -s_p, np.einsum("bm,bm->b", sh, c))
+    if not derivatives:
+        return g, s
+    cot = ch / sh
+    cw = c * omega
+    ds_p = -dot(cp, cw)
+    a1, a2 = dot(sp, c / 2), dot(cp, c * cot / 2)
+    b1, b2 = dot(cp, cw / 2), dot(sp, cw * cot / 2)
+    return (g, s, full(ds_p, ds_p, -np.einsum("bm,bm->b", ch, cw)),
+            full(a1 - a2, -a1 - a2, np.einsum("bm,bm->b", -sh - ch * cot, c / 2)),
+            full(b1 + b2, b1 - b2, np.einsum("bm,bm->b", ch - sh * cot, cw / 2)))
+
+
+def solve_stack(A: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """``np.linalg.solve`` of each matrix of the stack ``A`` ``(B, k, k)`` with the vectors ``rhs`` ``(B, k)``
+    (or matrices ``(B, k, p)``); rows whose matrix is singular come back NaN instead of raising."""
+    vector = rhs.ndim == 2
+    b = rhs[..., None] if vector else rhs
+    try:
+        x = np.linalg.solve(A, b)
+    except np.linalg.LinAlgError:
+        x = np.full(b.shape, np.nan)
+        for i in range(len(A)):
+            try:
+                x[i] = np.linalg.solve(A[i], b[i])
+            except np.linalg.LinAlgError:
+                pass
+    return x[..., 0] if vector else x
+
+
+def _residual_jacobian_stack(omega, b, T, times, lam, d, jacobian=True):
+    """:func:`_residual_jacobian` at many periods: residuals ``(B, 2k)`` and Jacobians ``(B, 2k, 2k-1)``."""
+    k = times.shape[1]
+    off = ~np.eye(k, dtype=bool)
+    sums = impact_kernels(omega, b, times, derivatives=jacobian, T=T)
+    g, s = sums[0], np.where(off, sums[1], 0.0)
+    r = np.concatenate([np.einsum("bij,bj->bi", s, lam), -np.einsum("bij,bj->bi", g, lam) - d], axis=1)
+    if not jacobian:
+        return r, None
+    dsD = np.where(off, sums[2], 0.0)
+    eye = np.eye(k)
+    A_pi = np.einsum("bij,bj->bi", dsD, lam)[:, :, None] * eye - dsD * lam[:, None, :]
+    A_sg = -(np.einsum("bij,bj->bi", s, lam)[:, :, None] * eye - s * lam[:, None, :])
+    top = np.concatenate([A_pi[:, :, : k - 1], s], axis=2)
+    bottom = np.concatenate([A_sg[:, :, : k - 1], -g], axis=2)
+    return r, np.concatenate([top, bottom], axis=1)
+
+
+def solve_times_stack(system: LinearSystem, T: np.ndarray, times0: np.ndarray,
+                      d: float) -> list[tuple[np.ndarray, np.ndarray] | None]:
+    """:func:`solve_times` for many periods ``T`` ``(B,)`` and starting impact times ``times0`` ``(B, k)``:
+    the Newton iterations of all of them vectorised, Levenberg–Marquardt one by one where Newton fails.
+
+    >>> from bladecase.nsm import chain
+    >>> s2 = chain(2, k=1.0, m=0.5, gap=1.0)
+    >>> sols = solve_times_stack(s2, np.array([13.5, 13.5]), np.array([[6.0, 13.5], [6.7, 13.5]]), 1.0)
+    >>> [round(float(t[0]), 4) for t, _ in sols]
+    [6.0829, 6.75]
+    """
+    omega, b, _ = system.spectrum.contact_modes
+    T = np.asarray(T, dtype=float)
+    times0 = np.asarray(times0, dtype=float)
+    count, k = times0.shape
+    out: list[tuple[np.ndarray, np.ndarray] | None] = [None] * count
+    if count == 0:
+        return out
+    Sigma = -impact_kernels(omega, b, times0, T=T)[0]
+    lam0 = lstsq_stack(Sigma, np.full((count, k), d), rcond=1e-12)
+    start = np.flatnonzero(np.all(np.isfinite(lam0), axis=1))
+    times, lam, ok = _newton_stack(omega, b, T[start], times0[start], lam0[start], d)
+    for j, i in enumerate(start):
+        if ok[j]:
+            out[i] = (times[j], lam[j])
+            continue
+        try:
+            out[i] = _levenberg_marquardt(ModalKernel.of(system, T[i]), times0[i], lam0[i], d)
+        except ValueError:
+            pass  # the residual is not finite at the start: no solution from there
+    return out
+
+
+def _newton_stack(omega, b, T, times, lam, d, maxiter: int = 12):
+    """:func:`newton_times` vectorised over many periods: ``(times, Λ, converged)``."""
+    count, k = times.shape
+    times, lam = times.copy(), lam.copy()
+    prev = np.full(count, np.inf)
+    live = np.ones(count, dtype=bool)
+    failed = np.zeros(count, dtype=bool)
+    for _ in range(maxiter):
+        rows = np.flatnonzero(live)
+        if rows.size == 0:
+            break
+        r, J = _residual_jacobian_stack(omega, b, T[rows], times[rows], lam[rows], d)
+        step = lstsq_stack(J, -r)
+        times[rows, : k - 1] += step[:, : k - 1]
+        lam[rows] += step[:, k - 1:]
+        size = (np.abs(step[:, : k - 1]).max(axis=1, initial=0.0) / T[rows]
+                + np.abs(step[:, k - 1:]).max(axis=1) / np.maximum(np.abs(lam[rows]).max(axis=1), d))
+        bad = ~np.all(np.isfinite(step), axis=1) | (size > 10 * prev[rows])
+        failed[rows[bad]] = True
+        live[rows[bad | (size < 1e-14)]] = False
+        prev[rows] = size
+    gaps = np.diff(np.concatenate([np.zeros((count, 1)), times], axis=1), axis=1)
+    ok = ~failed & np.all(gaps > DISTINCT_RTOL * T[:, None], axis=1)
+    rows = np.flatnonzero(ok)
+    if rows.size:
+        r = _residual_jacobian_stack(omega, b, T[rows], times[rows], lam[rows], d, jacobian=False)[0]
+        scale = float(b @ b) / 2 * np.abs(lam[rows]).max(axis=1)
+        ok[rows] = ((np.abs(r[:, :k]).max(axis=1) <= 1e-9 * np.maximum(scale, d))
+                    & (np.abs(r[:, k:]).max(axis=1) <= 1e-9 * d))
+    return times, lam, ok

@@ -4,6 +4,11 @@ Newton contact: every k-ipp family started from the orbits found at ``scan`` per
 (:func:`~bladecase.nsm.kipp.orbits_kipp`) and followed by continuation (:mod:`~bladecase.nsm.families`);
 ``k = 1`` is a scan (:func:`~bladecase.nsm.scan.backbone`). Massless contact: the branches grown from the
 open-phase modes at grazing (:mod:`~bladecase.nsm.massless_branches`). All are :class:`~bladecase.nsm.Branch` es.
+
+The k-ipp search, in this module: the families of many starts traced together in start order, a start skipped
+when an earlier family passes it — each crossing of a family with a scan period solved once and the starts
+matched by lookup (:func:`starts_passed`) — and, by geometry (:func:`on_curve`), each stretch of a branch
+listed once (:func:`distinct_runs`; a family lying on another is dropped).
 """
 
 from __future__ import annotations
@@ -12,14 +17,34 @@ import numpy as np
 
 from ..progress import progress_bar, progress_counter
 from .branches import Arc, Branch
-from .families import follow_family, passes
-from .kipp import check_k, orbits_kipp
+from .families import FamilyTracer, KippCurve, complete_families
+from .kipp import canonical_rotation, check_k, orbits_kipp
+from .modal import ModalKernel, solve_times
+from .orbits import REPEAT_RTOL, PeriodicOrbit
 from .system import LinearSystem
 
 __all__ = ["MASSLESS_MIN_POINTS", "nonsmooth_mode"]
 
 #: Least point budget of a massless branch: its steps are short where the contact time grows fast.
 MASSLESS_MIN_POINTS = 4000
+
+#: A start orbit is only re-solved from a crossing segment of a followed curve
+#: when the interpolated impact times lie within ``PASS_GATE·T`` of its own
+#: (under every re-anchoring); farther crossings are other orbits of that period.
+PASS_GATE = 0.05
+
+#: Families traced at once (their continuation steps are vectorised together).
+TRACE_WINDOW = 64
+
+#: Two orbits at one period are the same when their canonically rotated impact times agree to ``SAME_RTOL·T``.
+SAME_RTOL = REPEAT_RTOL
+
+#: An orbit is only re-solved on a curve segment whose interpolated impact times lie within ``SAME_GATE·T``
+#: of its own (:func:`on_curve`).
+SAME_GATE = 1e-3
+
+#: Up to ``FOLD_GAP`` orbits between two repeated stretches of a family count as repeated (:func:`distinct_runs`).
+FOLD_GAP = 3
 
 
 def nonsmooth_mode(
@@ -70,8 +95,12 @@ def nonsmooth_mode(
     list of Branch
         Each family's orbits in curve order (all within ``T_range``), certified,
         with admissible arcs.  A family crossing a later scan period is not
-        started again there.  k = 1: the one 1-ipp branch (a scan of
-        ``max(scan, 200)`` periods, resonant points left out).
+        started again there.  Each stretch of a branch is listed once: a
+        family whose curve runs over a stretch a second time is cut there
+        (what it goes on to beyond is a family of its own unless it continues
+        an end), and a family whose orbits all lie on another one is dropped.
+        k = 1: the one 1-ipp branch (a scan of ``max(scan, 200)`` periods,
+        resonant points left out).
 
     Examples
     --------
@@ -104,17 +133,326 @@ def nonsmooth_mode(
         except ValueError:
             continue
         starts.extend((T, o) for o in sols if o.repeats == 1)
-    families: list[Branch] = []
-    covered = [False] * len(starts)
+    return _follow_starts(system, k, starts, (T_lo, T_hi), step, max_points, refine, progress)
+
+
+def _follow_starts(system: LinearSystem, k: int, starts: list[tuple[float, PeriodicOrbit]], T_range, step: float,
+                   max_points: int, refine: bool, progress: bool) -> list[Branch]:
+    """The family of every start not passed by the family of an earlier start, in the order of the starts,
+    each branch listed once.
+
+    Up to ``TRACE_WINDOW`` families are traced at once (:class:`~bladecase.nsm.families.FamilyTracer`); they
+    are taken in the order of their starts: the first unresolved start whose family is traced is kept and
+    marks the later starts its curve passes (:func:`starts_passed`), whose traces, if begun, are dropped: the
+    same families as following the starts one by one.  Then, by geometry: a stretch a family's curve traces a
+    second time is left out (the family is cut there, :func:`distinct_runs`), and a family whose orbits all
+    lie on another family (one passing its start) is dropped (:func:`on_curve`).
+    """
+    tracer = FamilyTracer(system, k, T_range, step, max_points)
+    index = _StartIndex(starts)
+    covered = np.zeros(len(starts), dtype=bool)
+    kept = np.zeros(len(starts), dtype=bool)
+    running: set[int] = set()
+    families: dict[int, list] = {}  # start → its family's stretches (FollowedFamily)
+    same: list[tuple[int, int]] = []  # (earlier start, later start) whose families share the earlier start
+    todo: list = []
+    launched = resolved = 0
     with progress_counter(len(starts), f"{k}-ipp families", enabled=progress, unit="start") as bar:
-        for n, (_, o) in enumerate(starts):
-            bar.update()
-            if covered[n]:
-                continue
-            fam = follow_family(system, k, o, (T_lo, T_hi), step, max_points, refine)
-            for m in range(n + 1, len(starts)):
-                if not covered[m] and passes(fam.problem, fam.points, starts[m]):
-                    covered[m] = True
-            families.append(Branch(system=system, k=k, orbits=fam.orbits, arcs=[Arc(*a) for a in fam.arcs]))
-            bar.set_postfix_str(f"{len(families)} families, {sum(1 for f in families if f.arcs)} with arcs")
-    return families
+        while resolved < len(starts):
+            new = []
+            busy = tracer.run.running.size // 2  # families still being traced (two directions each)
+            while launched < len(starts) and busy + len(new) < TRACE_WINDOW and launched - resolved < 8 * TRACE_WINDOW:
+                if not covered[launched]:
+                    new.append(launched)
+                launched += 1
+            tracer.add(new, [starts[n][1] for n in new])
+            running.update(new)
+            while resolved < len(starts) and (covered[resolved] or (resolved in running and tracer.done(resolved))):
+                n = resolved
+                resolved += 1
+                bar.update()
+                if covered[n]:
+                    if n in running:
+                        running.discard(n)
+                        tracer.cancel(n)
+                    continue
+                running.discard(n)
+                problem, zs = tracer.result(n)
+                wanted = kept.copy()  # the earlier families' starts (the same branch?) and the later starts left
+                wanted[n + 1:] = ~covered[n + 1:]
+                passed = np.array(_passed(problem, zs, index, wanted), dtype=int)
+                covered[passed[passed > n]] = True
+                same.extend((int(m), n) for m in passed[passed < n])
+                kept[n] = True
+                todo.append((n, (problem, zs)))
+            if len(todo) >= TRACE_WINDOW or (todo and resolved == len(starts)):
+                done = complete_families([t for _, t in todo], T_range, refine, distinct_runs)
+                families.update((n, pieces) for (n, _), pieces in zip(todo, done))
+                todo = []
+                bar.set_postfix_str(f"{len(families)} families")
+            if resolved < len(starts):
+                tracer.step()
+    _contained(families, same)
+    return [Branch(system=system, k=k, orbits=f.orbits, arcs=[Arc(*a) for a in f.arcs])
+            for n in sorted(families) for f in families[n] if f.orbits]
+
+
+def _contained(families: dict[int, list], pairs: list[tuple[int, int]]) -> None:
+    """Drop from ``families`` (start → stretches) each stretch of one of two families through a common orbit
+    (``pairs``) whose orbits all lie on the other family: of two identical stretches, the earlier family's."""
+    for m, n in pairs:
+        for a, b in ((m, n), (n, m)):
+            if a in families and b in families:
+                families[a] = [f for f in families[a] if not (f.orbits and _all_on(families[b], f.orbits))]
+
+
+def _all_on(pieces: list, orbits: list[PeriodicOrbit]) -> bool:
+    """Do all ``orbits`` lie on the stretches ``pieces`` of a family (:func:`on_curve`)?"""
+    curves = [f.orbits for f in pieces if len(f.orbits) >= 2]
+    T = [o.T for o in orbits]
+    if not curves or min(T) < min(o.T for c in curves for o in c) or max(T) > max(o.T for c in curves for o in c):
+        return False  # outside the family's period range
+    close = np.zeros(len(orbits), dtype=bool)
+    for c in curves:
+        close |= _near(c, orbits)[0].any(axis=1)
+    if not close.all():
+        return False  # some orbit is not even close to the family: no need to solve
+    n = len(orbits)
+    for i in [0, n - 1, *range(1, n - 1)]:  # the ends first: where a stretch would stick out
+        if not any(_matches(c, [orbits[i]])[0] >= 0 for c in curves):
+            return False
+    return True
+
+
+def distinct_runs(orbits: list[PeriodicOrbit]) -> list[list[int]]:
+    """The branches in a family's ``orbits`` (in curve order), each as index runs in curve order, with each
+    stretch of the curve listed once.
+
+    A run of at least two orbits lying on segments of the curve listed before them (two points back or more,
+    :func:`on_curve`) repeats a stretch already listed, and is left out (so are up to ``FOLD_GAP`` orbits
+    between two such runs) — unless one of them is admissible on a segment between two orbits that are not
+    (the arc it belongs to is not seen on the first pass).  Where a repetition ends at an end of a run
+    already kept and the curve goes on, what follows continues that run beyond its end and is joined to it;
+    elsewhere it starts a new run.
+
+    >>> from bladecase.nsm import chain, orbits_kipp
+    >>> o = orbits_kipp(chain(2, k=1.0, m=0.5, gap=1.0), 13.5, 2)[1]
+    >>> distinct_runs([o])
+    [[0]]
+    """
+    n = len(orbits)
+    if n < 4:
+        return [list(range(n))] if n else []
+    i, j = np.arange(n)[:, None], np.arange(n - 1)[None, :]
+    where = _matches(orbits, orbits, allowed=j + 1 <= i - 2)
+    again = where >= 0
+    pair = again[:-1] & again[1:]
+    again &= np.concatenate([pair, [False]]) | np.concatenate([[False], pair])  # runs of two or more
+    adm = np.array([o.admissible for o in orbits])
+    seen = adm[np.maximum(where, 0)] | adm[np.minimum(np.maximum(where, 0) + 1, n - 1)]
+    for a, b in zip(*_true_runs(again)):  # an admissible orbit between two that are not: its arc is only here
+        if (adm[a:b] & ~seen[a:b]).any():
+            again[a:b] = False
+    marked = np.flatnonzero(again)
+    for a, b in zip(marked[:-1], marked[1:]):
+        if 1 < b - a <= FOLD_GAP + 1:  # a short gap between repetitions: the tip of a fold, beyond the
+            again[a + 1: b] = True  # periods the earlier segments bracket
+    runs: list[list[int]] = []
+    for a, b in zip(*_true_runs(~again)):
+        q = a - 1  # the segment where the repetition before this run left the curve already listed
+        while q >= 0 and again[q] and where[q] < 0:
+            q -= 1
+        runs.append(_joined(runs, list(range(a, b)), int(where[q]) if q >= 0 and again[q] else None))
+    return [r for r in runs if r]
+
+
+def _true_runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Starts and (exclusive) ends of the runs of ``True`` in ``mask``."""
+    edges = np.diff(np.concatenate([[0], mask.astype(int), [0]]))
+    return np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+
+
+def _joined(runs: list[list[int]], block: list[int], exit_: int | None) -> list[int]:
+    """Add ``block`` (consecutive orbits) to ``runs``: after the end or before the start of the run whose end
+    segment the repetition before it left from (``exit_``: segment ``(j, j+1)``), else as a run of its own;
+    returns what to append to ``runs`` (empty when joined)."""
+    if exit_ is not None:
+        for r in runs:
+            if len(r) >= 2 and exit_ in (r[0], r[1], r[0] - 1) and r[1] == r[0] + 1:
+                r[:0] = block[::-1]  # went back along r and on past its start
+                return []
+            if len(r) >= 2 and exit_ in (r[-2], r[-1] - 1, r[-1]) and r[-1] == r[-2] + 1:
+                r.extend(block)  # went along r and on past its end
+                return []
+    return block
+
+
+def _canonical(orbits: list[PeriodicOrbit]) -> np.ndarray:
+    """``(n, k)``: each orbit's period, then its canonically rotated impact times ``t₁ … t_{k-1}`` over ``T``."""
+    out = np.empty((len(orbits), orbits[0].k))
+    out[:, 0] = [o.T for o in orbits]
+    if orbits[0].k == 2:  # the rotations of (t₁, T) are (t₁, T) and (T - t₁, T): the smaller first time
+        t1 = np.array([o.impact_times[0] for o in orbits]) / out[:, 0]
+        out[:, 1] = np.minimum(t1, 1 - t1)
+        return out
+    for i, o in enumerate(orbits):
+        out[i, 1:] = canonical_rotation(o.impact_times, o.impulses, o.T)[0][:-1] / o.T
+    return out
+
+
+def on_curve(curve: list[PeriodicOrbit], orbits: list[PeriodicOrbit], allowed: np.ndarray | None = None) -> np.ndarray:
+    """Which of ``orbits`` are orbits of the branch through ``curve`` (consecutive orbits of one family).
+
+    An orbit is one when a segment of ``curve`` (``allowed[i, j]``: may orbit ``i`` be matched on segment
+    ``j``) brackets its period with interpolated (canonically rotated) impact times near its own (within
+    ``SAME_GATE·T`` plus the segment's length) and, re-solved at its period from there
+    (:func:`~bladecase.nsm.modal.solve_times`), gives its impact times to ``SAME_RTOL·T``: the same orbit,
+    whatever the points the two families were sampled at.
+
+    >>> from bladecase.nsm import chain, nonsmooth_mode
+    >>> fam = nonsmooth_mode(chain(2, k=1.0, m=0.5, gap=1.0), 2, (13.2, 13.75), scan=2)[0]
+    >>> on_curve(fam.orbits[::2], fam.orbits[1:-1:2]).all()      # every other point lies on the curve of the rest
+    np.True_
+    """
+    return _matches(curve, orbits, allowed) >= 0
+
+
+def _near(curve: list[PeriodicOrbit], orbits: list[PeriodicOrbit], allowed: np.ndarray | None = None):
+    """The segments of ``curve`` worth re-solving each orbit on (:func:`on_curve`): ``(near, guess, dist, Q)``
+    with ``near[i, j]`` true when segment ``j`` brackets orbit ``i``'s period with interpolated canonical
+    times ``guess[i, j]`` at ``dist[i, j]`` from its own ``Q[i, 1:]`` within the gate."""
+    P, Q = _canonical(curve), _canonical(orbits)
+    Ta, Tb, T = P[:-1, 0], P[1:, 0], Q[:, :1]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        a = (T - Ta) / (Tb - Ta)
+    inside = (a >= 0) & (a <= 1) & (Ta != Tb)
+    if allowed is not None:
+        inside &= allowed
+    guess = P[:-1, 1:] + a[:, :, None] * (P[1:, 1:] - P[:-1, 1:])
+    dist = np.where(inside, np.abs(guess - Q[:, None, 1:]).max(axis=2), np.inf)
+    step = np.abs(P[1:] - P[:-1])
+    gate = SAME_GATE + np.maximum(step[:, 0] / P[1:, 0], step[:, 1:].max(axis=1))  # a chord strays from the curve
+    return dist <= gate[None, :], guess, dist, Q  # by a fraction of its length
+
+
+def _matches(curve: list[PeriodicOrbit], orbits: list[PeriodicOrbit], allowed: np.ndarray | None = None
+             ) -> np.ndarray:
+    """:func:`on_curve`, as the segment of ``curve`` each orbit lies on (``-1``: none)."""
+    hit = np.full(len(orbits), -1)
+    if len(curve) < 2 or not orbits:
+        return hit
+    near, guess, dist, Q = _near(curve, orbits, allowed)
+    system = curve[0].system
+    for i in np.flatnonzero(near.any(axis=1)):
+        Ti = Q[i, 0]
+        md = ModalKernel.of(system, Ti)
+        for j in np.flatnonzero(near[i])[np.argsort(dist[i, near[i]])]:
+            sol = solve_times(md, np.append(guess[i, j], 1.0) * Ti, system.gap)
+            if sol is not None and np.abs(canonical_rotation(sol[0], sol[1], Ti)[0][:-1] / Ti - Q[i, 1:]).max() \
+                    <= SAME_RTOL:
+                hit[i] = j
+                break
+    return hit
+
+
+class _StartIndex:
+    """The start orbits of each scan period sorted by their first impact time, to find those near given
+    impact times without looking at the others."""
+
+    def __init__(self, starts: list[tuple[float, PeriodicOrbit]]):
+        groups: dict[float, list[int]] = {}
+        for n, (T, _) in enumerate(starts):
+            groups.setdefault(float(T), []).append(n)
+        self.periods = np.array(list(groups), dtype=float)
+        self.groups = []
+        for members in groups.values():
+            refs = np.array([starts[m][1].impact_times for m in members])
+            order = np.argsort(refs[:, 0], kind="stable")
+            self.groups.append((np.array(members)[order], refs[order]))
+
+    def near(self, g: int, guess: np.ndarray, T: float) -> tuple[np.ndarray, np.ndarray]:
+        """The starts of period ``g`` (indices and impact times) within ``PASS_GATE·T`` of the impact times
+        ``guess`` under some re-anchoring (:func:`phase_distances`)."""
+        members, refs = self.groups[g]
+        shifted = np.mod(guess[None, :] - guess[:, None], T)
+        shifted[shifted == 0] = T
+        first = np.sort(shifted, axis=1)[:, 0]  # each re-anchoring's first impact: within the gate of the start's
+        pad = PASS_GATE * T * (1 + 1e-9)
+        lo = np.searchsorted(refs[:, 0], first - pad, side="left")
+        hi = np.searchsorted(refs[:, 0], first + pad, side="right")
+        cand = np.unique(np.concatenate([np.arange(a, b) for a, b in zip(lo, hi)]))
+        if cand.size:
+            cand = cand[phase_distances(guess, refs[cand], T) <= PASS_GATE * T]
+        return members[cand], refs[cand]
+
+
+def _passed(problem: KippCurve, zs, index: _StartIndex, wanted: np.ndarray) -> list[int]:
+    """The ``wanted`` starts (a mask) that the polyline ``zs`` passes.
+
+    Each crossing of the polyline with a start period is solved once at that period (Newton from the
+    interpolated impact times) and the starts of that period are matched to the solution by their impact
+    times, looked up in ``index``: the cost is one fixed-``T`` solve per crossing, whatever the number of
+    starts.  A crossing is only solved when some start lies within ``PASS_GATE·T`` of its interpolated impacts
+    (under every re-anchoring); a start is passed when the solution, canonically rotated, has its impact
+    times to ``1e3·REPEAT_RTOL·T``.
+    """
+    if len(zs) < 2:
+        return []
+    Ts = np.array([problem.period(z) for z in zs])
+    lo, hi = np.minimum(Ts[:-1], Ts[1:]), np.maximum(Ts[:-1], Ts[1:])
+    crossings = []  # (period, interpolated impact times, the open starts near them, their impact times)
+    for g in np.flatnonzero((index.periods >= Ts.min()) & (index.periods <= Ts.max())):
+        T_s = float(index.periods[g])
+        for i in np.flatnonzero((lo <= T_s) & (T_s <= hi) & (hi > lo)):
+            a = (T_s - Ts[i]) / (Ts[i + 1] - Ts[i])
+            ta, tb = problem.times(zs[i])[1], problem.times(zs[i + 1])[1]
+            guess = ((1 - a) * ta / Ts[i] + a * tb / Ts[i + 1]) * T_s
+            members, refs = index.near(g, guess, T_s)
+            open_ = wanted[members]
+            if open_.any():  # else no start is left near the interpolated impacts: no need to solve
+                crossings.append((T_s, guess, members[open_], refs[open_]))
+    if not crossings:
+        return []
+    passed: set[int] = set()
+    for T_s, guess, members, refs in crossings:
+        sol = solve_times(ModalKernel.of(problem.system, T_s), guess, problem.d)
+        if sol is not None:
+            passed.update(members[_distances(sol, refs, T_s) <= 1e3 * REPEAT_RTOL * T_s].tolist())
+    return sorted(passed)
+
+
+def _distances(sol: tuple[np.ndarray, np.ndarray], refs: np.ndarray, T: float) -> np.ndarray:
+    """Largest impact-time difference between the solution (canonically rotated) and each row of ``refs``."""
+    times, _ = canonical_rotation(sol[0], sol[1], T)
+    return np.abs(refs - times[None, :]).max(axis=1)
+
+
+def phase_distance(times: np.ndarray, reference: np.ndarray, T: float) -> float:
+    """``min`` over re-anchorings of ``times`` (shift by each ``t_r``) of the largest
+    distance to ``reference`` (both sets of ``k`` impact times in ``(0, T]``).
+
+    >>> phase_distance(np.array([3.0, 10.0]), np.array([7.0, 10.0]), 10.0)    # the same orbit, re-anchored
+    0.0
+    """
+    return float(phase_distances(times, np.asarray(reference)[None, :], T)[0])
+
+
+def phase_distances(times: np.ndarray, references: np.ndarray, T: float) -> np.ndarray:
+    """:func:`phase_distance` of ``times`` to each row of ``references`` (shape ``(c, k)``), vectorised."""
+    shifted = np.mod(times[None, :] - times[:, None], T)  # row r: re-anchored at impact r
+    shifted[shifted == 0] = T
+    shifted.sort(axis=1)
+    refs = np.sort(references, axis=1)
+    return np.abs(shifted[None, :, :] - refs[:, None, :]).max(axis=2).min(axis=1)
+
+
+def passes(problem: KippCurve, zs, start: tuple[float, PeriodicOrbit]) -> bool:
+    """Does the polyline ``zs`` cross the start orbit (same period, same impacts)?"""
+    return bool(starts_passed(problem, zs, [start]))
+
+
+def starts_passed(problem: KippCurve, zs, starts: list[tuple[float, PeriodicOrbit]]) -> list[int]:
+    """Indices of the ``starts`` (``(T, orbit)`` pairs) that the polyline ``zs`` crosses (same period, same
+    impacts): each crossing of a start period solved once, the starts matched by lookup (see :func:`_passed`).
+    """
+    return _passed(problem, zs, _StartIndex(starts), np.ones(len(starts), dtype=bool)) if starts else []
