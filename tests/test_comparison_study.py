@@ -67,3 +67,22 @@ def test_face_weights_key():
         loads(PLATE.replace("clearance = 1e-4", 'clearance = 1e-4\nface = "tip"\nweights = "mass"'), base=ROOT)
     study = loads(PLATE.replace("clearance = 1e-4", 'clearance = 1e-4\nface = "tip"\nweights = "area"'), base=ROOT)
     assert study["contact"]["weights"] == "area"
+
+
+def test_reference_model_is_a_row_of_the_comparison(tmp_path):
+    """The reference model of the verification (4 × the size, another method) goes through the same search
+    and gets its row, its families in modes.json and its place in the report."""
+    text = PLATE.replace('method = "modal"\nsize = 10\n', 'method = "modal"\nsize = 10\nmethods = ["lanczos-si"]\n'
+                         'sizes = [6]\n') + '\n[output]\nformats = []\nanimate = 0\n'
+    result = run(loads(text, base=ROOT), out=tmp_path / "out", progress=False)
+    names = list(result.models)
+    assert names == ["modal-10", "lanczos-si-6", "craig-bampton-40 (reference)"]
+    ref = result.models["craig-bampton-40 (reference)"]
+    assert ref.reduced.n == 42 and ref.search_s > 0  # 40 fixed-interface modes + the 2 contact dofs and ref.build_s > 0
+    assert result.comparison["model"] == ["FE", *names]
+    row = dict(zip(result.comparison, [c[-1] for c in result.comparison.values()]))
+    # 40 Craig–Bampton dofs keep the plate's contact statics and first modes almost exactly
+    assert row["static_compliance_kept"] == pytest.approx(1.0, abs=0.02)
+    doc = json.loads((result.directory / "modes.json").read_text())
+    assert [c["model"] for c in doc["compare"]] == names[1:]
+    assert "craig-bampton-40 (reference)" in (result.directory / "report.md").read_text()

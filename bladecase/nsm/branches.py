@@ -403,9 +403,10 @@ class Branch:
             lines.append(f"no admissible arc: no admissible {k}-ipp orbit in the {self.source}")
         return "\n".join(lines)
 
-    def stability(self, tol: float | None = None) -> np.ma.MaskedArray:
+    def stability(self, tol: float | None = None, where=None) -> np.ma.MaskedArray:
         """Floquet verdict of every point: ``True`` (linearly stable) / ``False``, masked where there is no orbit
-        or no verdict (:func:`~bladecase.nsm.floquet.branch_stability`; saltation matrices at impacts).
+        or no verdict (:func:`~bladecase.nsm.floquet.branch_stability`; saltation matrices at impacts);
+        ``where``: only these points (e.g. ``branch.admissible``), the others masked.
 
         >>> from bladecase.nsm import backbone, chain
         >>> branch = backbone(chain(2, k=1.0, m=0.5, gap=1.0), np.linspace(6.0, 7.0, 5))
@@ -414,7 +415,7 @@ class Branch:
         """
         from .floquet import FLOQUET_TOL, branch_stability
 
-        return branch_stability(self, FLOQUET_TOL if tol is None else tol)
+        return branch_stability(self, FLOQUET_TOL if tol is None else tol, where)
 
     def plot(self, ax=None, **kwargs):
         """Frequency–energy plot (see :func:`bladecase.post.plots.frequency_energy`)."""

@@ -250,9 +250,11 @@ def floquet(orbit, tol: float = FLOQUET_TOL) -> Floquet:
     return Floquet(monodromy, multipliers, trivial, max_modulus, stable, verdict, tol)
 
 
-def branch_stability(branch, tol: float = FLOQUET_TOL) -> np.ma.MaskedArray:
+def branch_stability(branch, tol: float = FLOQUET_TOL, where=None) -> np.ma.MaskedArray:
     """Floquet stability of every orbit of a branch: a masked bool array, masked where there is no orbit
     (``None``, e.g. a resonant scan point) or where the multipliers are undefined (a grazing impact).
+    ``where`` (bool per point, optional): only these points are analysed, the others are masked (e.g.
+    ``branch.admissible`` for a plot of the admissible arcs).
 
     >>> from bladecase.nsm import backbone, chain
     >>> branch = backbone(chain(2, k=1.0, m=0.5, gap=1.0), [6.6, 7.0, 2 * np.pi / np.sqrt(3 - np.sqrt(5))])
@@ -261,6 +263,12 @@ def branch_stability(branch, tol: float = FLOQUET_TOL) -> np.ma.MaskedArray:
     """
     tol = _check_tol(tol)
     orbits = list(branch.orbits)
+    if where is not None:
+        where = np.asarray(where, dtype=bool)
+        if where.shape != (len(orbits),):
+            raise ValueError(f"where must hold one bool per point of the branch ({len(orbits)}), got shape "
+                             f"{where.shape}")
+        orbits = [o if w else None for o, w in zip(orbits, where)]
     out = np.zeros(len(orbits), dtype=bool)
     mask = np.ones(len(orbits), dtype=bool)
     failed = []

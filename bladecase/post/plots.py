@@ -181,7 +181,7 @@ def _narrow_arcs(ax, backbones, fmin: float, fmax: float, labelled: set) -> None
 
 def _stability_curves(ax, bb, f, E, adm, c, labelled: set) -> None:
     """Admissible points split by their Floquet verdict; each run keeps its neighbour so the curve is unbroken."""
-    st = bb.stability()
+    st = bb.stability(where=adm)
     stable = adm & ~np.ma.getmaskarray(st) & np.ma.filled(st, False).astype(bool)
     unstable = adm & ~stable
     for mask, ls, word in ((stable, "-", "stable"), (unstable, "--", "unstable")):

@@ -181,17 +181,25 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
                  np.round(mesh.points[contact.node], 6).tolist(), np.round(contact.normal_for(model), 6).tolist(),
                  contact.gap)
         log.info("reduced model: %s", reduced)
+        t0 = time.perf_counter()
         reference = reference_model(model, contact, reduced, factor) if o["reference"] else None
+        build_s.append(time.perf_counter() - t0)
         if reference is not None:
             log.info("reference model for the orbits' check: %s", reference)
+        # a comparison study compares the reference of the verification too, through the same search
+        known = {(r.method, r.size) for r in [reduced, *compares]}
+        extra = compares and reference is not None and (reference.method, reference.size) not in known
+        searched = [reduced, *compares, *([reference] if extra else [])]
     with stage("search"):
         unit, _ = period_unit(study, reduced.system)
         timed = executor.map(lambda r: _timed(search, study, r.system, progress=progress, unit=unit,
-                                              label=f"{r.method} {r.size} ({r.n} dofs)"), [reduced, *compares],
+                                              label=f"{r.method} {r.size} ({r.n} dofs)"), searched,
                              desc="models", progress=progress)
         found = [f for f, _ in timed]
-        families, compare_families = found[0], found[1:]
-        models = [ModelResult(r, fams, b, t) for r, fams, b, (_, t) in zip([reduced, *compares], found, build_s, timed)]
+        families, compare_families = found[0], found[1:1 + len(compares)]
+        names = [None] * (1 + len(compares)) + ([f"{reference.method}-{reference.size} (reference)"] if extra else [])
+        models = [ModelResult(r, fams, b, t, name) for r, fams, b, (_, t), name in
+                  zip(searched, found, build_s, timed, names)]
         document = families_document(families, reduced.system)
         if compares:  # every model's families are kept
             document["compare"] = [dict(model=m.name, **families_document(m.branches, m.reduced.system))

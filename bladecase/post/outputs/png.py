@@ -1,4 +1,5 @@
-"""``png``: the frequency–energy plot of every model of a run, one panel per model (``frequency_energy.png``)."""
+"""``png``: the frequency–energy plot of every model of a run, one panel per model (``frequency_energy.png``);
+admissible arcs solid where Floquet-stable, dashed where unstable."""
 
 from __future__ import annotations
 
@@ -16,7 +17,7 @@ def write(scene: PlotScene, folder: Path, formats: set[str]) -> dict[str, str]:
     for ax, (label, branches) in zip(axes, scene.models):
         title = f"{scene.title}: {label}"
         if branches:
-            frequency_energy(branches, ax=ax, title=title, time_unit="s", energy_unit="J")
+            frequency_energy(branches, ax=ax, title=title, time_unit="s", energy_unit="J", stability=True)
         else:
             ax.set_title(title + ": no family found")
         lo, hi = ax.get_xlim()
