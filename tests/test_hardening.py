@@ -412,3 +412,22 @@ def test_random_arrays_give_a_system_or_one_line():
         assert np.all(np.isfinite(s.spectrum.omega)) and s.spectrum.omega.min() > 0
         assert 1e-80 <= s.gap <= 1e80
     assert built >= 2  # valid systems among the random ones (seeded)
+
+
+def test_an_eigen_solution_out_of_proportion_is_refused_or_announced(caplog):
+    """`modal size = 2000` on a 7k-dof blade ran for minutes in silence: the study estimates the ARPACK work
+    (n·k² at the measured rate) and warns with the estimate, or refuses with the largest valid size."""
+    from bladecase.study.schema import StudyError
+    from bladecase.study.stages import _check_eigen_work
+
+    with caplog.at_level("WARNING", logger="bladecase"):
+        _check_eigen_work("modal", 2000, 7000)  # ~336 s: runs, with the estimate in words
+    assert re.search(r"modal 2000 on 7000 dofs: 2000 eigenmodes, estimated 3\d\d s", caplog.text)
+    with pytest.raises(StudyError, match=r"\[reduction\] size: craig-bampton 20000 on 50000 dofs needs 20000 "
+                                         r"eigenmodes, estimated 6\d\.\d h; valid: at most 2449 for this model"):
+        _check_eigen_work("craig-bampton", 20000, 50000)
+    caplog.clear()
+    with caplog.at_level("WARNING", logger="bladecase"):
+        _check_eigen_work("modal", 2000, 2500)  # dense below DENSE_LIMIT: seconds whatever the size
+        _check_eigen_work("modal", 50, 100_000)  # 3 s
+    assert caplog.text == ""
