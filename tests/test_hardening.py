@@ -431,3 +431,17 @@ def test_an_eigen_solution_out_of_proportion_is_refused_or_announced(caplog):
         _check_eigen_work("modal", 2000, 2500)  # dense below DENSE_LIMIT: seconds whatever the size
         _check_eigen_work("modal", 50, 100_000)  # 3 s
     assert caplog.text == ""
+
+
+def test_simulate_bounds_the_memory_of_its_stored_impacts():
+    """Each impact keeps its state (4 n floats); the default cap keeps them within 1 GB and says so."""
+    from bladecase.nsm.simulation import STATE_MEMORY_BYTES, default_max_impacts
+
+    assert default_max_impacts(200) * 32 * 200 <= STATE_MEMORY_BYTES < (default_max_impacts(200) + 1) * 32 * 200
+    assert default_max_impacts(1) == 1_000_000
+    s = bc.chain(2, k=1.0, m=0.5, gap=1.0)
+    o = bc.orbit_1ipp(s, 6.0)
+    x0, v0 = (z[:, 0] for z in o.state(0.0))
+    with pytest.warns(RuntimeWarning, match=r"max_impacts = 3 reached"):
+        tr = bc.simulate(s, x0, v0, 100.0, max_impacts=3)
+    assert tr.impact_times.size == 3 and not tr.complete and tr.t_end == pytest.approx(18.0, rel=1e-9)

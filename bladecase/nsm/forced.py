@@ -259,7 +259,7 @@ def simulate_forced(
     damping: Damping | None = None,
     load=None,
     restitution: float = 1.0,
-    max_impacts: int = 1_000_000,
+    max_impacts: int | None = None,
 ) -> ForcedTrajectory:
     """Integrate ``M x'' + C x' + K x = F₀ cos(2πt/T) f`` with impacts from ``(x0, v0)`` at ``t = 0``.
 
@@ -280,8 +280,9 @@ def simulate_forced(
         Load vector ``f``; ``None``: a unit force on every dof (the paper's "on every mass").
     restitution : float
         Newton coefficient ``e`` in ``(0, 1]``.
-    max_impacts : int
-        Safety stop (``complete = False``).
+    max_impacts : int or None
+        Safety stop (``complete = False``); default: the stored states fit in 1 GB
+        (:func:`bladecase.nsm.simulation.default_max_impacts`).
 
     Returns
     -------

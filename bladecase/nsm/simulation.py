@@ -22,7 +22,7 @@ from .flight import CONTACT_RTOL, FlightPropagator, ImpactLaw, ModalFlight, Newt
 from .signals import first_upcrossing
 from .system import LinearSystem
 
-__all__ = ["CONTACT_RTOL", "Trajectory", "integrate", "simulate"]
+__all__ = ["CONTACT_RTOL", "STATE_MEMORY_BYTES", "Trajectory", "default_max_impacts", "integrate", "simulate"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -133,13 +133,29 @@ def _next_impact(flight: FlightPropagator, q, p, t: float, t_end: float) -> floa
     return first_upcrossing(f, start, t_end - t) if start < t_end - t else None
 
 
+#: Memory the stored impact states of one simulation may take (bytes): every impact keeps its post-impact state
+#: twice (modal and physical coordinates, ``4 n`` floats), so the default ``max_impacts`` is
+#: ``min(1e6, STATE_MEMORY_BYTES / (32 n))`` — e.g. 156 000 impacts at ``n = 200``.
+STATE_MEMORY_BYTES = 1 << 30
+
+
+def default_max_impacts(n: int) -> int:
+    """The impacts whose states fit in :data:`STATE_MEMORY_BYTES` (at most a million) for ``n`` dofs.
+
+    >>> default_max_impacts(2), default_max_impacts(200)
+    (1000000, 167772)
+    """
+    return int(min(1_000_000, STATE_MEMORY_BYTES // (32 * max(int(n), 1))))
+
+
 def integrate(flight: FlightPropagator, impact: ImpactLaw, x0, v0, t_end: float,
-              max_impacts: int = 1_000_000, _stacklevel: int = 2) -> Trajectory:
+              max_impacts: int | None = None, _stacklevel: int = 2) -> Trajectory:
     """The event loop: fly with ``flight`` to the first contact, apply ``impact``, repeat until ``t_end``.
 
     ``(x0, v0)`` at ``t = 0`` must satisfy ``wᵀx0 <= d`` (up to the propagator's contact tolerance).
     Stops early (``complete = False``, with a ``RuntimeWarning``) when the state comes to rest on the obstacle
-    (where chattering with ``e < 1`` ends; the sticking phase is not modelled), after ``max_impacts`` impacts or when
+    (where chattering with ``e < 1`` ends; the sticking phase is not modelled), after ``max_impacts`` impacts
+    (default :func:`default_max_impacts`: the stored states stay within :data:`STATE_MEMORY_BYTES`) or when
     impacts accumulate (more than 50 flights shorter than ``1e-12`` of the time in a row).
     """
     system = flight.system
@@ -147,7 +163,8 @@ def integrate(flight: FlightPropagator, impact: ImpactLaw, x0, v0, t_end: float,
     t_end = float(t_end)
     if not np.isfinite(t_end) or t_end <= 0:
         raise ValueError(f"t_end must be finite and > 0, got {t_end!r}")
-    max_impacts = integer("max_impacts", max_impacts, 1)
+    bounded = max_impacts is None
+    max_impacts = default_max_impacts(system.n) if bounded else integer("max_impacts", max_impacts, 1)
     d = system.gap
     q0, p0 = flight.encode(x0, v0)
     tol0 = flight.contact_tol(q0)
@@ -183,7 +200,10 @@ def integrate(flight: FlightPropagator, impact: ImpactLaw, x0, v0, t_end: float,
         tiny_flights = tiny_flights + 1 if tau < 1e-12 * max(t, 1.0) else 0
         if len(times) >= max_impacts or tiny_flights > 50:
             complete = False
-            why = "max_impacts reached" if len(times) >= max_impacts else "impacts accumulate (chattering)"
+            why = "impacts accumulate (chattering)" if tiny_flights > 50 else (
+                f"max_impacts = {max_impacts} reached" + (f" (the states of that many impacts fill "
+                                                          f"{STATE_MEMORY_BYTES >> 20} MB: give max_impacts to go on)"
+                                                          if bounded else ""))
             warnings.warn(f"simulate stopped at t = {t:.6g} after {len(times)} impacts: {why}", RuntimeWarning,
                           stacklevel=_stacklevel)
             break
@@ -203,7 +223,7 @@ def simulate(
     v0,
     t_end: float,
     restitution: float = 1.0,
-    max_impacts: int = 1_000_000,
+    max_impacts: int | None = None,
 ) -> Trajectory:
     """Integrate the impacting system from ``(x0, v0)`` at ``t = 0`` to ``t_end``.
 
@@ -220,8 +240,9 @@ def simulate(
         Final time (> 0).
     restitution : float
         Newton coefficient ``e`` in ``(0, 1]``; ``e = 1`` conserves energy.
-    max_impacts : int
-        Safety stop; the result then has ``complete = False``.
+    max_impacts : int or None
+        Safety stop; the result then has ``complete = False``.  Default: as many impacts as the stored states
+        fit in 1 GB (:func:`default_max_impacts`: a million for small systems, 167 772 at 200 dofs).
 
     Returns
     -------
