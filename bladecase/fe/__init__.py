@@ -5,6 +5,9 @@ free dofs, the dof map) for the reduction layer.
 
 Modules: :mod:`~bladecase.fe.naca` (sections), :mod:`~bladecase.fe.geometry` (parametric blades,
 :func:`blade_mesh`), :mod:`~bladecase.fe.cad` (gmsh bodies), :mod:`~bladecase.fe.mesh` (:class:`Mesh`, files),
+:mod:`~bladecase.fe.cells` (accepted cell types: tetrahedra, hexahedra, wedges, triangles, quadrilaterals),
+:mod:`~bladecase.fe.groups` (named groups of mesh files), :mod:`~bladecase.fe.quality` (cell checks),
+:mod:`~bladecase.fe.select` (:func:`select_nodes`: nodes by group name or coordinates),
 :mod:`~bladecase.fe.material` (:class:`Material`, presets), :mod:`~bladecase.fe.model` (:class:`FEModel`,
 :class:`DofMap`), :mod:`~bladecase.fe.assembly` (:func:`assemble`), :mod:`~bladecase.fe.eigen`
 (:func:`natural_frequencies`, :func:`stiffness_factor`), :mod:`~bladecase.fe.storage` (stage files).
@@ -17,6 +20,7 @@ from .material import AL6061T6, INCONEL718, PRESETS, STEEL, TI6AL4V, Material
 from .mesh import Mesh, load_mesh, save_mesh
 from .model import DofMap, FEModel, node_operator
 from .naca import naca_parameters, naca_section
+from .select import select_nodes
 from .storage import load_model, model_from_arrays, model_to_arrays, save_model, sparse_from_arrays, sparse_to_arrays
 
 __all__ = [
@@ -24,5 +28,6 @@ __all__ = [
     "BladeGeometry", "DofMap", "FEModel", "Material", "Mesh", "PlateGeometry",
     "assemble", "blade_mesh", "cad_volume", "load_mesh", "load_model", "model_from_arrays", "model_to_arrays",
     "naca_parameters", "naca_section", "natural_frequencies", "node_operator", "save_mesh", "save_model",
+    "select_nodes",
     "sparse_from_arrays", "sparse_to_arrays", "stiffness_factor",
 ]

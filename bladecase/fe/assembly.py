@@ -1,17 +1,23 @@
 """Finite-element assembly: stiffness and mass of a clamped linear-elastic body from a :class:`~bladecase.fe.mesh.Mesh`.
 
-:func:`assemble` turns a simplex mesh (tetrahedra in 3-D, triangles in 2-D
-plane stress or plane strain) and a :class:`~bladecase.fe.material.Material`
+:func:`assemble` turns a mesh (tetrahedra, hexahedra or wedges in 3-D; triangles or
+quadrilaterals in 2-D plane stress or plane strain) and a :class:`~bladecase.fe.material.Material`
 into an :class:`~bladecase.fe.model.FEModel`: the sparse stiffness and mass
 matrices of linear elasticity with the clamped degrees of freedom removed
 (:func:`~bladecase.fe.eigen.natural_frequencies` then gives its lowest
 eigenfrequencies).
 
 The discretisation is scikit-fem's: the mesh's vertices make a
-``skfem.MeshTet``/``MeshTri`` (straight-sided cells; the extra nodes of
-``tetra10``/``triangle6`` cells are not used), the scalar Lagrange element
-``ElementTetP1/P2``/``ElementTriP1/P2`` gives the basis functions and the
-quadrature, ``skfem.models.elasticity.lame_parameters`` the Lamé constants.
+``skfem.MeshTet``/``MeshTri``/``MeshHex``/``MeshWedge1``/``MeshQuad`` (straight-sided,
+trilinear or prismatic cells; the extra nodes of second-order cells are not used),
+the scalar element of :data:`~bladecase.fe.cells.SKFEM_ELEMENTS` (``ElementTetP1/P2``,
+``ElementTriP1/P2``, ``ElementHex1``, ``ElementHexS2`` — ``ElementHex2`` on 27-node
+meshes —, ``ElementWedge1``, ``ElementQuad1``, ``ElementQuadS2`` — ``ElementQuad2`` on
+9-node meshes) gives the basis functions, ``skfem.models.elasticity.lame_parameters``
+the Lamé constants.  Simplices use scikit-fem's default quadrature; hexahedra and
+quadrilaterals the ``(p+1)``-point Gauss rule per direction (exact mass and stiffness
+on parallelepipeds), wedges a triangle × line product rule built here (scikit-fem
+12.0's wedge rule does not integrate the reference prism: weights summing to 1/4, not 1/2).
 The weak forms are those of ``skfem.models.elasticity.linear_elasticity``
 (``σ(u):ε(v)``) and of the mass ``ρ u·v`` on
 ``ElementVector(ElementTetP1/P2)``; they are integrated here by one batched
@@ -31,14 +37,19 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 import scipy.sparse as sp
+import skfem
 from scipy.sparse.csgraph import connected_components
-from skfem import CellBasis, ElementTetP1, ElementTetP2, ElementTriP1, ElementTriP2, MeshTet, MeshTri
+from skfem import CellBasis, ElementTetP1, ElementTetP2, ElementTriP1, ElementTriP2
+from skfem.quadrature import get_quadrature_line, get_quadrature_tri
 
 from ..checks import positive
+from .cells import KINDS, SKFEM_MESHES, element_name
 from .eigen import natural_frequencies
 from .material import AL6061T6, ALUMINIUM, INCONEL718, PLANE_KINDS, PRESETS, STEEL, TI6AL4V, Material
 from .mesh import Mesh
 from .model import DofMap, FEModel
+from .quality import corner_jacobians
+from .select import select_nodes
 from .storage import (
     MODEL_FORMAT,
     load_model,
@@ -68,8 +79,9 @@ CHUNK_CELLS = 4096
 #: A cell whose volume is below this fraction of the largest one is degenerate.
 DEGENERATE_RTOL = 1e-12
 
-Clamp = str | Sequence[int] | np.ndarray | Callable[[np.ndarray], np.ndarray] | None
+Clamp = str | dict | Sequence[int] | np.ndarray | Callable[[np.ndarray], np.ndarray] | None
 
+#: The simplex elements by (dim, order) (all elements: :data:`bladecase.fe.cells.SKFEM_ELEMENTS`).
 _ELEMENTS = {
     (3, 1): ElementTetP1, (3, 2): ElementTetP2,
     (2, 1): ElementTriP1, (2, 2): ElementTriP2,
@@ -90,24 +102,30 @@ def assemble(
     Parameters
     ----------
     mesh : Mesh
-        Tetrahedra (``dim == 3``) or triangles in the xy-plane (``dim == 2``);
-        quadratic cells (``tetra10``, ``triangle6``) contribute their vertices
-        only (straight-sided cells).
+        Tetrahedra, hexahedra or wedges (``dim == 3``), triangles or
+        quadrilaterals in the xy-plane (``dim == 2``); second-order cells
+        (``tetra10``, ``hexahedron20``, …) contribute their vertices only
+        (straight-sided cells).
     material : Material or str
         The material, or the name of a preset (:meth:`Material.preset`).
     order : {1, 2}
-        Lagrange element order: 2 (default; P2, accurate in bending) or 1
-        (P1, which locks in bending and needs fine meshes).
+        Element order: 2 (default; P2, serendipity or full quadratic
+        hexahedra and quadrilaterals, accurate in bending) or 1 (P1,
+        trilinear, bilinear, prismatic: they lock in bending and need fine
+        meshes).  Wedges have order 1 only (scikit-fem has no second-order
+        wedge).
     mass : {"consistent", "lumped"}
         Consistent mass, or lumped: row sum for P1, HRZ (diagonal scaled to
         the element mass, Hinton–Rock–Zienkiewicz 1976) for P2.  Both keep the
         total mass exactly.
-    clamp : str, sequence of int, callable or None
+    clamp : str, dict, sequence of int, callable or None
         Nodes whose displacements are fixed: a group name of ``mesh``
-        (default ``"root"``), mesh node indices (or a boolean mask over the
+        (default ``"root"``), a selection by coordinates (a dict of
+        :func:`~bladecase.fe.select.select_nodes`, e.g. ``{"plane": [0, 0,
+        0, 1, 0, 0]}``), mesh node indices (or a boolean mask over the
         nodes), or a function of the node coordinates ``(n, 3) -> (n,) bool``.
-        For P2, an edge dof is clamped when both end vertices are.  ``None``
-        gives the unclamped (free-free) model.
+        For order 2, an edge (face) dof is clamped when all the vertices of
+        its edge (face) are.  ``None`` gives the unclamped (free-free) model.
     thickness : float
         Out-of-plane thickness of a 2-D model (required, > 0); must be
         ``None`` in 3-D.
@@ -169,10 +187,7 @@ def assemble(
         raise ValueError(f"mesh.points must be a finite (n, 3) array, got shape {points.shape}")
     clamped = _clamp_nodes(mesh, points, clamp)
 
-    used, local = _body_cells(mesh, points, dim)
-    p = points[used, :dim].T
-    fe_mesh = (MeshTet if dim == 3 else MeshTri)(np.ascontiguousarray(p), np.ascontiguousarray(local.T))
-    basis = CellBasis(fe_mesh, _ELEMENTS[dim, order]())
+    basis, fe_mesh, used = _basis(mesh, points, dim, order)
     cell_volume = basis.dx.sum(axis=1)
     volume = float(cell_volume.sum())
     depth = thickness if dim == 2 else 1.0
@@ -191,11 +206,7 @@ def assemble(
     vertex_clamped = is_clamped[used]
     if clamp is not None and not vertex_clamped.any():
         raise ValueError(f"clamp {_describe(clamp)} selects no vertex of the body cells of mesh {mesh.source or ''}")
-    scalar_clamped = np.zeros(n_scalar, dtype=bool)
-    scalar_clamped[basis.nodal_dofs[0]] = vertex_clamped
-    if order == 2:
-        dofs2, ends = (basis.edge_dofs, fe_mesh.edges) if dim == 3 else (basis.facet_dofs, fe_mesh.facets)
-        scalar_clamped[dofs2[0]] = vertex_clamped[ends].all(axis=0)
+    scalar_clamped = _clamped_dofs(basis, fe_mesh, vertex_clamped)
 
     free = np.flatnonzero(~np.repeat(scalar_clamped, dim))
     scalar = free // dim
@@ -216,13 +227,49 @@ def assemble(
     )
 
 
+def _basis(mesh: Mesh, points: np.ndarray, dim: int, order: int):
+    """``(basis, fe_mesh, used)``: scikit-fem's basis on the straight body cells, its mesh, and the mesh node of
+    each of its vertices."""
+    body_type = mesh.body_type
+    kind = KINDS[body_type]
+    used, local = _body_cells(mesh, points, dim)
+    if kind.family in ("tetra", "triangle"):  # unchanged: scikit-fem's meshes and default quadrature
+        fe_mesh = getattr(skfem, SKFEM_MESHES[kind.family])(np.ascontiguousarray(points[used, :dim].T),
+                                                           np.ascontiguousarray(local.T))
+        return CellBasis(fe_mesh, _ELEMENTS[dim, order]()), fe_mesh, used
+    element = getattr(skfem, element_name(body_type, order))()
+    t = np.ascontiguousarray(local[:, list(kind.skfem_corners)].T)
+    fe_mesh = getattr(skfem, SKFEM_MESHES[kind.family])(np.ascontiguousarray(points[used, :dim].T), t)
+    if kind.family == "wedge":
+        X, W = get_quadrature_tri(2 * order + 1)
+        Z, V = get_quadrature_line(2 * order + 1)
+        quadrature = (np.vstack([np.tile(X, Z.shape[1]), np.repeat(Z, X.shape[1], axis=1)]), np.outer(V, W).ravel())
+        return CellBasis(fe_mesh, element, quadrature=quadrature), fe_mesh, used
+    return CellBasis(fe_mesh, element, intorder=2 * order + 1), fe_mesh, used
+
+
+def _clamped_dofs(basis: CellBasis, fe_mesh, vertex_clamped: np.ndarray) -> np.ndarray:
+    """Scalar dofs fixed by the clamped vertices: a vertex's, and an edge's (face's) when all its vertices are."""
+    clamped = np.zeros(basis.N, dtype=bool)
+    clamped[basis.nodal_dofs[0]] = vertex_clamped
+    elem = basis.elem
+    entities = [("facet_dofs", fe_mesh.facets)]
+    if fe_mesh.dim() == 3:
+        entities.insert(0, ("edge_dofs", fe_mesh.edges))
+    for name, ends in entities:
+        if getattr(elem, name, 0):
+            clamped[getattr(basis, name)[0]] = vertex_clamped[ends].all(axis=0)
+    return clamped
+
+
 def _body_cells(mesh: Mesh, points: np.ndarray, dim: int) -> tuple[np.ndarray, np.ndarray]:
     """``(used, local)``: the mesh nodes of the body cells (sorted) and the cells' corners numbered among them.
 
     Raises ``ValueError`` for cells referring to missing nodes, a 2-D mesh off
     the xy-plane, degenerate (zero-volume) cells.
     """
-    cells = np.asarray(mesh.cells[mesh.body_type])[:, : dim + 1].astype(np.int64)
+    kind = KINDS[mesh.body_type]
+    cells = np.asarray(mesh.cells[mesh.body_type])[:, : kind.corners].astype(np.int64)
     if cells.min() < 0 or cells.max() >= points.shape[0]:
         raise ValueError(f"mesh cells refer to nodes outside 0..{points.shape[0] - 1}")
     used, local = np.unique(cells, return_inverse=True)
@@ -230,8 +277,11 @@ def _body_cells(mesh: Mesh, points: np.ndarray, dim: int) -> tuple[np.ndarray, n
         scale = np.abs(points[used, :2]).max()
         if np.abs(points[used, 2]).max() > 1e-12 * max(scale, 1e-300):
             raise ValueError("a 2-D mesh must lie in the xy-plane (z = 0)")
-    corners = points[cells, :dim]
-    cell_volume = np.abs(np.linalg.det(corners[:, 1:] - corners[:, :1])) / math.factorial(dim)
+    if kind.family in ("tetra", "triangle"):
+        corners = points[cells, :dim]
+        cell_volume = np.abs(np.linalg.det(corners[:, 1:] - corners[:, :1])) / math.factorial(dim)
+    else:  # the largest corner Jacobian: zero for a cell collapsed to a point, a segment or a plane
+        cell_volume = np.abs(corner_jacobians(points, cells, kind.family)).max(axis=1)
     flat = cell_volume <= DEGENERATE_RTOL * cell_volume.max()
     if flat.any():
         i = int(np.flatnonzero(flat)[0])
@@ -242,7 +292,7 @@ def _body_cells(mesh: Mesh, points: np.ndarray, dim: int) -> tuple[np.ndarray, n
 
 
 def _describe(clamp) -> str:
-    if isinstance(clamp, str):
+    if isinstance(clamp, (str, dict)):
         return repr(clamp)
     if callable(clamp):
         return f"function {getattr(clamp, '__name__', repr(clamp))}"
@@ -258,6 +308,8 @@ def _clamp_nodes(mesh: Mesh, points: np.ndarray, clamp: Clamp) -> np.ndarray:
         nodes = np.asarray(mesh.group(clamp))
         if nodes.size == 0:
             raise ValueError(f"clamp group {clamp!r} of mesh {mesh.source or ''} is empty")
+    elif isinstance(clamp, dict):
+        nodes = select_nodes(mesh, clamp, what="clamp", allow_all=False)
     elif callable(clamp):
         mask = np.asarray(clamp(points.copy()))
         if mask.size != n:

@@ -18,7 +18,11 @@ from io import StringIO
 
 import numpy as np
 
+from .. import log
 from ..io import atomic_path, check_output_file
+from .cells import BODY_TYPES, BOUNDARY_TYPES, GMSH_WEDGE18, KINDS
+from .cells import cell_dim as _cell_dim
+from .groups import GROUP_PREFIX, file_groups
 from .quality import (  # noqa: F401  (the former home of these names)
     _P2_EDGES,
     DEGENERATE_RTOL,
@@ -27,22 +31,25 @@ from .quality import (  # noqa: F401  (the former home of these names)
     signed_measures,
 )
 
-#: meshio cell types accepted as the body of a model, by dimension and order.
+#: meshio simplex cell types accepted as the body of a model, by dimension and order (all accepted types:
+#: :data:`bladecase.fe.cells.BODY_TYPES`).
 VOLUME_TYPES = {3: {1: "tetra", 2: "tetra10"}, 2: {1: "triangle", 2: "triangle6"}}
 
 
 @dataclass(frozen=True, eq=False)
 class Mesh:
-    """A simplex mesh with named groups.
+    """A mesh of one body cell type with named groups.
 
     Attributes
     ----------
     points : (n_nodes, 3) float ndarray
         Node coordinates (``z = 0`` for planar meshes).
     cells : dict[str, ndarray]
-        Connectivity by meshio cell type (``"tetra"``, ``"tetra10"``,
-        ``"triangle"``, ``"triangle6"``, ``"line"``, ``"vertex"``, …), node
-        indices into ``points`` (0-based), gmsh/meshio node ordering.
+        Connectivity by meshio cell type: one body type (``"tetra"``, ``"tetra10"``,
+        ``"hexahedron"``, ``"hexahedron20"``, ``"hexahedron27"``, ``"wedge"``, ``"wedge15"``,
+        ``"wedge18"``; ``"triangle"``, ``"triangle6"``, ``"quad"``, ``"quad8"``, ``"quad9"`` in 2-D)
+        and boundary cells (``"triangle"``, ``"quad"``, …, ``"line"``, ``"vertex"``), node
+        indices into ``points`` (0-based), meshio (VTK) node ordering.
     dim : int
         2 (planar, plane stress) or 3 (solid).
     groups : dict[str, ndarray]
@@ -77,17 +84,17 @@ class Mesh:
 
     @property
     def body_type(self) -> str:
-        """The meshio type of the body cells (tetra/tetra10 in 3-D, triangle/triangle6 in 2-D)."""
-        for order in (2, 1):
-            t = VOLUME_TYPES[self.dim][order]
+        """The meshio type of the body cells (:data:`bladecase.fe.cells.BODY_TYPES` of ``dim``)."""
+        for t in BODY_TYPES.get(self.dim, ()):
             if t in self.cells and len(self.cells[t]):
                 return t
-        raise ValueError(f"mesh {self.source or ''} has no {self.dim}-D simplex cells")
+        raise ValueError(f"mesh {self.source or ''} has no {self.dim}-D body cells "
+                         f"({', '.join(BODY_TYPES.get(self.dim, ()))})")
 
     @property
     def order(self) -> int:
         """Geometric order of the body cells (1 or 2)."""
-        return 2 if self.body_type in ("tetra10", "triangle6") else 1
+        return KINDS[self.body_type].order
 
     def group(self, name: str) -> np.ndarray:
         """Node indices of group ``name``; ``ValueError`` naming the groups that exist."""
@@ -99,32 +106,18 @@ class Mesh:
 
 # ----------------------------------------------------------------------------- reading
 
-#: Prefix of the ``.vtu``/``.vtk`` point-data arrays that carry named node groups:
-#: ``group:root`` is a per-node mask (non-zero = in the group).
-GROUP_PREFIX = "group:"
 
 
 #: meshio simplex cell types by topological dimension.
 _SIMPLEX = {0: ("vertex",), 1: ("line", "line3"), 2: ("triangle", "triangle6"), 3: ("tetra", "tetra10")}
 _ALIASES = {"tetra4": "tetra"}  # meshio's name for Abaqus C3D4H
 
-#: Abaqus simplex element types missing from meshio 5.3's table (plane stress/strain).
+#: Abaqus element types missing from meshio 5.3's table (plane stress/strain, solids).
 _ABAQUS_EXTRA = {
     "CPS6": "triangle6", "CPS6M": "triangle6", "CPE3": "triangle", "CPE6M": "triangle6", "CPS3H": "triangle",
+    "CPE4": "quad", "CPE4R": "quad", "CPS8": "quad8", "CPS8R": "quad8", "CPE8": "quad8", "CPE8R": "quad8",
+    "C3D6H": "wedge", "C3D15H": "wedge15",
 }
-
-
-def _cell_dim(cell_type: str) -> int:
-    """Topological dimension of a meshio cell type (-1 if unknown)."""
-    if cell_type == "vertex":
-        return 0
-    if cell_type.startswith("line"):
-        return 1
-    if cell_type.startswith(("triangle", "quad", "polygon")):
-        return 2
-    if cell_type.startswith(("tetra", "hexahedron", "wedge", "pyramid", "polyhedron")):
-        return 3
-    return -1
 
 
 def load_mesh(path: str | os.PathLike, require: Sequence[str] = ()) -> Mesh:
@@ -181,7 +174,7 @@ def load_mesh(path: str | os.PathLike, require: Sequence[str] = ()) -> Mesh:
     """
     import meshio
 
-    _register_abaqus_types()
+    _register_types()
     source = str(path)
     # ".msh" is also an ANSYS suffix: name gmsh first, try ANSYS if gmsh fails.
     formats = ["gmsh", "ansys"] if source.lower().endswith(".msh") else [None]
@@ -208,24 +201,32 @@ def _read_quietly(meshio, path, file_format):
         return None, " ".join(filter(None, [text, said])) or type(exc).__name__
 
 
-def _register_abaqus_types() -> None:
-    """Teach meshio's Abaqus reader the simplex types it lacks (never overrides an entry)."""
+def _register_types() -> None:
+    """Teach meshio's Abaqus reader the types it lacks, and meshio 5.3 the dimension of the 15/18-node wedges
+    (its gmsh reader fails on them without it); never overrides an entry."""
+    from meshio import _mesh
     from meshio.abaqus import _abaqus
 
     for key, value in _ABAQUS_EXTRA.items():
         _abaqus.abaqus_to_meshio_type.setdefault(key, value)
+    for key in ("wedge15", "wedge18"):
+        _mesh.topological_dimension.setdefault(key, 3)
 
 
 def from_meshio(m, source: str = "", require: Sequence[str] = ()) -> Mesh:
     """Convert a ``meshio.Mesh`` to a checked :class:`Mesh`.
 
-    * **Dimension**: 3 if the mesh has ``tetra``/``tetra10`` cells, else 2 if it
-      has ``triangle``/``triangle6`` cells (which must then lie in ``z = 0``).
-    * **Cells kept**: the body cells (one simplex type, all blocks merged) and
-      the lower-dimensional simplex cells (``vertex``, ``line``, ``line3``,
-      ``triangle``, ``triangle6`` in 3-D), e.g. the faces of physical groups.
-      Other cell types of lower dimension are dropped; non-simplex cells of
-      the body dimension are an error.
+    * **Dimension**: 3 if the mesh has volume cells (tetrahedra, hexahedra,
+      wedges: :data:`~bladecase.fe.cells.BODY_TYPES`), else 2 if it has
+      triangles or quadrilaterals (which must then lie in ``z = 0``).
+    * **Cells kept**: the body cells (one cell type, all blocks merged) and
+      the lower-dimensional cells (``vertex``, ``line``, ``line3``, and
+      ``triangle``, ``triangle6``, ``quad``, ``quad8``, ``quad9`` in 3-D), e.g.
+      the faces of physical groups.  Other cell types of lower dimension are
+      dropped, with a log message naming them; several body cell types (e.g.
+      hexahedra and wedges, or tetrahedra and pyramids) are an error naming
+      the counts: scikit-fem assembles one cell type per mesh.  gmsh's 18-node
+      wedges (which meshio 5.3 leaves in gmsh's order) are put in VTK order.
     * **Nodes**: all points of the file are kept, with their indices, even the
       ones no kept cell uses (e.g. geometry vertices); points are padded to
       three columns.
@@ -234,13 +235,19 @@ def from_meshio(m, source: str = "", require: Sequence[str] = ()) -> Mesh:
       ["gmsh:physical"]`` for MSH 2.2) → the nodes of their cells; Abaqus
       ``*NSET`` (``point_sets``) as they are and ``*ELSET`` (``cell_sets``) →
       the nodes of their elements; MED families (``point_tags``,
-      ``cell_tags``); point-data masks ``group:<name>`` (``.vtu``/``.vtk``).
+      ``cell_tags``); point-data masks ``group:<name>`` (``.vtu``/``.vtk``);
+      Nastran property ids (``cell_data["nastran:ref"]``, the PID of each
+      element) → ``pid_<id>``, the nodes of the elements of that property.
     * **Checks**: degenerate elements (``|volume| <= DEGENERATE_RTOL · mean``),
       inverted elements (negative signed volume of the straight element
       through the corner nodes) and, for ``tetra10``/``triangle6``, curved
-      elements whose Jacobian is not positive at every corner node.  Planar
-      triangles that are ALL clockwise are reoriented to counter-clockwise
-      (corner and midside nodes); a mix is an error.  Errors name the count
+      elements whose Jacobian is not positive at every corner node.  Hexahedra,
+      wedges and quadrilaterals: the Jacobian of the straight cell at every
+      corner (:func:`~bladecase.fe.quality.corner_jacobians`) must be positive
+      (all negative: inverted; some: twisted or collapsed), and of the curved
+      cell too for second-order ones.  Planar triangles and quadrilaterals, and
+      wedges, that are ALL reversed are reoriented (corner and midside nodes);
+      a mix is an error.  Errors name the count
       and the first offending element (its index among the body cells and
       its nodes).  One body: lines or triangles that use nodes no body cell uses (a stray planar
       part beside a solid) are an error naming the counts.
@@ -258,22 +265,7 @@ def from_meshio(m, source: str = "", require: Sequence[str] = ()) -> Mesh:
 
     blocks = [(_ALIASES.get(b.type, b.type), np.asarray(b.data)) for b in m.cells]
     present = {t for t, d in blocks if len(d)}
-    dim = 3 if present & set(_SIMPLEX[3]) else 2 if present & set(_SIMPLEX[2]) else 0
-    if dim == 0:
-        found = ", ".join(sorted(present)) or "none"
-        raise ValueError(
-            f"mesh {source} has no volume cells (tetra, tetra10) nor planar cells (triangle, triangle6); "
-            f"cell types: {found}"
-        )
-    body_types = present & set(_SIMPLEX[dim])
-    if len(body_types) > 1:
-        raise ValueError(f"mesh {source} mixes element orders ({', '.join(sorted(body_types))}); use one order")
-    other = sorted(t for t in present if _cell_dim(t) == dim and t not in _SIMPLEX[dim])
-    if other:
-        raise ValueError(
-            f"mesh {source} has non-simplex {dim}-D cells ({', '.join(other)}); only "
-            f"{' and '.join(_SIMPLEX[dim])} are supported"
-        )
+    btype, dim = _body_type(blocks, present, source)
     if dim == 2:
         extent = float(np.ptp(points[:, :2], axis=0).max()) or 1.0
         zmax = float(np.abs(points[:, 2]).max())
@@ -281,23 +273,71 @@ def from_meshio(m, source: str = "", require: Sequence[str] = ()) -> Mesh:
             raise ValueError(f"2-D mesh {source} does not lie in the plane z = 0 (max |z| = {zmax:.6g})")
         points[:, 2] = 0.0
 
-    groups = _groups(m, blocks, len(points), source)
-    btype = body_types.pop()
+    groups = file_groups(m, blocks, len(points), source)
     body = np.concatenate([d for t, d in blocks if t == btype]).astype(np.int64)
     if body.min() < 0 or body.max() >= len(points):
         raise ValueError(f"mesh {source}: {btype} cells refer to nodes outside 0..{len(points) - 1}")
     _check_one_body(blocks, body, btype, dim, source)
+    if btype == "wedge18":
+        body = _wedge18_in_vtk_order(points, body, source)
     body = _check_orientation(points, body, btype, dim, source)
     cells = {btype: body}
     for d in range(dim - 1, -1, -1):  # boundary cells: faces, edges, vertices
-        for t in _SIMPLEX[d]:
+        for t in BOUNDARY_TYPES[d]:
             if t in present:
                 cells[t] = np.concatenate([c for tt, c in blocks if tt == t]).astype(np.int64)
+    dropped = {t: sum(len(c) for tt, c in blocks if tt == t) for t in sorted(present - set(cells))}
+    if dropped:
+        log.info("mesh %s: %s dropped (cell types a %d-D model does not use)", source,
+                 ", ".join(f"{n} {t} cell(s)" for t, n in dropped.items()), dim)
     mesh = Mesh(points=points, cells=cells, dim=dim, groups=groups, source=source)
     for name in require:
         if len(mesh.group(name)) == 0:
             raise ValueError(f"mesh {source}: group {name!r} is empty")
     return mesh
+
+
+def _body_type(blocks, present: set, source: str) -> tuple[str, int]:
+    """``(body cell type, dimension)``: the one accepted cell type of the highest dimension; ``ValueError``
+    naming the counts when that dimension has several cell types, or none that a model accepts."""
+    dim = max((d for d in (3, 2) if any(_cell_dim(t) == d for t in present)), default=0)
+    body_types = sorted(t for t in present if _cell_dim(t) == dim)
+    if not body_types or not set(body_types) & set(BODY_TYPES[dim]):
+        found = ", ".join(sorted(present)) or "none"
+        raise ValueError(f"mesh {source} has no volume cells ({', '.join(BODY_TYPES[3])}) nor planar cells "
+                         f"({', '.join(BODY_TYPES[2])}); cell types: {found}")
+    if len(body_types) == 1:
+        return body_types[0], dim
+    if len({KINDS[t].family if t in KINDS else t for t in body_types}) == 1:
+        raise ValueError(f"mesh {source} mixes element orders ({', '.join(body_types)}); use one order")
+    counts = ", ".join(f"{sum(len(c) for tt, c in blocks if tt == t)} {t}" for t in body_types)
+    simplex = [t for t in body_types if t in _SIMPLEX[dim]]
+    other = [t for t in body_types if t not in _SIMPLEX[dim]]
+    what = (f"non-simplex {dim}-D cells ({', '.join(other)}) beside {', '.join(simplex)} cells" if simplex
+            else f"{dim}-D cell types")
+    unknown = [t for t in body_types if t not in KINDS]
+    note = f"; {', '.join(unknown)} cells have no scikit-fem element" if unknown else ""
+    valid = "; ".join(" or ".join(t for t in BODY_TYPES[dim] if KINDS[t].family == f)
+                      for f in dict.fromkeys(KINDS[t].family for t in BODY_TYPES[dim]))
+    raise ValueError(f"mesh {source} mixes {what} ({counts} cells){note}: a model has one body cell type "
+                     f"(scikit-fem assembles one per mesh); valid bodies: {valid}. Remesh with one type (e.g. "
+                     f"split the cells into tetrahedra), or export each part separately")
+
+
+def _wedge18_in_vtk_order(points: np.ndarray, body: np.ndarray, source: str) -> np.ndarray:
+    """18-node wedges in VTK order: gmsh's order (which meshio 5.3 keeps) is recognised by its midside nodes
+    sitting on other edges, and permuted."""
+    parents = KINDS["wedge18"].parents[6:15]
+
+    def misfit(cells):
+        mids = np.stack([points[cells[:, list(p)]].mean(axis=1) for p in parents], axis=1)
+        return float(np.abs(points[cells[:, 6:15]] - mids).sum())
+
+    gmsh = body[:, list(GMSH_WEDGE18)]
+    if misfit(gmsh) < misfit(body):
+        log.info("mesh %s: 18-node wedges in gmsh node order, put in VTK order", source)
+        return gmsh
+    return body
 
 
 def _check_one_body(blocks, body: np.ndarray, btype: str, dim: int, source: str) -> None:
@@ -310,7 +350,7 @@ def _check_one_body(blocks, body: np.ndarray, btype: str, dim: int, source: str)
     on_body[body.ravel()] = True
     stray: dict[str, tuple[int, int]] = {}
     for d in range(1, dim):
-        for t in _SIMPLEX[d]:
+        for t in BOUNDARY_TYPES[d]:
             data = [np.asarray(c, dtype=np.int64) for tt, c in blocks if tt == t and len(c)]
             if not data:
                 continue
@@ -327,59 +367,9 @@ def _check_one_body(blocks, body: np.ndarray, btype: str, dim: int, source: str)
                          f"one dimension (e.g. export only the {dim}-D region, or only the planar one)")
 
 
-def _groups(m, blocks, n_points: int, source: str) -> dict[str, np.ndarray]:
-    """Named node sets from every source meshio exposes (see :func:`from_meshio`)."""
-    found: dict[str, list[np.ndarray]] = {}
-
-    def add(name, nodes):
-        found.setdefault(str(name), []).append(np.asarray(nodes, dtype=np.int64).ravel())
-
-    cell_sets = {k: v for k, v in (getattr(m, "cell_sets", None) or {}).items() if not k.startswith("gmsh:")}
-    for name, per_block in cell_sets.items():
-        add(name, [])
-        for (_, data), idx in zip(blocks, per_block):
-            if idx is not None and len(idx):
-                add(name, data[np.asarray(idx, dtype=np.int64)])
-    # gmsh MSH 2.2: physical names in field_data, tags in cell_data (no cell_sets).
-    physical = (getattr(m, "cell_data", None) or {}).get("gmsh:physical")
-    if physical is not None:
-        for name, value in (getattr(m, "field_data", None) or {}).items():
-            if name in cell_sets or np.size(value) != 2:
-                continue
-            tag, gdim = (int(v) for v in np.ravel(value))
-            add(name, [])
-            for (t, data), tags in zip(blocks, physical):
-                if _cell_dim(t) == gdim:
-                    add(name, data[np.asarray(tags) == tag])
-    for name, nodes in (getattr(m, "point_sets", None) or {}).items():
-        add(name, nodes)
-    point_data = getattr(m, "point_data", None) or {}
-    for key, mask in point_data.items():
-        if key.startswith(GROUP_PREFIX):
-            add(key[len(GROUP_PREFIX):], np.flatnonzero(np.asarray(mask).ravel()))
-    # MED families: family id -> group names, on nodes and on cells.
-    fam = point_data.get("point_tags")
-    for tag, names in (getattr(m, "point_tags", None) or {}).items():
-        if fam is not None:
-            for name in names:
-                add(name, np.flatnonzero(np.asarray(fam) == tag))
-    cell_fam = (getattr(m, "cell_data", None) or {}).get("cell_tags")
-    for tag, names in (getattr(m, "cell_tags", None) or {}).items():
-        if cell_fam is not None:
-            for name in names:
-                for (_, data), tags in zip(blocks, cell_fam):
-                    add(name, data[np.asarray(tags) == tag])
-
-    groups = {}
-    for name, parts in found.items():
-        nodes = np.unique(np.concatenate(parts)) if parts else np.zeros(0, dtype=np.int64)
-        if len(nodes) and (nodes[0] < 0 or nodes[-1] >= n_points):
-            raise ValueError(f"mesh {source}: group {name!r} refers to nodes outside 0..{n_points - 1}")
-        groups[name] = nodes
-    return groups
-
-
-_ABAQUS_TYPES = {"tetra": "C3D4", "tetra10": "C3D10", "triangle": "CPS3", "triangle6": "CPS6"}
+_ABAQUS_TYPES = {"tetra": "C3D4", "tetra10": "C3D10", "triangle": "CPS3", "triangle6": "CPS6",
+                 "hexahedron": "C3D8", "hexahedron20": "C3D20", "wedge": "C3D6", "wedge15": "C3D15",
+                 "quad": "CPS4", "quad8": "CPS8"}
 _ABAQUS_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,79}$")
 
 
@@ -429,6 +419,10 @@ def save_mesh(mesh: Mesh, path: str | os.PathLike) -> None:
         with atomic_path(path) as tmp:
             meshio.write(tmp, out, file_format="vtu" if suffix == ".vtu" else "vtk")
     elif suffix == ".inp":
+        if mesh.body_type not in _ABAQUS_TYPES:
+            valid = ", ".join(f"{k} ({v})" for k, v in _ABAQUS_TYPES.items())
+            raise ValueError(f"save_mesh cannot write {mesh.body_type} cells to Abaqus {path!r} (meshio reads no "
+                             f"such element back); valid: {valid}; write .vtu or .vtk instead")
         for name in mesh.groups:
             if not _ABAQUS_NAME.match(name):
                 raise ValueError(

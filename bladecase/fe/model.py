@@ -16,9 +16,9 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
+from .cells import KINDS
 from .material import Material
 from .mesh import Mesh
-from .quality import _P2_EDGES
 
 _DIRECTIONS = {"x": 0, "y": 1, "z": 2}
 
@@ -172,8 +172,10 @@ def node_operator(model: FEModel) -> sp.csr_array:
     Row ``dim·p + c`` gives component ``c`` at mesh node ``p``: the vertex dof
     of ``p`` when it has one; for the midside nodes of quadratic mesh cells,
     the FE field at the straight edge's midpoint (P2: the edge dof located
-    there; P1: the mean of the two end vertices); zero for clamped nodes and
-    nodes outside the body cells.
+    there; P1: the mean of the two end vertices), and likewise for the face and
+    cell centres of 27-node hexahedra, 18-node wedges and 9-node quadrilaterals
+    (the face or cell dof, or the mean of the corners); zero for clamped nodes
+    and nodes outside the body cells.
     """
     dofs, dim = model.dofs, model.dim
     n_nodes = model.mesh.points.shape[0]
@@ -181,33 +183,43 @@ def node_operator(model: FEModel) -> sp.csr_array:
     rows = [dim * dofs.node[vertex] + dofs.direction[vertex]]
     cols = [vertex]
     vals = [np.ones(vertex.size)]
+    kind = KINDS[model.mesh.body_type]
     cells = np.asarray(model.mesh.cells[model.mesh.body_type])
-    if cells.shape[1] > dim + 1:  # quadratic mesh: fill its midside nodes
-        pairs = np.stack([cells[:, [a, b]] for a, b in _P2_EDGES[dim]], axis=1).reshape(-1, 2)
-        mids = cells[:, dim + 1:].reshape(-1)
-        mids, first = np.unique(mids, return_index=True)
-        pairs = pairs[first]
-        if model.order == 2:  # the dim dofs of an edge location are consecutive, direction 0 first
-            edge = np.flatnonzero((dofs.node < 0) & (dofs.direction == 0))
-            if edge.size:
-                centre = 0.5 * (model.mesh.points[pairs[:, 0]] + model.mesh.points[pairs[:, 1]])
-                dist, k = cKDTree(dofs.coords[edge]).query(centre)
-                ok = dist <= 1e-9 * np.abs(model.mesh.points).max()  # else: a clamped edge
+    edge = np.flatnonzero((dofs.node < 0) & (dofs.direction == 0))  # the dim dofs of a location: consecutive
+    tree = cKDTree(dofs.coords[edge]) if model.order == 2 and edge.size else None
+    table = np.full((n_nodes, dim), -1, dtype=np.int64)  # free dof of (node, direction), -1 if none
+    table[dofs.node[vertex], dofs.direction[vertex]] = vertex
+    for mids, parents in _extra_nodes(kind, cells):  # the extra nodes of quadratic mesh cells
+        if model.order == 2:  # the FE node at the straight entity's centre (an edge, face or cell dof)
+            if tree is None:
+                continue
+            dist, k = tree.query(model.mesh.points[parents].mean(axis=1))
+            ok = dist <= 1e-9 * np.abs(model.mesh.points).max()  # else: a clamped edge
+            for c in range(dim):
+                rows.append(dim * mids[ok] + c)
+                cols.append(edge[k[ok]] + c)
+                vals.append(np.ones(int(ok.sum())))
+        else:  # order 1: the mean of the corners (the bilinear/trilinear field at the centre)
+            for end in range(parents.shape[1]):
                 for c in range(dim):
-                    rows.append(dim * mids[ok] + c)
-                    cols.append(edge[k[ok]] + c)
-                    vals.append(np.ones(int(ok.sum())))
-        else:
-            table = np.full((n_nodes, dim), -1, dtype=np.int64)  # free dof of (node, direction), -1 if none
-            table[dofs.node[vertex], dofs.direction[vertex]] = vertex
-            for end in (0, 1):
-                for c in range(dim):
-                    d = table[pairs[:, end], c]
+                    d = table[parents[:, end], c]
                     ok = d >= 0
                     rows.append(dim * mids[ok] + c)
                     cols.append(d[ok])
-                    vals.append(np.full(int(ok.sum()), 0.5))
+                    vals.append(np.full(int(ok.sum()), 1.0 / parents.shape[1]))
     return sp.csr_array(
         (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
         shape=(n_nodes * dim, model.n_dofs),
     )
+
+
+def _extra_nodes(kind, cells: np.ndarray):
+    """``(nodes, parents)`` per count of parents (2: edge midpoints, 4: face centres, 8: cell centres): the mesh
+    nodes beyond the corners (each once) and the corner nodes they sit between."""
+    extra = range(kind.corners, kind.n_nodes)
+    for size in sorted({len(kind.parents[j]) for j in extra}):
+        idx = [j for j in extra if len(kind.parents[j]) == size]
+        mids = cells[:, idx].reshape(-1)
+        parents = np.stack([cells[:, list(kind.parents[j])] for j in idx], axis=1).reshape(-1, size)
+        mids, first = np.unique(mids, return_index=True)
+        yield mids, parents[first]

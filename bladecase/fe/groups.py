@@ -1,0 +1,67 @@
+"""Named node groups of a mesh file, from every source meshio exposes (see :func:`bladecase.fe.mesh.from_meshio`)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .cells import cell_dim as _cell_dim
+
+#: Prefix of the ``.vtu``/``.vtk`` point-data arrays that carry named node groups:
+#: ``group:root`` is a per-node mask (non-zero = in the group).
+GROUP_PREFIX = "group:"
+
+
+def file_groups(m, blocks, n_points: int, source: str) -> dict[str, np.ndarray]:
+    """Named node sets from every source meshio exposes (see :func:`bladecase.fe.mesh.from_meshio`)."""
+    found: dict[str, list[np.ndarray]] = {}
+
+    def add(name, nodes):
+        found.setdefault(str(name), []).append(np.asarray(nodes, dtype=np.int64).ravel())
+
+    cell_sets = {k: v for k, v in (getattr(m, "cell_sets", None) or {}).items() if not k.startswith("gmsh:")}
+    for name, per_block in cell_sets.items():
+        add(name, [])
+        for (_, data), idx in zip(blocks, per_block):
+            if idx is not None and len(idx):
+                add(name, data[np.asarray(idx, dtype=np.int64)])
+    # gmsh MSH 2.2: physical names in field_data, tags in cell_data (no cell_sets).
+    physical = (getattr(m, "cell_data", None) or {}).get("gmsh:physical")
+    if physical is not None:
+        for name, value in (getattr(m, "field_data", None) or {}).items():
+            if name in cell_sets or np.size(value) != 2:
+                continue
+            tag, gdim = (int(v) for v in np.ravel(value))
+            add(name, [])
+            for (t, data), tags in zip(blocks, physical):
+                if _cell_dim(t) == gdim:
+                    add(name, data[np.asarray(tags) == tag])
+    for name, nodes in (getattr(m, "point_sets", None) or {}).items():
+        add(name, nodes)
+    for (_, data), ids in zip(blocks, (getattr(m, "cell_data", None) or {}).get("nastran:ref") or []):
+        ids = np.asarray(ids).ravel()
+        for pid in np.unique(ids) if ids.size == len(data) else ():
+            add(f"pid_{int(pid)}", data[ids == pid])
+    point_data = getattr(m, "point_data", None) or {}
+    for key, mask in point_data.items():
+        if key.startswith(GROUP_PREFIX):
+            add(key[len(GROUP_PREFIX):], np.flatnonzero(np.asarray(mask).ravel()))
+    # MED families: family id -> group names, on nodes and on cells.
+    fam = point_data.get("point_tags")
+    for tag, names in (getattr(m, "point_tags", None) or {}).items():
+        if fam is not None:
+            for name in names:
+                add(name, np.flatnonzero(np.asarray(fam) == tag))
+    cell_fam = (getattr(m, "cell_data", None) or {}).get("cell_tags")
+    for tag, names in (getattr(m, "cell_tags", None) or {}).items():
+        if cell_fam is not None:
+            for name in names:
+                for (_, data), tags in zip(blocks, cell_fam):
+                    add(name, data[np.asarray(tags) == tag])
+
+    groups = {}
+    for name, parts in found.items():
+        nodes = np.unique(np.concatenate(parts)) if parts else np.zeros(0, dtype=np.int64)
+        if len(nodes) and (nodes[0] < 0 or nodes[-1] >= n_points):
+            raise ValueError(f"mesh {source}: group {name!r} refers to nodes outside 0..{n_points - 1}")
+        groups[name] = nodes
+    return groups
