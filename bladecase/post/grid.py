@@ -21,13 +21,18 @@ from __future__ import annotations
 import numpy as np
 
 from ..fe import FEModel, Mesh
+from ..fe.cells import KINDS
 
 #: Edges of the midside nodes of quadratic cells, VTK/meshio node order (``tetra10``, ``triangle6``).
 VTK_EDGES = {3: ((0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3)), 2: ((0, 1), (1, 2), (2, 0))}
 
 #: VTK cell type (``pyvista.CellType`` name) of each meshio body cell type; the node orders are the same.
 VTK_CELL_TYPES = {"tetra": "TETRA", "tetra10": "QUADRATIC_TETRA", "triangle": "TRIANGLE",
-                  "triangle6": "QUADRATIC_TRIANGLE"}
+                  "triangle6": "QUADRATIC_TRIANGLE", "hexahedron": "HEXAHEDRON", "wedge": "WEDGE", "quad": "QUAD"}
+
+#: Simplex families: their order-2 grid carries the edge nodes; hexahedra, wedges and quadrilaterals are drawn
+#: on their corner nodes (the vertex dofs; the higher-order dofs of an order-2 model are not drawn).
+SIMPLICES = ("tetra", "triangle")
 
 #: meshio cell type of the grid's body cells, by dimension and model order.
 GRID_TYPES = {(3, 1): "tetra", (3, 2): "tetra10", (2, 1): "triangle", (2, 2): "triangle6"}
@@ -40,10 +45,21 @@ def _vertices(model: FEModel) -> tuple[np.ndarray, np.ndarray]:
     """``(used, corners)``: the sorted mesh nodes that are vertices of the body cells (the FE vertices, in
     scalar-dof order, as :func:`bladecase.fe.assemble` numbers them) and the cells' corners as indices into
     ``used`` (the mesh's own orientation)."""
-    mesh, dim = model.mesh, model.dim
-    cells = np.asarray(mesh.cells[mesh.body_type])[:, : dim + 1].astype(np.int64)
+    mesh = model.mesh
+    cells = np.asarray(mesh.cells[mesh.body_type])[:, : KINDS[mesh.body_type].corners].astype(np.int64)
     used, local = np.unique(cells, return_inverse=True)
     return used, local.reshape(cells.shape)
+
+
+def _family(model: FEModel) -> str:
+    return KINDS[model.mesh.body_type].family
+
+
+def _n_points(model: FEModel) -> int:
+    """Grid points of :func:`fe_grid`: every scalar dof (simplices), the vertices only (other families)."""
+    if _family(model) in SIMPLICES or model.order == 1:
+        return model.dofs.n_total // model.dim
+    return _vertices(model)[0].size
 
 
 def _check_model(model) -> None:
@@ -103,7 +119,8 @@ def fe_grid(model: FEModel) -> Mesh:
     n_v = used.size
     vertex_points = np.zeros((n_v, 3))
     vertex_points[:, :dim] = np.asarray(mesh.points, dtype=float)[used, :dim]
-    if order == 1:
+    family = _family(model)
+    if order == 1 or family not in SIMPLICES:
         points, cells, edges = vertex_points, corners, np.zeros((0, 2), dtype=np.int64)
     else:
         edges, cell_edges = _edges(corners, dim)
@@ -119,7 +136,8 @@ def fe_grid(model: FEModel) -> Mesh:
         on_edges = n_v + np.flatnonzero(in_group[edges].all(axis=1))
         groups[name] = np.concatenate([np.flatnonzero(in_group), on_edges]).astype(np.int64)
     source = f"FE nodes of P{order} model on {mesh.source or 'mesh'}"
-    return Mesh(points=points, cells={GRID_TYPES[dim, order]: cells}, dim=dim, groups=groups, source=source)
+    body = GRID_TYPES[dim, order] if family in SIMPLICES else family
+    return Mesh(points=points, cells={body: cells}, dim=dim, groups=groups, source=source)
 
 
 def _edges(corners: np.ndarray, dim: int) -> tuple[np.ndarray, np.ndarray]:
@@ -141,6 +159,13 @@ def _edges(corners: np.ndarray, dim: int) -> tuple[np.ndarray, np.ndarray]:
 def _check_dofs(model: FEModel, points: np.ndarray) -> None:
     """``ValueError`` unless the model's free dofs sit on the grid points their ``fe_index`` names."""
     dofs, dim = model.dofs, model.dim
+    if len(points) < dofs.n_total // dim:  # drawn on the vertices: their dofs come first in scikit-fem
+        keep = dofs.fe_index < dim * len(points)
+        err = np.abs(points[dofs.fe_index[keep] // dim] - dofs.coords[keep]).max(initial=0.0)
+        if err > COORDS_RTOL * max(float(np.abs(points).max()), 1e-300):
+            raise ValueError(f"the model's vertex dofs differ from the mesh's vertices by up to {err:.3g}: its dof "
+                             "numbering is not scikit-fem's vertices first")
+        return
     if dofs.n_total != dim * len(points):
         raise ValueError(
             f"model has {dofs.n_total} dofs before clamping, its mesh gives {len(points)} P{model.order} nodes "
@@ -204,7 +229,7 @@ def nodal_field(model: FEModel, x_free) -> np.ndarray:
     cols = x.reshape(model.n_dofs, -1)
     out = np.zeros((dofs.n_total, cols.shape[1]))
     out[dofs.fe_index] = cols
-    out = out.reshape(dofs.n_total // dim, dim, -1)
+    out = out.reshape(dofs.n_total // dim, dim, -1)[: _n_points(model)]
     return out if x.ndim == 2 else out[:, :, 0]
 
 
