@@ -31,6 +31,7 @@ from .fe import (
     load_mesh,
     natural_frequencies,
     save_mesh,
+    select_nodes,
     stiffness_factor,
 )
 from .nsm import (
@@ -69,14 +70,19 @@ from .reduction import (
     FULL_LIMIT,
     METHODS,
     Contact,
+    EngineOrderLoad,
     LanczosChain,
     MassFactor,
     PerDofDefect,
     ReducedModel,
     SymmetryBasis,
+    engine_order_load,
     lanczos_chain,
     mass_factor,
+    nodal_load,
     per_dof_defect,
+    pressure_load,
+    project_load,
     radial_normal,
     reduce,
 )
@@ -85,10 +91,12 @@ from .study import RunResult, Study, StudyError, demo_study, load_study, run
 __all__ = [
     # fe
     "BladeGeometry", "DofMap", "FEModel", "Material", "Mesh", "PlateGeometry",
-    "assemble", "blade_mesh", "load_mesh", "natural_frequencies", "save_mesh", "stiffness_factor",
+    "assemble", "blade_mesh", "load_mesh", "natural_frequencies", "save_mesh", "select_nodes",
+    "stiffness_factor",
     # reduction
-    "Contact", "FULL_LIMIT", "LanczosChain", "METHODS", "MassFactor", "PerDofDefect", "ReducedModel",
-    "SymmetryBasis", "lanczos_chain", "mass_factor", "per_dof_defect", "radial_normal", "reduce",
+    "Contact", "EngineOrderLoad", "FULL_LIMIT", "LanczosChain", "METHODS", "MassFactor", "PerDofDefect",
+    "ReducedModel", "SymmetryBasis", "engine_order_load", "lanczos_chain", "mass_factor", "nodal_load",
+    "per_dof_defect", "pressure_load", "project_load", "radial_normal", "reduce",
     # nsm
     "Arc", "Backbone", "Branch", "Damping", "Family", "Floquet", "ForcedTrajectory", "Interval", "LinearSystem",
     "MasslessSystem", "PeriodicOrbit", "PhasedOrbit", "Spectrum", "SweepPoint", "Trajectory", "backbone", "bar",

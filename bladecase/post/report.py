@@ -43,6 +43,8 @@ def report(summary: dict) -> str:
         lines.append(f"| {j + 1} | {f:.3f} | {b2:.3e} | {_counterpart(matches[j])} |")
     if summary.get("comparison"):
         lines += comparison_report(summary["comparison"])
+    if summary.get("forcing"):
+        lines += forcing_report(summary["forcing"], summary["files"].get("forced_animations", []))
     s = summary["search"]
     lines += ["", "## Nonsmooth modes", "",
               f"Search: ipp {s['ipp']}, periods {s['periods']} × {s['period_unit']} "
@@ -121,6 +123,23 @@ def _reference_words(check: dict, k: int) -> str:
     return (f"**Does not survive** {where}: after one period it has drifted by {check['drift']:.1%} (energy norm), "
             f"with {check['contacts']} contact(s) for {k} — an artefact of the reduced model, animated only because "
             "it was asked for in [output] orbits.")
+
+
+def forcing_report(section: dict, animations: list[dict]) -> list[str]:
+    """The forced-response section of ``report.md``."""
+    files = section["files"]
+    lines = ["", "## Forced response", "",
+             f"- Load: {section['load']}, amplitude {section['amplitude']:g} {section['amplitude_unit']}; damping: "
+             f"{section['damping']}; {section['periods_per_point']} forcing periods per frequency.",
+             f"- {section['words']}"]
+    if files:
+        lines.append("- Steady states: " + ", ".join(f"`{v}`" for v in files.values()) + ".")
+    for a in animations:
+        shown = ", ".join(f"`{a[k]}`" for k in ("gif", "mp4", "pvd") if k in a)
+        lines.append(f"- Animated steady state {a['label']} (impacts/forcing periods) at {a['frequency_hz']:.6g} Hz "
+                     f"({a['sweep']} sweep, re-simulation return error {a['return_error']:.1e}): "
+                     f"{shown or 'no files'}.")
+    return lines
 
 
 def comparison_report(section: dict) -> list[str]:

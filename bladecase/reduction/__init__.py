@@ -14,6 +14,7 @@ method), :mod:`~bladecase.reduction.storage` (stage files).
 
 from .contact import Contact, radial_normal
 from .lanczos import LanczosChain, chain_grounding, chain_jacobi, lanczos_chain
+from .loads import EngineOrderLoad, engine_order_load, nodal_load, pressure_load, project_load
 from .massless import MasslessReducedModel, massless_masses, massless_model
 from .methods import FULL_LIMIT
 from .model import ReducedModel, node_operator
@@ -22,8 +23,10 @@ from .storage import load_reduced, save_reduced
 from .symmetry import MassFactor, PerDofDefect, SymmetryBasis, mass_factor, per_dof_defect, per_dof_law
 
 __all__ = [
-    "FULL_LIMIT", "METHODS", "Contact", "LanczosChain", "MassFactor", "MasslessReducedModel", "PerDofDefect",
+    "FULL_LIMIT", "METHODS", "Contact", "EngineOrderLoad", "LanczosChain", "MassFactor", "MasslessReducedModel",
+    "PerDofDefect",
     "ReducedModel", "Registry", "SymmetryBasis", "chain_grounding", "chain_jacobi", "lanczos_chain", "load_reduced",
     "mass_factor", "massless_masses", "massless_model", "node_operator", "per_dof_defect", "per_dof_law",
-    "radial_normal", "reduce", "register", "save_reduced",
+    "radial_normal", "reduce", "register", "save_reduced", "engine_order_load", "nodal_load", "pressure_load",
+    "project_load",
 ]

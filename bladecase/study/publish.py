@@ -35,7 +35,7 @@ from ..io import check_output_dir, replace_dir
 
 #: Top-level result names a run owns in its output directory (older ones it did not write are removed).
 RUN_RESULTS = ("summary.json", "report.md", "run.log", "modes.json", "frequency_energy.png", "mesh.vtu", "animations",
-               "vtk")
+               "vtk", "forced.csv", "forced_response.png")
 
 LOCK = ".bladecase.lock"
 STAGING_PREFIX = ".bladecase-run-"

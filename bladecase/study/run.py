@@ -26,6 +26,7 @@ from ..progress import progress_counter
 from .comparison import FE_MODES, compare_models
 from .documents import contact_summary, families_document, family_summary, model_summary, reduced_summary
 from .executor import Executor, SerialExecutor
+from .forcing import forced_response, forced_scene
 from .publish import RUN_RESULTS, check_inputs, publish, release, staging_dir
 from .reference import reference_model
 from .render import render_all
@@ -127,7 +128,7 @@ def run(study: Study, out: str | os.PathLike | None = None, progress: bool = Tru
     if not study.parametric:
         check_inputs(out, [study.mesh_path()])
     staging = staging_dir(out)
-    stages = _Stages(progress)
+    stages = _Stages(progress, total=7 if study["forcing"]["amplitude"] is not None else 6)
     try:
         with log.transcript() as lines:
             log.info("study %s (%s) → %s", study.name, study.source, out)
@@ -217,6 +218,15 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
             files["comparison_figures"] = comparison["figures"]
     with stage("render"):
         files["animations"] = render_all(study, reduced, families, staging, progress, reference)
+    forcing = None
+    if study["forcing"]["amplitude"] is not None:
+        with stage("forcing"):
+            forcing = forced_response(reduced, families, study["forcing"], folder=staging,
+                                      figures="png" in o["formats"], title=study.name, executor=executor,
+                                      progress=progress)
+            orbits = forcing.pop("orbits")
+            files["forced"] = dict(forcing["files"])
+            files["forced_animations"] = _animate_forced(study, reduced, forcing, orbits, staging)
     files["log"] = "run.log"
     from .. import __version__
 
@@ -231,10 +241,30 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
                     for r, fams in zip(compares, compare_families)],
         "search": {**study["search"], "period_unit_s": unit},
         "families": [family_summary(f) for f in families],
+        "forcing": forcing,
         "comparison": None if comparison is None else {k: comparison[k] for k in ("rows", "diagnostics", "figures")},
         "files": files,
     }
     return summary, families, {m.name: m for m in models}
+
+
+def _animate_forced(study: Study, reduced, section: dict, orbits: list, folder: Path) -> list[dict]:
+    """The ``[forcing] animate`` highest-energy periodic steady states with impacts, through the orbit writers."""
+    c = section["points"]
+    picks = [i for i, lab in enumerate(c["label"])
+             if "/" in lab and not lab.startswith("0/") and orbits[i] is not None]
+    picks = sorted(picks, key=lambda i: -c["energy_j"][i])[: study["forcing"]["animate"]]
+    out = []
+    for n, i in enumerate(picks):
+        stem = f"forced_{n + 1}_{c['label'][i].replace('/', '-')}"
+        scene = forced_scene(study, reduced, orbits[i], stem)
+        entry = {"index": i, "sweep": c["sweep"][i], "frequency_hz": c["frequency_hz"][i], "label": c["label"][i],
+                 "energy_j": c["energy_j"][i], "return_error": c["return_error"][i]}
+        entry.update(FORMATS.write(study["output"]["formats"], "orbit", scene, folder))
+        log.info("animated forced steady state %s at %.6g Hz (%s sweep)", entry["label"], entry["frequency_hz"],
+                 entry["sweep"])
+        out.append(entry)
+    return out
 
 
 def _timed(fn, *args, **kwargs):

@@ -27,6 +27,8 @@ from typing import Any
 from ..fe import BladeGeometry, PlateGeometry
 from ..post.outputs import FORMATS as OUTPUT_FORMATS
 from ..reduction import METHODS
+from .forcing_keys import FORCING_KEYS, forcing_checks
+from .keys import _BOOL, _INT, _LIST, _NUM, _STR, REQUIRED, Key, StudyError  # noqa: F401
 from .values import (  # noqa: F401  (RANGES, LIMITS: part of the schema's documented surface)
     LIMITS,
     RANGES,
@@ -38,12 +40,14 @@ from .values import (  # noqa: F401  (RANGES, LIMITS: part of the schema's docum
     _ipp,
     _manifold_size,
     _method_names,
+    _nonzero,
     _num,
     _one_of,
     _orbit_list,
     _period_unit,
     _periods,
     _positive,
+    _rayleigh,
     _reduction_list,
     _scale,
     _size_list,
@@ -51,28 +55,10 @@ from .values import (  # noqa: F401  (RANGES, LIMITS: part of the schema's docum
     _window,
 )
 
-REQUIRED = object()  #: marks a key without a default
-
-
-class StudyError(ValueError):
-    """A study file that cannot be run: the message names the key and the reason."""
-
-
-@dataclass(frozen=True)
-class Key:
-    """One study-file key: accepted types, default, and a one-line meaning."""
-
-    types: tuple
-    default: Any
-    doc: str
-    check: Any = None  # callable(value) -> str | None (an error message)
-
-
 #: The registry of output formats (:mod:`bladecase.post.outputs`): GIF/MP4 animations, VTK time series
 #: (+ manifold samples), PNG plots, and any format registered there.
 FORMATS = OUTPUT_FORMATS
 
-_STR, _INT, _NUM, _BOOL, _LIST = (str,), (int,), (int, float), (bool,), (list,)
 
 #: The study-file schema: section → key → :class:`Key`.  ``[geometry]`` also
 #: takes the fields of :class:`~bladecase.BladeGeometry` (``kind = "blade"``)
@@ -158,6 +144,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "max_points": Key(_INT, 400, "Cap on continuation points per direction of each family.",
                           _int_between(2, LIMITS["max_points"])),
     },
+    "forcing": FORCING_KEYS,
     "output": {
         "directory": Key(_STR, None, "Output directory, relative to the current directory; default "
                          "'results/<name>'; the command line's --out overrides it."),
@@ -378,6 +365,7 @@ def _cross_checks(c: dict) -> None:
     _expand_grid(r)
     _contact_model_checks(c)
     _work_checks(c["search"])
+    forcing_checks(c)
     o, s = c["output"], c["search"]
     for i, item in enumerate(o["orbits"]):
         if item["ipp"] not in s["ipp"]:

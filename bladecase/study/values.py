@@ -38,7 +38,7 @@ RANGES = {"clearance": (1e-9, 10.0, "m"), "E": (1e3, 1e13, "Pa"), "rho": (1e-2, 
 #: or not fit in memory).
 LIMITS = {"frames": 1000, "scan": 2000, "resolution": 1000, "max_points": 100_000, "fps": 1000, "frequencies": 100,
           "manifold_axis": 1000, "manifold_samples": 100_000, "period_multiple": 100, "grid_cells": 1_000_000,
-          "models": 32}
+          "models": 32, "forcing_points": 2000, "forcing_periods": 100_000, "engine_order": 1000}
 
 
 def _in_range(name: str):
@@ -149,3 +149,13 @@ def _orbit_list(v) -> str | None:
         if not _num(item["T"]) or not math.isfinite(item["T"]) or item["T"] <= 0:
             return f"item {i}: T must be a number > 0, got {item['T']!r}"
     return None
+
+
+def _rayleigh(v) -> str | None:
+    if len(v) != 2 or not all(_num(x) and math.isfinite(x) and x >= 0 for x in v) or not any(v):
+        return "must be [alpha, beta], two finite numbers >= 0, not both 0 (C = alpha K + beta M)"
+    return None
+
+
+def _nonzero(v) -> str | None:
+    return None if math.isfinite(v) and v != 0 else "must be a finite number, not 0"

@@ -1,0 +1,71 @@
+"""The ``[forcing]`` section of a study: the forced–damped response of the blade (damping, load, forcing
+frequencies, the sweep) and its cross-checks; run by :func:`bladecase.study.forcing.forced_response`."""
+
+from __future__ import annotations
+
+from .keys import _INT, _LIST, _NUM, _STR, Key, StudyError
+from .values import LIMITS, _direction, _int_at_least, _int_between, _nonzero, _one_of, _periods, _rayleigh
+
+#: ``[forcing]``: key → :class:`~bladecase.study.keys.Key` (the section runs when ``amplitude`` is given).
+FORCING_KEYS: dict[str, Key] = {
+    "rayleigh": Key(_LIST, None, "Rayleigh damping [alpha, beta]: C = alpha K + beta M (alpha in s, beta in 1/s); "
+                    "give this or 'ratio'.", _rayleigh),
+    "ratio": Key(_NUM, None, "Modal damping ratio of every mode (e.g. 0.01); give this or 'rayleigh'.",
+                 lambda v: None if 0 < v < 1 else "must be in (0, 1) (a damping ratio)"),
+    "load": Key(_STR, "nodal", "'nodal' (a force shared by nodes) or 'pressure' (a uniform pressure on the "
+                "face 'group').", _one_of("nodal", "pressure")),
+    "node": Key(_INT, None, "Nodal load: the mesh node loaded; default (no node, no group): the contact "
+                "node(s).", _int_at_least(0)),
+    "group": Key(_STR, None, "Nodal load: the mesh group whose nodes share the force; pressure load: the face "
+                 "group (required)."),
+    "load_direction": Key(_LIST, None, "Nodal load: the force's direction; default: the casing normal.",
+                          _direction),
+    "amplitude": Key(_NUM, None, "Load amplitude F0: the total force (N) of a nodal load, the pressure (Pa) "
+                     "of a pressure load (> 0 pushes into the body); the load is F0 f cos(2π f t).  The forced "
+                     "response runs when it is given.", _nonzero),
+    "engine_order": Key(_INT, None, "Engine order EO of a travelling excitation: the blade is forced at "
+                        "EO × rotation speed (its phase on a single blade only shifts time).",
+                        _int_between(1, LIMITS["engine_order"])),
+    "frequencies": Key(_LIST, [0.8, 1.2], "Forcing range [lower, upper] in 'frequency_unit'.", _periods),
+    "frequency_unit": Key(_STR, "f1", "'Hz', 'f1' (× the first linear frequency of the reduced model that sees "
+                          "the contact) or 'rpm' (rotation speeds; needs engine_order).",
+                          _one_of("Hz", "f1", "rpm")),
+    "points": Key(_INT, 41, "Forcing frequencies of the sweep, evenly spaced.",
+                  _int_between(1, LIMITS["forcing_points"])),
+    "periods": Key(_INT, 300, "Forcing periods integrated at each frequency (>= 2 max_p + 1).",
+                   _int_between(3, LIMITS["forcing_periods"])),
+    "direction": Key(_STR, "up", "Sweep in forcing frequency: 'up', 'down' or 'both' (each point starts from the "
+                     "previous one's end state).", _one_of("up", "down", "both")),
+    "restitution": Key(_NUM, 1.0, "Newton's coefficient of restitution e in (0, 1] (1: as the nonsmooth modes).",
+                       lambda v: None if 0 < v <= 1 else "must be in (0, 1]"),
+    "max_p": Key(_INT, 4, "Longest steady-state period looked for, in forcing periods.", _int_between(1, 16)),
+    "animate": Key(_INT, 1, "Periodic steady states with impacts to animate (the highest-energy ones).",
+                   _int_at_least(0)),
+}
+
+
+def forcing_checks(c: dict) -> None:
+    """``[forcing]`` (when its amplitude is given): one damping, the keys of its load kind, enough periods,
+    Newton's contact model."""
+    f = c["forcing"]
+    if f["amplitude"] is None:
+        given = sorted(k for k, spec in FORCING_KEYS.items() if f[k] != spec.default)
+        if given:
+            raise StudyError(f"[forcing] amplitude: required to run the forced response (the section sets "
+                             f"{', '.join(given)})")
+        return
+    if (f["rayleigh"] is None) == (f["ratio"] is None):
+        raise StudyError("[forcing] rayleigh / ratio: give exactly one damping: rayleigh = [alpha, beta] "
+                         "(C = alpha K + beta M) or ratio = zeta (every mode)")
+    if f["frequency_unit"] == "rpm" and f["engine_order"] is None:
+        raise StudyError("[forcing] frequency_unit: 'rpm' (rotation speeds) needs an engine_order")
+    if f["load"] == "pressure" and f["group"] is None:
+        raise StudyError("[forcing] group: a pressure load needs the mesh group of its face, e.g. group = 'tip'")
+    if f["load"] == "pressure" and (f["node"] is not None or f["load_direction"] is not None):
+        raise StudyError("[forcing] node / load_direction: only for load = 'nodal' (a pressure acts along the "
+                         "face's normal)")
+    if f["periods"] < 2 * f["max_p"] + 1:
+        raise StudyError(f"[forcing] periods: at least 2 × max_p + 1 = {2 * f['max_p'] + 1}, got {f['periods']}")
+    if c["contact"]["model"] != "newton":
+        raise StudyError("[forcing]: needs [contact] model = 'newton' for now (the massless contact model has no "
+                         "forced simulation)")
