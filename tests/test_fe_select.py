@@ -100,3 +100,25 @@ def test_nastran_property_ids_become_groups(tmp_path):
     wedges = split(hexa, WEDGES)
     meshio.write(tmp_path / "w.nas", wedges, file_format="nastran")
     assert load_mesh(tmp_path / "w.nas").body_type == "wedge"
+
+
+def test_a_study_clamps_by_coordinates(tmp_path):
+    """[fem] clamp = {plane = ...} on a mesh without a root group gives the frequencies of the group clamp."""
+    from _studies import PLATE, ROOT
+
+    from bladecase.study import run
+    from bladecase.study.schema import StudyError, loads
+
+    base = PLATE + '\n[output]\nformats = []\nanimate = 0\nreference = false\n'
+    by_group = run(loads(base, base=ROOT), out=tmp_path / "a", progress=False)
+    text = base.replace("thickness = 0.002", 'thickness = 0.002\nclamp = {plane = [0, 0, 0, 0, 1, 0]}')
+    by_plane = run(loads(text, base=ROOT), out=tmp_path / "b", progress=False)
+    fa, fb = (r.summary["model"]["linear_frequencies_hz"] for r in (by_group, by_plane))
+    assert by_plane.summary["model"]["clamped_nodes"] == by_group.summary["model"]["clamped_nodes"]
+    assert np.allclose(fa, fb, rtol=1e-12)
+    with pytest.raises(StudyError, match=r"\[fem\] clamp: must hold exactly one of plane, box, sphere"):
+        loads(base.replace("thickness = 0.002", 'thickness = 0.002\nclamp = {plane = [0, 0, 0, 0, 1, 0], '
+                           'box = [[0, 0], [1, 1]]}'), base=ROOT)
+    bad = base.replace("thickness = 0.002", 'thickness = 0.002\nclamp = {plane = [0, 5, 0, 0, 1, 0]}')
+    with pytest.raises(StudyError, match=r"\[fem\] clamp .* selects no node of mesh"):
+        run(loads(bad, base=ROOT), out=tmp_path / "c", progress=False)

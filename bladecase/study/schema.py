@@ -32,6 +32,7 @@ from .keys import _BOOL, _INT, _LIST, _NUM, _STR, REQUIRED, Key, StudyError  # n
 from .values import (  # noqa: F401  (RANGES, LIMITS: part of the schema's documented surface)
     LIMITS,
     RANGES,
+    _clamp_spec,
     _direction,
     _formats,
     _in_range,
@@ -89,7 +90,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
     "fem": {
         "order": Key(_INT, 2, "Polynomial order of the elements (1 or 2).", _one_of(1, 2)),
         "mass": Key(_STR, "consistent", "'consistent' or 'lumped' mass matrix.", _one_of("consistent", "lumped")),
-        "clamp": Key(_STR, "root", "Mesh group whose nodes are clamped."),
+        "clamp": Key((str, dict), "root", "Clamped nodes: a mesh group, or by coordinates (meshes without groups): "
+                     "{plane = [x0, y0, z0, nx, ny, nz]}, {box = [[xmin, ymin, zmin], [xmax, ymax, zmax]]} or "
+                     "{sphere = [x, y, z, r]}, with an optional tol (m).", _clamp_spec),
         "thickness": Key(_NUM, None, "Out-of-plane thickness of a 2-D model (m); required in 2-D.", _positive),
         "plane": Key(_STR, "stress", "'stress' or 'strain' (2-D models).", _one_of("stress", "strain")),
         "frequencies": Key(_INT, 6, "Linear frequencies of the full FE model to compute and report.",
@@ -242,7 +245,8 @@ class Study:
 
 
 def _type_name(types: tuple) -> str:
-    names = {str: "a string", int: "an integer", float: "a number", bool: "true/false", list: "a list"}
+    names = {str: "a string", int: "an integer", float: "a number", bool: "true/false", list: "a list",
+             dict: "a table"}
     if types == _NUM:
         return "a number"
     return " or ".join(names[t] for t in types)

@@ -26,10 +26,11 @@ def build_mesh(study: Study, path: str | os.PathLike | None = None) -> Mesh:
 
     The clamp group and, when the contact is picked by group, the contact group must exist.
     """
-    need = [study["fem"]["clamp"]]
+    clamp = study["fem"]["clamp"]
+    need = [("[fem] clamp", clamp)] if isinstance(clamp, str) else []  # a table selects by coordinates
     group = contact_group(study)
     if group is not None:
-        need.append(group)
+        need.append(("[contact] group", group))
     if study.parametric:
         g = study["geometry"]
         try:
@@ -46,7 +47,7 @@ def build_mesh(study: Study, path: str | os.PathLike | None = None) -> Mesh:
             from ..fe import save_mesh
 
             save_mesh(mesh, path)
-    for name, key in zip(need, ("[fem] clamp", "[contact] group")):
+    for key, name in need:
         if name not in mesh.groups:
             have = ", ".join(sorted(mesh.groups)) or "none"
             raise StudyError(f"{key}: the mesh {mesh.source} has no group {name!r} (groups: {have})")
@@ -70,8 +71,13 @@ def build_model(study: Study, mesh: Mesh) -> FEModel:
         raise StudyError("[fem] thickness: required for a 2-D (plane) mesh, e.g. thickness = 0.002 (metres)")
     if mesh.dim == 3 and f["thickness"] is not None:
         raise StudyError(f"[fem] thickness: only for 2-D meshes; this mesh is 3-D (got {f['thickness']!r})")
-    return assemble(mesh, material(study), order=f["order"], mass=f["mass"], clamp=f["clamp"],
-                    thickness=f["thickness"], plane=f["plane"])
+    try:
+        return assemble(mesh, material(study), order=f["order"], mass=f["mass"], clamp=f["clamp"],
+                        thickness=f["thickness"], plane=f["plane"])
+    except ValueError as exc:
+        if isinstance(f["clamp"], dict) and str(exc).startswith("clamp"):
+            raise StudyError(f"[fem] {exc}") from None
+        raise
 
 
 def contact_group(study: Study) -> str | None:

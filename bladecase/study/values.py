@@ -159,3 +159,19 @@ def _rayleigh(v) -> str | None:
 
 def _nonzero(v) -> str | None:
     return None if math.isfinite(v) and v != 0 else "must be a finite number, not 0"
+
+
+#: The coordinate rules of a clamp (:func:`bladecase.fe.select_nodes`); ``tol`` may go with any of them.
+CLAMP_RULES = ("plane", "box", "sphere")
+
+
+def _clamp_spec(v) -> str | None:
+    """A group name, or a table with exactly one coordinate rule (its values are checked by ``select_nodes``)."""
+    if isinstance(v, str):
+        return None if v else "must be a mesh group name or a table such as {plane = [0, 0, 0, 0, 0, 1]}"
+    rules = [k for k in v if k in CLAMP_RULES]
+    unknown = sorted(set(v) - set(CLAMP_RULES) - {"tol"})
+    if unknown or len(rules) != 1:
+        return (f"must hold exactly one of {', '.join(CLAMP_RULES)} (and optionally tol)"
+                + (f"; unknown keys {unknown}" if unknown else ""))
+    return None
