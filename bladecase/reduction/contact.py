@@ -371,28 +371,50 @@ class Contact:
         return f"Contact({where}, normal={self.normal}, gap={self.gap})"
 
 
+#: Boundary facets of each cell family (corner indices, cyclic order), grouped by their number of corners.
+_FACETS = {
+    "triangle": [((0, 1), (1, 2), (2, 0))],
+    "quad": [((0, 1), (1, 2), (2, 3), (3, 0))],
+    "tetra": [((0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3))],
+    "hexahedron": [((0, 3, 7, 4), (1, 2, 6, 5), (0, 1, 5, 4), (3, 2, 6, 7), (0, 1, 2, 3), (4, 5, 6, 7))],
+    "wedge": [((0, 1, 2), (3, 4, 5)), ((0, 1, 4, 3), (1, 2, 5, 4), (2, 0, 3, 5))],
+}
+
+
+def _facet_measure(P: np.ndarray, face: np.ndarray) -> np.ndarray:
+    """Length (2 corners), area of a triangle (3) or of a planar quadrilateral (4, by its diagonals)."""
+    if face.shape[1] == 2:
+        return np.linalg.norm(P[face[:, 1]] - P[face[:, 0]], axis=1)
+    if face.shape[1] == 3:
+        return 0.5 * np.linalg.norm(np.cross(P[face[:, 1]] - P[face[:, 0]], P[face[:, 2]] - P[face[:, 0]]), axis=1)
+    return 0.5 * np.linalg.norm(np.cross(P[face[:, 2]] - P[face[:, 0]], P[face[:, 3]] - P[face[:, 1]]), axis=1)
+
+
 def _area_weights(model: FEModel, group: str, nodes: np.ndarray) -> np.ndarray:
-    """Tributary weights of ``nodes``: each boundary facet of the body cells whose vertices all lie in ``group``
-    gives ``|f|/dim`` to each of its vertices; divided by the face's total measure (see :meth:`Contact.face`)."""
-    from itertools import combinations
+    """Tributary weights of ``nodes``: each boundary facet of the body cells whose corners all lie in ``group``
+    gives ``|f|/c`` to each of its ``c`` corners; divided by the face's total measure (see :meth:`Contact.face`)."""
+    from ..fe.cells import KINDS
 
     mesh, dim = model.mesh, model.dim
-    vertices = mesh.cells[mesh.body_type][:, :dim + 1]  # gmsh/meshio order: the corner vertices first
-    facets = np.vstack([np.sort(vertices[:, list(f)], axis=1) for f in combinations(range(dim + 1), dim)])
-    unique, count = np.unique(facets, axis=0, return_counts=True)
+    cells = mesh.cells[mesh.body_type]  # meshio order: the corner vertices first
     inside = np.zeros(mesh.points.shape[0], dtype=bool)
     inside[mesh.group(group)] = True
-    face = unique[(count == 1) & inside[unique].all(axis=1)]
-    if face.size == 0:
+    P = np.zeros((mesh.points.shape[0], 3))
+    P[:, :dim] = mesh.points[:, :dim]
+    share, total = np.zeros(mesh.points.shape[0]), 0.0
+    for kind in _FACETS[KINDS[mesh.body_type].family]:
+        facets = np.vstack([cells[:, list(f)] for f in kind])
+        _, first, count = np.unique(np.sort(facets, axis=1), axis=0, return_index=True, return_counts=True)
+        face = facets[first[count == 1]]
+        face = face[inside[face].all(axis=1)]
+        size = _facet_measure(P, face)
+        np.add.at(share, face.ravel(), np.repeat(size / face.shape[1], face.shape[1]))
+        total += size.sum()
+    if total == 0:
         raise ValueError(f"group {group!r} holds no boundary facet of the body cells: weights='area' needs a face "
                          "(use weights='equal' for a set of nodes)")
-    P = mesh.points[:, :dim]
-    edge = P[face[:, 1]] - P[face[:, 0]]
-    size = np.linalg.norm(edge if dim == 2 else np.cross(edge, P[face[:, 2]] - P[face[:, 0]]), axis=1)
-    size = size if dim == 2 else 0.5 * size
-    share = np.zeros(mesh.points.shape[0])
-    np.add.at(share, face.ravel(), np.repeat(size / dim, dim))
-    return share[nodes] / size.sum()
+    return share[nodes] / total
+
 
 def _finite_vector(name: str, value) -> np.ndarray:
     try:
