@@ -79,6 +79,28 @@ def _progress_options(p) -> None:
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
 
 
+def _execution_options(p) -> None:
+    p.add_argument("--executor", choices=("serial", "processes", "dask"),
+                   help="where independent tasks run (overrides [execution] executor; see docs/distributed.md)")
+    p.add_argument("--workers", type=_positive_int, metavar="N", help="local worker processes")
+    p.add_argument("--scheduler", metavar="ADDR", help="an existing Dask scheduler, e.g. tcp://host:8786")
+
+
+def _run_study(study, args, progress: bool):
+    """``run`` with the executor of the command line, else of ``[execution]`` (closed afterwards)."""
+    from .study import StudyError, run
+    from .study.executor import make_executor
+
+    x = study["execution"]
+    kind = args.executor or (None if args.scheduler or args.workers else x["executor"])
+    try:
+        executor = make_executor(kind, args.workers or x["workers"], args.scheduler or x["scheduler"])
+    except ValueError as exc:
+        raise StudyError(f"--executor/--workers/--scheduler: {exc}") from None
+    with executor:
+        return run(study, out=args.out, progress=progress, executor=executor)
+
+
 def _study_commands(sub) -> None:
     run = sub.add_parser(
         "run", help="run a study file end to end: mesh, FE model, reduction, nonsmooth modes, animations, VTK",
@@ -88,6 +110,7 @@ def _study_commands(sub) -> None:
     run.add_argument("study", type=Path, metavar="STUDY.toml")
     run.add_argument("--out", type=Path, metavar="DIR", help="output directory (overrides [output] directory)")
     _progress_options(run)
+    _execution_options(run)
     run.set_defaults(func=_cmd_run)
 
     demo = sub.add_parser(
@@ -98,6 +121,7 @@ def _study_commands(sub) -> None:
     demo.add_argument("--out", type=Path, metavar="DIR", help="output directory (default results/demo)")
     demo.add_argument("--print-study", action="store_true", help="print the demo study file and exit")
     _progress_options(demo)
+    _execution_options(demo)
     demo.set_defaults(func=_cmd_demo)
 
     mesh = sub.add_parser("mesh", help="stage 1: mesh the study's blade (gmsh) or convert its mesh file",
@@ -182,19 +206,17 @@ def _study(path: Path, model: bool = True):
 
 def _cmd_run(args) -> int:
     from .io import check_output_dir
-    from .study import run
 
     progress = _setup(args)
     study = _study(args.study)
     check_output_dir(study.output_dir(args.out))
-    result = run(study, out=args.out, progress=progress)
+    result = _run_study(study, args, progress)
     print(result.directory / "report.md")
     return 0
 
 
 def _cmd_demo(args) -> int:
     from .io import check_output_dir
-    from .study import run
     from .study.schema import demo_study, demo_text
 
     if args.print_study:
@@ -203,7 +225,7 @@ def _cmd_demo(args) -> int:
     progress = _setup(args)
     study = demo_study()
     check_output_dir(study.output_dir(args.out))
-    result = run(study, out=args.out, progress=progress)
+    result = _run_study(study, args, progress)
     print(result.directory / "report.md")
     return 0
 

@@ -3,6 +3,7 @@
 
 import json
 
+import numpy as np
 import pytest
 from _studies import PLATE, ROOT
 
@@ -86,3 +87,19 @@ def test_reference_model_is_a_row_of_the_comparison(tmp_path):
     doc = json.loads((result.directory / "modes.json").read_text())
     assert [c["model"] for c in doc["compare"]] == names[1:]
     assert "craig-bampton-40 (reference)" in (result.directory / "report.md").read_text()
+
+
+def test_the_grid_on_a_dask_local_cluster_gives_the_serial_results(result, tmp_path):
+    """The models' searches shipped to a 2-worker Dask LocalCluster come back with the same families and arcs
+    (records without their system, bound again on return)."""
+    from bladecase.study import DaskExecutor
+
+    with DaskExecutor(workers=2) as executor:
+        remote = run(loads(GRID, base=ROOT), out=tmp_path / "dask", progress=False, executor=executor)
+    assert list(remote.models) == list(result.models)
+    for name, m in remote.models.items():
+        mine = result.models[name]
+        assert len(m.branches) == len(mine.branches), name
+        arcs = [(a.T_lo, a.T_hi) for b in m.branches for a in b.arcs]
+        assert np.allclose(arcs, [(a.T_lo, a.T_hi) for b in mine.branches for a in b.arcs], rtol=1e-12), name
+        assert all(b.system is m.reduced.system for b in m.branches)

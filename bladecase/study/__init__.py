@@ -6,14 +6,15 @@
 - :mod:`~bladecase.study.render` — each chosen orbit checked and handed to the output writers;
 - :mod:`~bladecase.study.documents` — the modes file and the summary's parts (JSON);
 - :mod:`~bladecase.study.publish` — staging and all-or-nothing publishing;
-- :mod:`~bladecase.study.executor` — where independent tasks run (serial today);
+- :mod:`~bladecase.study.executor` — where independent tasks run (serial, local processes, Dask);
 - :mod:`~bladecase.study.run` — :func:`run`, the whole chain.
 
 The command line (:mod:`bladecase.cli`) is a thin layer over this package.
 """
 
-from .executor import Executor, SerialExecutor
+from .executor import DaskExecutor, Executor, ProcessExecutor, SerialExecutor, keyword_task, make_executor
 from .run import RunResult, run
 from .schema import Study, StudyError, demo_study, load_study
 
-__all__ = ["Executor", "RunResult", "SerialExecutor", "Study", "StudyError", "demo_study", "load_study", "run"]
+__all__ = ["DaskExecutor", "Executor", "ProcessExecutor", "RunResult", "SerialExecutor", "Study", "StudyError",
+           "demo_study", "keyword_task", "load_study", "make_executor", "run"]

@@ -1,29 +1,138 @@
-"""Where the independent tasks of a study run: one after the other in this process today.
+"""Where the independent tasks of a study run: here one after the other, in local processes, or on Dask.
 
-A task is a plain function applied to each item (e.g. the nonsmooth-mode search of each model of a
-comparison).  An executor maps it; the results come back in the order of the items.  A distributed
-executor (Dask) is another class with the same ``map`` — the stages do not change.
+A task is a plain function applied to each item (the nonsmooth-mode search of each model of a
+comparison, the forced response at each period of a sweep).  An executor maps it; the results come back
+in the order of the items, whichever executor ran them — the stages do not change:
+
+* :class:`SerialExecutor` — every task in this process, one after the other;
+* :class:`ProcessExecutor` — a pool of local processes (``concurrent.futures``, spawned, so safe on every
+  platform and with every BLAS);
+* :class:`DaskExecutor` — a ``dask.distributed`` cluster: a ``LocalCluster`` it starts (and closes), or an
+  existing scheduler by address (``tcp://host:8786``) or ``Client``.
+
+All three take the same call ``map(fn, items, *, shared=None, desc=, progress=)``: ``fn(item, **shared)``
+for each item.  ``shared`` holds the big arguments common to every task (a system's matrices, a study):
+they are sent to each worker once (a Dask ``scatter(..., broadcast=True)``; a process pool's initializer),
+not once per task.  :func:`keyword_task` maps a library function over any one of its keyword parameters.
+
+A task's exception is re-raised in the caller with its type kept and the failing item named in its
+message.  The ``bladecase`` log messages of a task run elsewhere are relayed into the caller's log (and so
+into a run's ``run.log``) when the task returns.  Workers run single-threaded BLAS
+(``OPENBLAS_NUM_THREADS=1`` and the like): the parallelism is across tasks.
 
 >>> SerialExecutor().map(lambda x: x * x, [1, 2, 3])
 [1, 4, 9]
+>>> SerialExecutor().map(lambda x, scale: scale * x, [1, 2], shared={"scale": 10})
+[10, 20]
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
-from typing import Protocol, TypeVar
+import os
+import uuid
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from typing import Any, Protocol, TypeVar
 
-from ..progress import progress_bar
+from .. import log
+from ..progress import progress_bar, progress_counter
+
+__all__ = ["EXECUTOR_KINDS", "DaskExecutor", "Executor", "KeywordTask", "ProcessExecutor", "SerialExecutor",
+           "keyword_task", "make_executor"]
 
 A = TypeVar("A")
 R = TypeVar("R")
+
+#: The kinds :func:`make_executor` accepts.
+EXECUTOR_KINDS = ("serial", "processes", "dask")
+
+#: The environment of every worker: one BLAS/OpenMP thread each (the tasks are the parallelism).
+WORKER_ENV = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
 
 
 class Executor(Protocol):
     """Maps a function over items and returns the results in the items' order."""
 
-    def map(self, fn: Callable[[A], R], items: Iterable[A], *, desc: str = "", progress: bool = False) -> list[R]:
+    name: str
+
+    def map(self, fn: Callable[..., R], items: Iterable[A], *, shared: dict[str, Any] | None = None,
+            desc: str = "tasks", progress: bool = False) -> list[R]:
         ...
+
+
+@dataclass(frozen=True)
+class KeywordTask:
+    """``fn`` with each item passed as its keyword argument ``name`` (see :func:`keyword_task`)."""
+
+    fn: Callable[..., Any]
+    name: str
+
+    def __call__(self, item: Any, **kwargs: Any) -> Any:
+        return self.fn(**{self.name: item}, **kwargs)
+
+
+def keyword_task(fn: Callable[..., R], name: str) -> KeywordTask:
+    """A task that calls ``fn(name=item, **shared)``: any parameter of a library function as the mapped one.
+
+    With the big arguments in ``shared`` (sent to each worker once), e.g. a forced sweep's system:
+
+    >>> from bladecase.nsm import chain, forced_point
+    >>> task = keyword_task(forced_point, "T")
+    >>> pts = SerialExecutor().map(task, [4.5, 4.6], shared={"system": chain(2, k=1.0, m=0.5, gap=1.0),
+    ...                                                      "amplitude": 0.6, "n_periods": 40})
+    >>> [p.T for p in pts]
+    [4.5, 4.6]
+    """
+    if not callable(fn):
+        raise ValueError(f"keyword_task: fn must be callable, got {fn!r}")
+    if not isinstance(name, str) or not name.isidentifier():
+        raise ValueError(f"keyword_task: name must be a parameter name (an identifier), got {name!r}")
+    return KeywordTask(fn, name)
+
+
+def _label(item: Any, width: int = 60) -> str:
+    text = repr(item)
+    return text if len(text) <= width else text[: width - 3] + "..."
+
+
+def _named(exc: BaseException, desc: str, index: int, item: Any) -> BaseException:
+    """``exc`` (same object, same type) with the failing item in its message and as a note."""
+    where = f"{desc or 'task'} {index} (item {_label(item)})"
+    if exc.args and isinstance(exc.args[0], str) and not exc.args[0].startswith(where):
+        exc.args = (f"{where}: {exc.args[0]}", *exc.args[1:])
+    exc.add_note(f"raised by {where}")
+    return exc
+
+
+class _Logged:
+    """A task run in a worker: ``(fn(item, **shared), the bladecase log lines it wrote)``.
+
+    ``shared`` is one positional dict (never keywords of Dask's ``submit``, whatever its names)."""
+
+    def __init__(self, fn: Callable[..., Any]):
+        self.fn = fn
+
+    def __call__(self, item: Any, shared: dict[str, Any]) -> tuple[Any, list[str]]:
+        with log.transcript() as lines:
+            out = self.fn(item, **shared)
+        return out, lines
+
+
+def _relay(lines: list[str]) -> None:
+    """Re-log a worker's transcript lines (``date time LEVEL message``) in this process."""
+    for line in lines:
+        parts = line.split(" ", 3)
+        level, msg = (parts[2], parts[3]) if len(parts) == 4 else ("INFO", line)
+        (log.warning if level in ("WARNING", "ERROR", "CRITICAL") else log.info)("%s", msg)
+
+
+def _check_workers(workers: int | None, what: str) -> int | None:
+    if workers is None:
+        return None
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise ValueError(f"{what}: workers must be a positive integer (or None for one per core), got {workers!r}")
+    return workers
 
 
 class SerialExecutor:
@@ -31,9 +140,290 @@ class SerialExecutor:
 
     name = "serial"
 
-    def map(self, fn: Callable[[A], R], items: Iterable[A], *, desc: str = "tasks", progress: bool = False) -> list[R]:
+    def map(self, fn: Callable[..., R], items: Iterable[A], *, shared: dict[str, Any] | None = None,
+            desc: str = "tasks", progress: bool = False) -> list[R]:
         items = list(items)
-        return [fn(x) for x in progress_bar(items, desc, enabled=progress and len(items) > 1, unit="task")]
+        kwargs = dict(shared or {})
+        out = []
+        for i, x in enumerate(progress_bar(items, desc, enabled=progress and len(items) > 1, unit="task")):
+            try:
+                out.append(fn(x, **kwargs))
+            except Exception as exc:
+                raise _named(exc, desc, i, x) from None
+        return out
+
+    def close(self) -> None:
+        """Nothing to release (same interface as the parallel executors)."""
+
+    def __enter__(self) -> SerialExecutor:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
 
     def __repr__(self) -> str:
         return "SerialExecutor()"
+
+
+@contextmanager
+def _worker_env() -> Iterator[None]:
+    """:data:`WORKER_ENV` in ``os.environ`` (where not set) while worker processes are spawned."""
+    added = {k: v for k, v in WORKER_ENV.items() if k not in os.environ}
+    os.environ.update(added)
+    try:
+        yield
+    finally:
+        for k in added:
+            os.environ.pop(k, None)
+
+
+@contextmanager
+def _environ_kept() -> Iterator[None]:
+    """``os.environ`` as it was before the block, whatever the block set."""
+    saved = dict(os.environ)
+    try:
+        yield
+    finally:
+        for k in set(os.environ) - set(saved):
+            del os.environ[k]
+        os.environ.update(saved)
+
+
+_SHARED: dict[str, Any] = {}
+
+
+def _install_shared(shared: dict[str, Any]) -> None:
+    """Process-pool initializer: keep the shared arguments in this worker."""
+    _SHARED.clear()
+    _SHARED.update(shared)
+
+
+def _run_with_shared(task: _Logged, item: Any) -> tuple[Any, list[str]]:
+    return task(item, _SHARED)
+
+
+class ProcessExecutor:
+    """Tasks in a pool of ``workers`` local processes (default: one per core), started for each ``map``.
+
+    The processes are spawned (not forked): ``fn``, the items and ``shared`` must pickle (module-level
+    functions, ``functools.partial`` of them, :func:`keyword_task`; not lambdas).  ``shared`` goes to each
+    process once; each process has one BLAS thread.  The pool lives for one ``map`` call.
+
+    >>> ProcessExecutor(2)
+    ProcessExecutor(workers=2)
+    """
+
+    name = "processes"
+
+    def __init__(self, workers: int | None = None):
+        self.workers = _check_workers(workers, "ProcessExecutor")
+
+    def map(self, fn: Callable[..., R], items: Iterable[A], *, shared: dict[str, Any] | None = None,
+            desc: str = "tasks", progress: bool = False) -> list[R]:
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor, as_completed
+
+        items = list(items)
+        if not items:
+            return []
+        n = min(self.workers or os.cpu_count() or 1, len(items))
+        task = _Logged(fn)
+        pool = ProcessPoolExecutor(n, mp_context=multiprocessing.get_context("spawn"),
+                                   initializer=_install_shared, initargs=(dict(shared or {}),))
+        results: list[Any] = [None] * len(items)
+        try:
+            with _worker_env():  # the workers are spawned as tasks are submitted
+                index = {pool.submit(_run_with_shared, task, x): i for i, x in enumerate(items)}
+            with progress_counter(len(items), desc, enabled=progress and len(items) > 1, unit="task") as bar:
+                bar.set_postfix_str(f"{n} processes")
+                for fut in as_completed(index):
+                    i = index[fut]
+                    try:
+                        results[i], lines = fut.result()
+                    except Exception as exc:
+                        pool.shutdown(wait=False, cancel_futures=True)
+                        raise _named(exc, desc, i, items[i]) from None
+                    _relay(lines)
+                    bar.update()
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
+        return results
+
+    def close(self) -> None:
+        """Nothing to release: each ``map`` closes its own pool."""
+
+    def __enter__(self) -> ProcessExecutor:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        return f"ProcessExecutor(workers={self.workers})"
+
+
+class DaskExecutor:
+    """Tasks on a ``dask.distributed`` cluster.
+
+    ``scheduler=None``: a ``LocalCluster`` of ``workers`` processes (default: one per core), one thread
+    each, started at the first ``map`` and closed by :meth:`close` (or at the end of a ``with`` block);
+    ``cluster_options`` go to ``LocalCluster`` (e.g. ``dashboard_address=":8787"``, ``memory_limit``).
+    ``scheduler="tcp://host:8786"`` (or a cluster object such as a
+    dask-jobqueue ``SLURMCluster``, or a ``distributed.Client``): an existing cluster, connected to at the
+    first ``map`` within ``timeout`` seconds, and its workers' bladecase version checked (RuntimeError when
+    one differs: workers need bladecase installed at the same version); :meth:`close` closes only the
+    connection this executor opened, never a cluster it did not start.
+
+    ``fn`` and the items are pickled with cloudpickle; ``shared`` is scattered to every worker once per
+    ``map``.  Progress advances as tasks complete on any worker.
+
+    >>> DaskExecutor(workers=2)
+    DaskExecutor(local cluster, workers=2)
+    >>> DaskExecutor("tcp://scheduler:8786")
+    DaskExecutor('tcp://scheduler:8786')
+    """
+
+    name = "dask"
+
+    def __init__(self, scheduler: Any = None, workers: int | None = None, *, timeout: float = 30.0,
+                 **cluster_options: Any):
+        self.workers = _check_workers(workers, "DaskExecutor")
+        if scheduler is not None:
+            if workers is not None or cluster_options:
+                raise ValueError(f"DaskExecutor: workers and cluster options apply to a local cluster only, not to "
+                                 f"the existing scheduler {scheduler!r}; valid: scheduler=None, or no workers")
+            if isinstance(scheduler, str) and not scheduler.strip():
+                raise ValueError("DaskExecutor: scheduler address is empty; valid: e.g. 'tcp://host:8786' or None")
+        if not timeout > 0:
+            raise ValueError(f"DaskExecutor: timeout must be > 0 seconds, got {timeout!r}")
+        self.scheduler = scheduler
+        self.timeout = float(timeout)
+        self.cluster_options = cluster_options
+        self._client = None
+        self._cluster = None
+        self._own_client = False
+
+    @property
+    def client(self):
+        """The ``distributed.Client`` (the local cluster is started, or the scheduler connected, on first use)."""
+        if self._client is None:
+            from distributed import Client, LocalCluster
+
+            if self.scheduler is None:
+                options = dict(dashboard_address=None, env=dict(WORKER_ENV)) | self.cluster_options
+                with _environ_kept():  # Dask's nannies write their pre-spawn variables into os.environ
+                    self._cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True,
+                                                 **options)
+                self._client, self._own_client = Client(self._cluster), True
+            elif isinstance(self.scheduler, Client):
+                self._client = self.scheduler
+            else:
+                self._client = Client(self.scheduler, timeout=self.timeout)
+                self._own_client = True
+            if self._cluster is None:
+                self._check_versions()
+        return self._client
+
+    def _check_versions(self) -> None:
+        """Every worker of an existing cluster runs this bladecase version (else close and raise RuntimeError)."""
+        from .. import __version__
+
+        try:
+            found = self._client.run(_bladecase_version)
+            problem = ", ".join(f"{w} has {v}" for w, v in sorted(found.items()) if v != __version__)
+        except Exception as exc:  # bladecase missing on a worker: it cannot unpickle the probe
+            problem = f"a worker cannot import bladecase ({type(exc).__name__}: {exc})"
+        if problem:
+            self.close()
+            raise RuntimeError(f"Dask workers of {self.scheduler!r} must run bladecase {__version__} (install it "
+                               f"there at the same version): {problem}")
+
+    def map(self, fn: Callable[..., R], items: Iterable[A], *, shared: dict[str, Any] | None = None,
+            desc: str = "tasks", progress: bool = False) -> list[R]:
+        from distributed import as_completed
+
+        items = list(items)
+        if not items:
+            return []
+        client = self.client
+        kwargs = {k: client.scatter([v], broadcast=True, hash=False)[0] for k, v in (shared or {}).items()}
+        task, tag = _Logged(fn), uuid.uuid4().hex[:8]
+        futures = [client.submit(task, x, kwargs, key=f"bladecase-{tag}-{i}", pure=False)
+                   for i, x in enumerate(items)]
+        index = {f.key: i for i, f in enumerate(futures)}
+        results: list[Any] = [None] * len(items)
+        try:
+            with progress_counter(len(items), desc, enabled=progress and len(items) > 1, unit="task") as bar:
+                bar.set_postfix_str(f"{len(client.nthreads())} workers")
+                for fut in as_completed(futures):
+                    i = index[fut.key]
+                    try:
+                        results[i], lines = fut.result()
+                    except Exception as exc:
+                        raise _named(exc, desc, i, items[i]) from None
+                    _relay(lines)
+                    bar.update()
+        finally:
+            client.cancel([f for f in futures if not f.done()])
+            del futures, kwargs  # release the scattered data and the results on the workers
+        return results
+
+    def close(self) -> None:
+        """Close the connection this executor opened and the local cluster it started (if any)."""
+        if self._client is not None and self._own_client:
+            self._client.close()
+        if self._cluster is not None:
+            self._cluster.close()
+        self._client = self._cluster = None
+        self._own_client = False
+
+    def __enter__(self) -> DaskExecutor:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        if self.scheduler is None:
+            return f"DaskExecutor(local cluster, workers={self.workers})"
+        return f"DaskExecutor({self.scheduler!r})"
+
+
+def _bladecase_version() -> str:
+    """The bladecase version of the process this runs in (a Dask worker)."""
+    from .. import __version__
+
+    return __version__
+
+
+def make_executor(kind: str | None = None, workers: int | None = None, scheduler: Any = None) -> Executor:
+    """The executor of ``kind`` (``"serial"``, ``"processes"``, ``"dask"``).
+
+    ``kind=None`` picks from the other arguments: a ``scheduler`` → Dask on that cluster; ``workers > 1``
+    → Dask on a ``LocalCluster`` of that many workers; otherwise serial.  ``workers`` is the number of local
+    processes (``None``: one per core), ``scheduler`` an existing Dask scheduler (``"tcp://host:8786"``).
+
+    >>> make_executor(), make_executor("processes", workers=2), make_executor(workers=4)
+    (SerialExecutor(), ProcessExecutor(workers=2), DaskExecutor(local cluster, workers=4))
+    >>> make_executor(scheduler="tcp://10.0.0.5:8786")
+    DaskExecutor('tcp://10.0.0.5:8786')
+    >>> make_executor("threads")
+    Traceback (most recent call last):
+    ...
+    ValueError: executor kind 'threads' is not known; valid: 'serial', 'processes', 'dask'
+    """
+    if kind is None:
+        kind = "dask" if scheduler is not None or (workers is not None and workers != 1) else "serial"
+    if kind not in EXECUTOR_KINDS:
+        raise ValueError(f"executor kind {kind!r} is not known; valid: {', '.join(map(repr, EXECUTOR_KINDS))}")
+    _check_workers(workers, f"{kind} executor")
+    if scheduler is not None and kind != "dask":
+        raise ValueError(f"a scheduler ({scheduler!r}) needs the 'dask' executor, not {kind!r}")
+    if kind == "serial":
+        if workers not in (None, 1):
+            raise ValueError(f"the serial executor runs 1 worker, got workers={workers!r}; valid: 'processes' or "
+                             "'dask' for more")
+        return SerialExecutor()
+    if kind == "processes":
+        return ProcessExecutor(workers)
+    return DaskExecutor(scheduler, workers)

@@ -1,6 +1,6 @@
 """The building blocks of the study schema: :class:`Key` (one key: types, default, meaning, check),
 :class:`StudyError` and the accepted type tuples.  The sections live in :mod:`bladecase.study.schema`
-(and :mod:`bladecase.study.forcing_keys`)."""
+(and :mod:`bladecase.study.sections`)."""
 
 from __future__ import annotations
 

@@ -25,7 +25,7 @@ from ..post.report import report
 from ..progress import progress_counter
 from .comparison import FE_MODES, compare_models
 from .documents import contact_summary, families_document, family_summary, model_summary, reduced_summary
-from .executor import Executor, SerialExecutor
+from .executor import Executor, make_executor
 from .forcing import forced_response, forced_scene
 from .publish import RUN_RESULTS, check_inputs, publish, release, staging_dir
 from .reference import reference_model
@@ -129,10 +129,12 @@ def run(study: Study, out: str | os.PathLike | None = None, progress: bool = Tru
         check_inputs(out, [study.mesh_path()])
     staging = staging_dir(out)
     stages = _Stages(progress, total=7 if study["forcing"]["amplitude"] is not None else 6)
+    x = study["execution"]
+    own = None if executor is not None else make_executor(x["executor"], x["workers"], x["scheduler"])
     try:
         with log.transcript() as lines:
             log.info("study %s (%s) → %s", study.name, study.source, out)
-            summary, families, models = _compute(study, staging, stages, progress, executor or SerialExecutor())
+            summary, families, models = _compute(study, staging, stages, progress, executor or own)
             summary["timings_s"] = dict(stages.timings, total=round(time.perf_counter() - t_start, 3))
             log.info("results in %s (%.1f s)", out, summary["timings_s"]["total"])
         write_text(staging / "run.log", "\n".join(lines) + "\n")
@@ -146,6 +148,8 @@ def run(study: Study, out: str | os.PathLike | None = None, progress: bool = Tru
         raise
     finally:
         stages.bar.close()
+        if own is not None:
+            own.close()
     return RunResult(directory=out, summary=summary, families=families, models=models)
 
 
@@ -193,10 +197,12 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         searched = [reduced, *compares, *([reference] if extra else [])]
     with stage("search"):
         unit, _ = period_unit(study, reduced.system)
-        timed = executor.map(lambda r: _timed(search, study, r.system, progress=progress, unit=unit,
-                                              label=f"{r.method} {r.size} ({r.n} dofs)"), searched,
+        timed = executor.map(_search_model, [(f"{r.method} {r.size} ({r.n} dofs)", r.system) for r in searched],
+                             shared={"study": study, "unit": unit, "progress": progress and executor.name == "serial"},
                              desc="models", progress=progress)
-        found = [f for f, _ in timed]
+        # a parallel executor sends the families back without their system (light records): attach it again
+        found = [[b if b.system is not None else b.bind(r.system) for b in fams]
+                 for r, (fams, _) in zip(searched, timed)]
         families, compare_families = found[0], found[1:1 + len(compares)]
         names = [None] * (1 + len(compares)) + ([f"{reference.method}-{reference.size} (reference)"] if extra else [])
         models = [ModelResult(r, fams, b, t, name) for r, fams, b, (_, t), name in
@@ -265,6 +271,13 @@ def _animate_forced(study: Study, reduced, section: dict, orbits: list, folder: 
                  entry["sweep"])
         out.append(entry)
     return out
+
+
+def _search_model(item: tuple[str, object], *, study: Study, unit: float, progress: bool) -> tuple[list, float]:
+    """One model's search, timed; ``item = (label, system)``.  Module-level so that an executor can ship it to
+    other processes (the study and the period unit go once per worker, as ``shared``)."""
+    label, system = item
+    return _timed(search, study, system, progress=progress, unit=unit, label=label)
 
 
 def _timed(fn, *args, **kwargs):

@@ -27,8 +27,8 @@ from typing import Any
 from ..fe import BladeGeometry, PlateGeometry
 from ..post.outputs import FORMATS as OUTPUT_FORMATS
 from ..reduction import METHODS
-from .forcing_keys import FORCING_KEYS, forcing_checks
 from .keys import _BOOL, _INT, _LIST, _NUM, _STR, REQUIRED, Key, StudyError  # noqa: F401
+from .sections import EXECUTION_KEYS, FORCING_KEYS, execution_checks, forcing_checks
 from .values import (  # noqa: F401  (RANGES, LIMITS: part of the schema's documented surface)
     LIMITS,
     RANGES,
@@ -172,6 +172,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "fps": Key(_NUM, 20, "Frames per second of the animations.",
                    lambda v: None if 0 < v <= LIMITS["fps"] else f"must be a number in (0, {LIMITS['fps']}]"),
     },
+    "execution": EXECUTION_KEYS,
 }
 
 #: ``[geometry]`` keys taken from the geometry dataclasses (the parametric shape).
@@ -370,6 +371,7 @@ def _cross_checks(c: dict) -> None:
     _contact_model_checks(c)
     _work_checks(c["search"])
     forcing_checks(c)
+    execution_checks(c)
     o, s = c["output"], c["search"]
     for i, item in enumerate(o["orbits"]):
         if item["ipp"] not in s["ipp"]:

@@ -1,8 +1,11 @@
-"""The ``[forcing]`` section of a study: the forced–damped response of the blade (damping, load, forcing
-frequencies, the sweep) and its cross-checks; run by :func:`bladecase.study.forcing.forced_response`."""
+"""The sections of a study beyond the pipeline's own: ``[forcing]`` (the forced–damped response of the blade:
+damping, load, forcing frequencies, the sweep; run by :func:`bladecase.study.forcing.forced_response`) and
+``[execution]`` (where independent tasks run: :func:`bladecase.study.executor.make_executor`), with their
+cross-checks."""
 
 from __future__ import annotations
 
+from .executor import make_executor
 from .keys import _INT, _LIST, _NUM, _STR, Key, StudyError
 from .values import LIMITS, _direction, _int_at_least, _int_between, _nonzero, _one_of, _periods, _rayleigh
 
@@ -69,3 +72,26 @@ def forcing_checks(c: dict) -> None:
     if c["contact"]["model"] != "newton":
         raise StudyError("[forcing]: needs [contact] model = 'newton' for now (the massless contact model has no "
                          "forced simulation)")
+
+
+#: ``[execution]``: key → :class:`~bladecase.study.keys.Key`.
+EXECUTION_KEYS: dict[str, Key] = {
+    "executor": Key(_STR, None, "Where the independent tasks (each model's search, the forcing sweeps) run: "
+                    "'serial', 'processes' (local processes) or 'dask' (a Dask LocalCluster of 'workers' processes, "
+                    "or the cluster at 'scheduler'); default: 'dask' with a scheduler or workers > 1, else 'serial'.",
+                    _one_of("serial", "processes", "dask")),
+    "workers": Key(_INT, None, "Local worker processes ('processes', or 'dask' without 'scheduler'); default: "
+                   "one per core.", _int_at_least(1)),
+    "scheduler": Key(_STR, None, "Address of an existing Dask scheduler, e.g. 'tcp://host:8786' (the workers "
+                     "need bladecase at the same version); implies executor = 'dask'.",
+                     lambda v: None if v.strip() else "must be an address such as 'tcp://host:8786'"),
+}
+
+
+def execution_checks(c: dict) -> None:
+    """``[execution]``: the executor's own checks (nothing is started here)."""
+    x = c["execution"]
+    try:
+        make_executor(x["executor"], x["workers"], x["scheduler"])
+    except ValueError as exc:
+        raise StudyError(f"[execution] {exc}") from None
