@@ -99,7 +99,7 @@ def test_massless_study_keys_go_together():
 
     with pytest.raises(StudyError, match=r"\[reduction\] method: the massless contact model needs"):
         loads(PLATE.replace("[contact]\n", '[contact]\nmodel = "massless"\n'), base=ROOT)
-    with pytest.raises(StudyError, match=r"\[reduction\] method: 'massless' is the reduction of the massless"):
+    with pytest.raises(StudyError, match=r"\[reduction\] method: 'massless' is a reduction of the massless"):
         loads(PLATE.replace('method = "modal"', 'method = "massless"'), base=ROOT)
     with pytest.raises(StudyError, match=r"\[contact\] model"):
         loads(PLATE.replace("[contact]\n", '[contact]\nmodel = "penalty"\n'), base=ROOT)

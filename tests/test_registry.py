@@ -38,12 +38,14 @@ def contact(plate) -> Contact:
 
 
 def test_methods_behave_as_the_tuple_of_names():
-    names = ("full", "modal", "lanczos", "lanczos-si", "craig-bampton", "massless")
+    names = ("full", "modal", "lanczos", "lanczos-si", "craig-bampton", "massless", "massless-lanczos",
+             "massless-modal")
     assert METHODS == names and tuple(METHODS) == names and list(METHODS) == list(names)
-    assert len(METHODS) == 6 and METHODS[0] == "full" and METHODS[-1] == "massless"
+    assert len(METHODS) == 8 and METHODS[0] == "full" and METHODS[-1] == "massless-modal"
     assert METHODS[1:3] == ("modal", "lanczos") and METHODS.index("lanczos-si") == 3
     assert "modal" in METHODS and "guyan" not in METHODS and ["modal"] not in METHODS and None not in METHODS
-    assert ", ".join(METHODS) == "full, modal, lanczos, lanczos-si, craig-bampton, massless"
+    assert ", ".join(METHODS) == ("full, modal, lanczos, lanczos-si, craig-bampton, massless, massless-lanczos, "
+                                  "massless-modal")
     assert repr(METHODS) == repr(names)
     assert METHODS.entry("full").sized is False and METHODS.entry("modal").sized is True
     assert list(METHODS.summaries()) == list(names)
@@ -92,7 +94,7 @@ def test_a_new_method_is_one_builder_and_one_registration(plate, contact):
         reduced = reduce(plate, contact, "guyan")
     finally:
         METHODS.unregister("guyan")
-    assert "guyan" not in METHODS and len(METHODS) == 6
+    assert "guyan" not in METHODS and len(METHODS) == 8
     assert calls == [(None, None)] and reduced.method == "guyan" and reduced.n == 2
     K = plate.K.toarray()
     b = contact.dofs(plate)

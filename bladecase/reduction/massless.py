@@ -228,8 +228,12 @@ def _split(model: FEModel, contact: Contact) -> _Split:
     return _Split(w, c, i, K, sp.csr_array(K[c][:, i]), cc)
 
 
+#: Interior bases of :func:`massless_model`: the registered method of each.
+BASES = {"modes": "massless", "krylov": "massless-lanczos", "modal": "massless-modal"}
+
+
 def massless_model(model: FEModel, contact: Contact, size: int | None = None,
-                   factor: SPDFactor | None = None) -> MasslessReducedModel:
+                   factor: SPDFactor | None = None, basis: str = "modes") -> MasslessReducedModel:
     """The massless contact model of ``model`` with ``contact``, exact or reduced (module docstring).
 
     Parameters
@@ -244,6 +248,12 @@ def massless_model(model: FEModel, contact: Contact, size: int | None = None,
         dofs (``1 <= m <= n_interior - 1``).
     factor : SPDFactor or None
         ``bladecase.fe.stiffness_factor(model)``, reused (the modes and the attachment vector need ``K⁻¹``).
+    basis : str
+        How a ``size`` reduces the interior (the existing methods applied to the redistributed mass):
+        ``"modes"`` (method ``massless``: the massless-boundary Craig–Bampton, modes + attachment vector),
+        ``"krylov"`` (``massless-lanczos``: the shift-invert Lanczos vectors ``(K⁻¹M)^j K⁻¹w``, j = 0…size, of the
+        massless structure, started from the attachment vector — ``size + 1`` dofs, the static compliance exact)
+        or ``"modal"`` (``massless-modal``: the ``size`` modes alone, the compliance truncated).
 
     Returns
     -------
@@ -259,6 +269,8 @@ def massless_model(model: FEModel, contact: Contact, size: int | None = None,
     """
     if not isinstance(model, FEModel):
         raise ValueError(f"model must be an FEModel (from bladecase.assemble), got {type(model).__name__}")
+    if basis not in BASES:
+        raise ValueError(f"basis must be one of {', '.join(map(repr, BASES))}, got {basis!r}")
     if not isinstance(contact, Contact):
         raise ValueError(f"contact must be a bladecase.Contact (node or face, normal, gap), "
                          f"got {type(contact).__name__}")
@@ -285,14 +297,22 @@ def massless_model(model: FEModel, contact: Contact, size: int | None = None,
         V, M_r = _exact_basis(split), np.diag(masses[split.i])
     else:
         fac = factor if factor is not None else spd_factor(model.K, _K, hint=_HINT)
-        V_i = _m_orthonormal(_interior_modes(split, masses, size, fac), fac.solve(split.w)[split.i], masses[split.i])
+        attach = fac.solve(split.w)[split.i]
+        if basis == "krylov":
+            V_i = _krylov(split, masses, size, fac)
+        elif basis == "modal":
+            phi = _interior_modes(split, masses, size, fac)
+            V_i = phi / np.sqrt(np.einsum("ij,i,ij->j", phi, masses[split.i], phi))
+        else:
+            V_i = _m_orthonormal(_interior_modes(split, masses, size, fac), attach, masses[split.i])
         V = np.zeros((split.w.size, V_i.shape[1]))
         V[split.i], V[split.c] = V_i, split.slave(V_i)
         M_r = V_i.T @ (masses[split.i][:, None] * V_i)
     S_r = split.schur() if size is None else V.T @ (split.K @ V)
     system = MasslessSystem(0.5 * (M_r + M_r.T), 0.5 * (S_r + S_r.T), np.asarray(V.T @ split.w), split.kc,
                             contact.gap)
-    return MasslessReducedModel("massless", size, system, V, model, contact, closed_shape=split.closed_shape(),
+    method = "massless" if size is None else BASES[basis]
+    return MasslessReducedModel(method, size, system, V, model, contact, closed_shape=split.closed_shape(),
                                 masses=masses)
 
 
@@ -321,6 +341,31 @@ def _interior_modes(split: _Split, masses: np.ndarray, count: int, fac: SPDFacto
     _, phi = lowest_modes(split.K, sp.diags_array(masses, format="csr"), count, factor=fac, dense=False, name=_K,
                           hint=_HINT)
     return phi[split.i]
+
+
+def _krylov(split: _Split, masses: np.ndarray, size: int, fac: SPDFactor) -> np.ndarray:
+    """Interior parts of ``u_0 = K⁻¹w``, ``u_{j+1} = K⁻¹M u_j`` (``M`` the redistributed masses, zero on the
+    contact), ``j < size``, ``M_ii``-orthonormalised with full re-orthogonalisation (twice); the vectors from
+    ``u_1`` on carry the slaved contact rows (their load vanishes on the contact). Stops early, with fewer
+    vectors, when the space is exhausted (an invariant subspace to round-off)."""
+    m_i = masses[split.i]
+    Q = np.zeros((split.i.size, size + 1))
+    u = fac.solve(split.w)
+    count = 0
+    for _ in range(size + 1):
+        q = u[split.i].copy()
+        size0 = np.sqrt(q @ (m_i * q))
+        for _ in range(2):
+            q -= Q[:, :count] @ (Q[:, :count].T @ (m_i * q))
+        norm = np.sqrt(q @ (m_i * q))
+        if norm <= 1e-10 * size0:
+            break
+        Q[:, count] = q / norm
+        count += 1
+        full = np.zeros(split.w.size)
+        full[split.i] = masses[split.i] * Q[:, count - 1]
+        u = fac.solve(full)
+    return Q[:, :count]
 
 
 def _m_orthonormal(phi: np.ndarray, extra: np.ndarray, m: np.ndarray) -> np.ndarray:

@@ -413,23 +413,29 @@ def _expand_grid(r: dict) -> None:
                          f"{LIMITS['models'] + 1}")
 
 
+#: The reductions of the massless contact model (:data:`bladecase.reduction.massless.BASES`).
+MASSLESS_METHODS = ("massless", "massless-lanczos", "massless-modal")
+
+
 def _contact_model_checks(c: dict) -> None:
     """The massless contact model and the keys it needs go together."""
     massless = c["contact"]["model"] == "massless"
     methods = [c["reduction"]["method"]] + [x["method"] for x in c["reduction"]["compare"]]
     if massless:
-        bad = [m for m in methods if m != "massless"]
+        bad = [m for m in methods if m not in MASSLESS_METHODS]
         if bad:
-            raise StudyError(f"[reduction] method: the massless contact model needs method = 'massless' "
-                             f"(for every model, compare included), got {bad[0]!r}")
+            raise StudyError(f"[reduction] method: the massless contact model needs a massless method "
+                             f"({', '.join(map(repr, MASSLESS_METHODS))}) for every model, compare included; "
+                             f"got {bad[0]!r}")
         if c["search"]["ipp"] != [1]:
             raise StudyError(f"[search] ipp: the massless contact model has modes with one contact phase per "
                              f"period: ipp = [1], got {c['search']['ipp']}")
         if c["fem"]["mass"] != "lumped":
             raise StudyError("[fem] mass: the massless contact model moves lumped masses: mass = 'lumped', got "
                              f"{c['fem']['mass']!r}")
-    elif "massless" in methods:
-        raise StudyError("[reduction] method: 'massless' is the reduction of the massless contact model: set "
+    elif any(m in MASSLESS_METHODS for m in methods):
+        m = next(m for m in methods if m in MASSLESS_METHODS)
+        raise StudyError(f"[reduction] method: {m!r} is a reduction of the massless contact model: set "
                          "[contact] model = 'massless'")
 
 

@@ -14,10 +14,22 @@ from ...linalg import SPDFactor
 from ..contact import Contact
 from ..massless import MasslessReducedModel, massless_masses, massless_model
 
-__all__ = ["MasslessReducedModel", "build", "massless_masses"]
+__all__ = ["MasslessReducedModel", "build", "build_krylov", "build_modal", "massless_masses"]
 
 
 def build(model: FEModel, contact: Contact, size: int | None, factor: SPDFactor | None = None
           ) -> MasslessReducedModel:
     """``size`` modes of the massless structure plus the attachment vector, or (``None``) every interior dof."""
     return massless_model(model, contact, size, factor=factor)
+
+
+def build_krylov(model: FEModel, contact: Contact, size: int | None, factor: SPDFactor | None = None
+                 ) -> MasslessReducedModel:
+    """Shift-invert Lanczos on the redistributed mass: ``size`` Krylov steps from the attachment vector."""
+    return massless_model(model, contact, size, factor=factor, basis="krylov")
+
+
+def build_modal(model: FEModel, contact: Contact, size: int | None, factor: SPDFactor | None = None
+                ) -> MasslessReducedModel:
+    """The ``size`` lowest modes of the massless structure, without the attachment vector."""
+    return massless_model(model, contact, size, factor=factor, basis="modal")
