@@ -10,6 +10,11 @@ $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e ".[test,video]"
+	@# optional CHOLMOD (faster sparse factorisation): only where SuiteSparse's headers are installed
+	@if [ -f /usr/include/suitesparse/cholmod.h ]; then \
+	    $(BIN)/python -m pip install --quiet "scikit-sparse<0.5" \
+	    || echo "optional scikit-sparse (CHOLMOD) not installed: SuperLU used"; \
+	else echo "optional CHOLMOD: no SuiteSparse headers (apt install libsuitesparse-dev): SuperLU used"; fi
 	touch $(STAMP)
 
 demo: $(STAMP)
@@ -23,6 +28,11 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_kipp.py --skip-b
 	$(BIN)/python benchmarks/bench_fem.py
 	$(BIN)/python benchmarks/bench_demo.py
+	$(BIN)/python benchmarks/bench_search.py --cases chain10,chain20,chain50,demo8
+	$(BIN)/python benchmarks/bench_scaling.py
+	$(BIN)/python benchmarks/bench_fe_pipeline.py --skip-110k
+	$(BIN)/python benchmarks/bench_solvers.py --skip-110k
+	$(BIN)/python benchmarks/bench_executor.py
 
 clean:
 	rm -rf $(VENV) results build *.egg-info

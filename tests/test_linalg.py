@@ -17,8 +17,11 @@ import scipy.sparse as sp
 import bladecase as bc
 from bladecase import checks
 from bladecase.linalg import (
+    BLOCK_MIN_DOFS,
     DENSE_LIMIT,
+    Factor,
     SPDFactor,
+    _eigen_method,
     check_factor,
     diagonal,
     factor_backend,
@@ -27,6 +30,7 @@ from bladecase.linalg import (
     spd_factor,
     symmetric_factor,
 )
+from bladecase.linalg_block import block_lanczos
 
 MESHES = Path(__file__).resolve().parent.parent / "meshes"
 
@@ -164,6 +168,68 @@ def test_lowest_modes_errors():
         lowest_modes(big, big, 3, dense=True)
     with pytest.raises(ValueError, match=r"K is not positive definite: eigenvalue -1 \(a mechanism"):
         lowest_modes(np.diag([-1.0, 1.0]), np.eye(2), 1)
+
+
+def grid_matrices(k: int) -> tuple[sp.csr_array, sp.csr_array]:
+    """Stiffness and consistent mass of a k × k grid (Kronecker products of 1-D P1 chains, clamped ends):
+    double eigenvalues (modes (i, j) and (j, i)), eigenvalues ``λ_ij = (a_i + a_j) / (b_i b_j)``-like."""
+    h = 1.0 / (k + 1)
+    k1 = sp.diags_array([[-1.0] * (k - 1), [2.0] * k, [-1.0] * (k - 1)], offsets=[-1, 0, 1]) / h
+    m1 = sp.diags_array([[1.0] * (k - 1), [4.0] * k, [1.0] * (k - 1)], offsets=[-1, 0, 1]) * (h / 6)
+    return sp.csr_array(sp.kron(k1, m1) + sp.kron(m1, k1)), sp.csr_array(sp.kron(m1, m1))
+
+
+@pytest.mark.parametrize("count", [1, 8, 20])
+def test_block_lanczos_matches_the_dense_eigen_solution_with_double_eigenvalues(count):
+    K, M = grid_matrices(30)  # 900 dofs
+    ref = sla.eigh(K.toarray(), M.toarray(), eigvals_only=True, subset_by_index=[0, count - 1])
+    assert count < 8 or np.isclose(ref[1], ref[2], rtol=1e-12)  # a double eigenvalue among the wanted ones
+    f = spd_factor(K, "K")
+    assert block_lanczos(K, M, f.solve, count) is not None  # converged: no fall-back to ARPACK below
+    lam, phi = lowest_modes(K, M, count, factor=f, method="block")
+    np.testing.assert_allclose(lam, ref, rtol=1e-10, atol=0)
+    np.testing.assert_allclose(phi.T @ (M @ phi), np.eye(count), atol=1e-10)
+    residual = np.linalg.norm(K @ phi - (M @ phi) * lam, axis=0) / np.linalg.norm(K @ phi, axis=0)
+    assert residual.max() < 1e-7
+    lam_a, _ = lowest_modes(K, M, count, factor=f, method="arpack")
+    np.testing.assert_allclose(lam, lam_a, rtol=1e-10, atol=0)
+
+
+def test_block_lanczos_converges_reproducibly_or_says_it_did_not():
+    K, M = grid_matrices(20)
+    solve = spd_factor(K, "K").solve
+    lam, phi = block_lanczos(K, M, solve, 6, block=4)
+    lam2, phi2 = block_lanczos(K, M, solve, 6, block=4)
+    np.testing.assert_array_equal(lam, lam2)  # a seeded start block
+    np.testing.assert_array_equal(phi, phi2)
+    ref = sla.eigh(K.toarray(), M.toarray(), eigvals_only=True, subset_by_index=[0, 5])
+    np.testing.assert_allclose(lam, ref, rtol=1e-10, atol=0)
+    assert block_lanczos(K, M, solve, 6, block=2, max_dim=8) is None  # 8 vectors cannot give 6 pairs to 1e-10
+    with pytest.raises(ValueError, match="block must be an integer >= 1, got 0"):
+        block_lanczos(K, M, solve, 6, block=0)
+    with pytest.raises(ValueError, match=r"max_dim = 8 is too small for count = 6 and block = 4"):
+        block_lanczos(K, M, solve, 6, block=4, max_dim=8)
+
+
+def test_lowest_modes_method():
+    K, M = chain_matrices(30)
+    with pytest.raises(ValueError, match=r"method must be one of 'auto', 'arpack', 'block', got 'lobpcg'"):
+        lowest_modes(K, M, 2, method="lobpcg")
+    n, solve = BLOCK_MIN_DOFS, (lambda b: b)
+    assert _eigen_method("auto", Factor("K", n, "sparse", "cholmod", solve), n) == "block"
+    assert _eigen_method("auto", Factor("K", n - 1, "sparse", "cholmod", solve), n - 1) == "arpack"
+    assert _eigen_method("auto", Factor("K", n, "sparse", "superlu", solve), n) == "arpack"
+    assert _eigen_method("block", Factor("K", 10, "sparse", "superlu", solve), 10) == "block"
+
+
+def test_natural_frequencies_block_and_arpack_agree_on_the_plate():
+    model = bc.assemble(bc.load_mesh(MESHES / "plate.msh"), "Ti-6Al-4V", order=1, thickness=0.002)
+    factor = bc.stiffness_factor(model)
+    f_block = bc.natural_frequencies(model, 12, factor=factor, method="block")
+    f_arpack = bc.natural_frequencies(model, 12, factor=factor, method="arpack")
+    np.testing.assert_allclose(f_block, f_arpack, rtol=1e-9, atol=0)
+    with pytest.raises(ValueError, match="method must be one of"):
+        bc.natural_frequencies(model, 3, method="dense")
 
 
 def test_fe_eigen_solutions_never_form_a_dense_model_matrix(monkeypatch):

@@ -51,11 +51,13 @@ def _check_rigid(model: FEModel) -> None:
         raise ValueError(f"K is singular: {why}; clamp a face of every part")
 
 
-def natural_frequencies(model: FEModel, count: int, return_modes: bool = False, *, factor: SPDFactor | None = None):
+def natural_frequencies(model: FEModel, count: int, return_modes: bool = False, *, factor: SPDFactor | None = None,
+                        method: str = "auto"):
     """The ``count`` lowest natural frequencies (Hz) of a clamped model.
 
-    Shift-invert Lanczos (ARPACK ``eigsh``) about 0 with the sparse LDLᵀ of
-    ``K`` (:func:`bladecase.linalg.lowest_modes`, :func:`stiffness_factor`); no
+    Shift-invert Lanczos about 0 with the sparse factorisation of ``K``
+    (:func:`bladecase.linalg.lowest_modes`, :func:`stiffness_factor`): ARPACK's,
+    or block Lanczos for a CHOLMOD factor of a large model (``method``); no
     dense matrix is formed unless more than half of the modes of a model of
     at most :data:`bladecase.linalg.DENSE_LIMIT` dofs are asked for.
 
@@ -68,6 +70,8 @@ def natural_frequencies(model: FEModel, count: int, return_modes: bool = False, 
         Also return the mode shapes.
     factor : SPDFactor or None
         ``stiffness_factor(model)``, to reuse a factorisation (computed here if ``None``).
+    method : str
+        ``"auto"``, ``"arpack"`` or ``"block"`` (:func:`bladecase.linalg.lowest_modes`).
 
     Returns
     -------
@@ -82,7 +86,7 @@ def natural_frequencies(model: FEModel, count: int, return_modes: bool = False, 
     ValueError
         ``count`` out of range; a model with rigid-body modes (no clamp, or a
         clamp that leaves a rotation free) or otherwise singular ``K``; a
-        ``factor`` that is not this model's.
+        ``factor`` that is not this model's; an unknown ``method``.
 
     Examples
     --------
@@ -103,6 +107,6 @@ def natural_frequencies(model: FEModel, count: int, return_modes: bool = False, 
     count = integer("count", count, 1, n, strict_high=True, note=" (the number of free dofs)")
     factor = check_factor(factor, model.K, "this model's K", "bladecase.fe.stiffness_factor(model)")
     _check_rigid(model)
-    lam, phi = lowest_modes(model.K, model.M, count, factor=factor, hint=_SINGULAR_HINT)
+    lam, phi = lowest_modes(model.K, model.M, count, factor=factor, hint=_SINGULAR_HINT, method=method)
     f = np.sqrt(lam) / (2 * np.pi)
     return (f, phi) if return_modes else f
