@@ -40,7 +40,7 @@ from bladecase.nsm import ModalKernel
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 NAMES = ["fig2_impact_time_map", "fig3_trajectories", "fig4_manifold", "frequency_energy", "fig11_stability",
-         "fig9_forced_response", "fig10_forced_response", "compare_models"]
+         "fig9_forced_response", "fig10_forced_response", "compare_models", "fig8_sensitivity"]
 FIVE_T2 = 10 * np.pi / np.sqrt(3 + np.sqrt(5))  # 5 · 2π/ω₂ for chain(2, k=1, m=1/2): ω₂² = 3 + √5
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
