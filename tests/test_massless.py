@@ -32,15 +32,18 @@ def test_condensation_of_the_bilinear_oscillator():
     assert s.S.tolist() == [[1.0]] and s.w.tolist() == [1.0] and s.kc == 3.0
 
 
-def test_bilinear_branch_matches_the_closed_form_period_energy_relation():
-    s = bilinear()
-    orbits = follow_from_grazing(s, T_min=4.8, ds=0.02)
+@pytest.mark.parametrize("k2", [3.0, 1.0, 0.5])
+def test_bilinear_branch_matches_the_closed_form_period_energy_relation(k2):
+    """Also with k2 <= k1, where a plain Newton step for the first point jumped over the residual's pole."""
+    s = bilinear(k2=k2)
+    T_inf = np.pi + np.pi / np.sqrt(1 + k2)  # the high-energy limit: half a period in each phase
+    orbits = follow_from_grazing(s, T_min=T_inf + 0.03 * (2 * np.pi - T_inf), ds=0.02)
     assert len(orbits) > 20
     assert orbits[0].T == pytest.approx(2 * np.pi, rel=1e-6)  # grazing: the free linear mode
     for o in orbits[1:]:
         assert o.admissible
-        assert o.T == pytest.approx(bilinear_period(o.energy), rel=1e-10)
-    assert orbits[-1].T < 4.9  # stiffening: frequency rises with energy
+        assert o.T == pytest.approx(bilinear_period(o.energy, k2=k2), rel=1e-10)
+    assert orbits[-1].T < T_inf + 0.1 * (2 * np.pi - T_inf)  # stiffening: frequency rises with energy
 
 
 def random_system(seed=1, n=5, gap=0.3):

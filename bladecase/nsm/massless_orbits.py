@@ -229,11 +229,18 @@ def follow_from_grazing(system: MasslessSystem, T_min: float, mode: int = 0, ds:
     w = system.open.omega[mode]
     L = np.pi / (2 * w)
     z = np.array([np.pi / w, 1e-6 / w])
-    for _ in range(50):  # first point: r(α, β₀) = 0 in α near half the linear period
+    for _ in range(100):  # first point: r(α, β₀) = 0 in α near half the linear period
         _, r, g = closing_residual(system, *z, True)
-        z[0] -= r / g[0]
-        if abs(r / g[0]) <= 1e-14 * z[0]:
+        step = r / g[0]
+        if abs(step) <= 1e-14 * z[0]:
             break
+        # r has a pole next to its root near grazing (the mid-open amplitudes' matrix is singular at grazing):
+        # a full Newton step can land beyond it (e.g. the bilinear oscillator with k2 <= k1), so backtrack until
+        # |r| decreases
+        lam = 1.0
+        while lam > 1e-12 and abs(closing_residual(system, z[0] - lam * step, z[1])[1]) >= abs(r):
+            lam /= 2
+        z[0] -= lam * step
     out: list[SymmetricOrbit] = []
     tangent, h, ds_max = None, ds * L, ds_max * L
     while len(out) < max_points:
