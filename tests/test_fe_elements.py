@@ -125,7 +125,7 @@ def test_gmsh_orderings_of_second_order_cells_match_the_tables():
     import tempfile
 
     for incomplete, btype, wtype in [(1, "hexahedron20", "wedge15"), (0, "hexahedron27", "wedge18")]:
-        gmsh.initialize(["", "-v", "0"])
+        gmsh.initialize(["", "-v", "0"], readConfigFiles=False, interruptible=False)  # keeps SIGINT
         try:
             gmsh.model.add("box")
             r = gmsh.model.occ.addRectangle(0, 0, 0, 1.0, 0.2)
@@ -346,8 +346,9 @@ def test_hex_and_wedge_models_are_drawn_on_their_corner_nodes(tmp_path, btype, o
     root = grid.points[:, 0] < 1e-12
     assert np.abs(u[root]).max() == 0 and np.abs(u[~root]).max() > 0  # clamped root, moving tip
     tip = grid.points[:, 0] > 0.2 - 1e-12
-    # the first bending mode: the tip's transverse motion dominates its axial motion
-    assert np.abs(u[tip][:, 1:]).max() > 10 * np.abs(u[tip][:, 0]).max()
+    # the first bending mode (y and z bending share a frequency: any mix): the tip's transverse motion dominates
+    # its axial motion (the section's rotation; 11–13 × on this coarse beam)
+    assert np.linalg.norm(u[tip][:, 1:], axis=1).min() > 5 * np.abs(u[tip][:, 0]).max()
     pv = pytest.importorskip("pyvista")
     from bladecase.post.grid import VTK_CELL_TYPES
 
