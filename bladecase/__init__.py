@@ -64,6 +64,7 @@ from .nsm import (
     orbits_kipp,
     simulate,
     simulate_forced,
+    simulate_forced_massless,
     verify,
 )
 from .reduction import (
@@ -101,7 +102,7 @@ __all__ = [
     "Arc", "Backbone", "Branch", "Damping", "Family", "Floquet", "ForcedTrajectory", "Interval", "LinearSystem",
     "MasslessSystem", "PeriodicOrbit", "PhasedOrbit", "Spectrum", "SweepPoint", "Trajectory", "backbone", "bar",
     "chain", "floquet", "forced_point", "forced_sweep", "impact_matrices", "make_orbit", "massless_mode",
-    "nonsmooth_mode", "orbit_1ipp", "orbits_kipp", "simulate", "simulate_forced", "verify",
+    "nonsmooth_mode", "orbit_1ipp", "orbits_kipp", "simulate", "simulate_forced", "simulate_forced_massless", "verify",
     # study
     "RunResult", "Study", "StudyError", "demo_study", "load_study", "run",
 ]

@@ -145,11 +145,30 @@ def test_bad_settings(plate, bad, match):
         forced_response(reduced, families, bad)
 
 
-def test_massless_refused(plate):
+def test_massless_stage_runs_and_loads_the_contact_dofs(plate, tmp_path):
+    """The massless contact model (4 modes + attachment): the default load sits on the massless contact node, so
+    it enters as the condensed load plus its static contact displacement g = w_cᵀK_cc⁻¹f_c; the state with contact
+    phases is confirmed by re-simulation and touches the casing exactly."""
+    from bladecase.study.forcing import contact_load
+
     _, reduced, _ = plate
     massless = reduce(reduced.model, reduced.contact, "massless", 4)
-    with pytest.raises(ValueError, match=r"needs \[contact\] model = 'newton'"):
-        forced_response(massless, [], {"ratio": 0.01, "amplitude": 1.0})
+    f, _ = build_load(massless, {"ratio": 0.03, "amplitude": 1.0})
+    K, w = massless.model.K.tocsc(), massless.contact.w(massless.model)
+    c = np.flatnonzero(w)
+    g_direct = float(w[c] @ np.linalg.solve(K[c][:, c].toarray(), f[c]))
+    assert g_direct > 0 and abs(contact_load(massless, f) - g_direct) <= 1e-12 * g_direct
+    assert contact_load(reduced, f) == 0.0  # Newton's model: the load is just a load
+    out = forced_response(massless, [], {"ratio": 0.03, "amplitude": 900.0, "frequencies": [0.96, 1.04],
+                                         "points": 2, "periods": 100}, folder=tmp_path)
+    pts = out["points"]
+    assert pts["label"] == ["1/1", "0/1"], pts["label"]
+    assert pts["return_error"][0] <= 1e-8 and pts["resimulated_impacts"][0] == pts["k"][0] == 1
+    assert pts["contact_max_m"][0] == massless.system.gap and pts["contact_max_m"][1] < massless.system.gap
+    assert "1 periodic with contact phases (1 × 1/1 contact phases per forcing periods)" in out["words"]
+    assert (tmp_path / "forced.csv").stat().st_size > 100
+    with pytest.raises(ValueError, match="restitution: Newton's contact model only"):
+        forced_response(massless, [], {"ratio": 0.01, "amplitude": 1.0, "restitution": 0.8})
 
 
 def test_a_study_with_forcing_writes_the_forced_response_and_animates_a_steady_state(tmp_path):
@@ -176,3 +195,26 @@ def test_a_study_with_forcing_writes_the_forced_response_and_animates_a_steady_s
     anim = result.summary["files"]["forced_animations"]
     assert len(anim) == 1 and (out / anim[0]["gif"]).stat().st_size > 1000
     assert "## Forced response" in (out / "report.md").read_text()
+
+
+def test_a_massless_study_with_forcing(tmp_path):
+    """[forcing] with [contact] model = "massless" through bladecase.study.run: the steady states with contact
+    phases are re-simulated back to themselves and one is animated; restitution is refused by the schema."""
+    from _studies import PLATE, ROOT
+
+    from bladecase.study import StudyError, run
+    from bladecase.study.schema import loads
+
+    text = PLATE.replace("size = 10", "size = 4").replace("[contact]\n", '[contact]\nmodel = "massless"\n').replace(
+        'method = "modal"', 'method = "massless"').replace("periods = [0.5, 0.9999]", "periods = [0.8, 1.001]") + (
+        '\n[output]\nformats = ["png", "gif"]\nanimate = 1\nreference = false\nframes = 6\nmanifold = false\n'
+        '[forcing]\nratio = 0.03\namplitude = 900.0\nfrequencies = [0.9, 1.1]\npoints = 5\nperiods = 100\n')
+    result = run(loads(text, base=ROOT), out=tmp_path / "out", progress=False)
+    pts = result.summary["forcing"]["points"]
+    touching = [i for i, lab in enumerate(pts["label"]) if "/" in lab and not lab.startswith("0/")]
+    assert touching, pts["label"]
+    assert all(pts["return_error"][i] <= 1e-6 and pts["resimulated_impacts"][i] == pts["k"][i] for i in touching)
+    anim = result.summary["files"]["forced_animations"]
+    assert len(anim) == 1 and (result.directory / anim[0]["gif"]).stat().st_size > 1000
+    with pytest.raises(StudyError, match="restitution: Newton's contact model only"):
+        loads(text + "restitution = 0.9\n", base=ROOT)

@@ -25,7 +25,9 @@ The pipeline inside, one module per step:
   (:func:`integrate`) and :func:`simulate`;
 - :mod:`~bladecase.nsm.forced` (+ :mod:`~bladecase.nsm.damped_signals`) — forced–damped exact flight and
   simulation (:func:`simulate_forced`, :class:`Damping`); :mod:`~bladecase.nsm.sweep` — forcing-period sweeps
-  with steady-state detection and classification (:func:`forced_sweep`);
+  with steady-state detection and classification (:func:`forced_sweep`), either contact model;
+  :mod:`~bladecase.nsm.forced_massless` — the massless contact model forced and damped
+  (:func:`simulate_forced_massless`);
 - :mod:`~bladecase.nsm.verify` — the independent check of an orbit by simulation (:func:`verify`);
 - :mod:`~bladecase.nsm.floquet` — stability: monodromy with saltation matrices, multipliers, a verdict
   (:func:`floquet`, :func:`branch_stability`, :func:`stable_arcs`);
@@ -43,6 +45,7 @@ from .families import KippCurve
 from .flight import FlightPropagator, ImpactLaw, ModalFlight, NewtonImpact
 from .floquet import FLOQUET_TOL, Floquet, branch_stability, floquet, stable_arcs
 from .forced import Damping, EnergyBalance, ForcedFlight, ForcedTrajectory, simulate_forced
+from .forced_massless import MasslessForcedFlight, MasslessForcedTrajectory, simulate_forced_massless
 from .kipp import canonical_rotation, orbits_kipp
 from .massless import MASSLESS_DENSE_LIMIT, MasslessSystem, condense, redistribute_mass, simulate_massless
 from .massless_branches import massless_mode
@@ -67,7 +70,8 @@ from .verify import VERIFY_RTOL, verify
 __all__ = [
     "Arc", "Backbone", "Branch", "Curve", "Damping", "EnergyBalance", "FLOQUET_TOL", "Family", "FlightPropagator",
     "Floquet", "ForcedFlight", "ForcedTrajectory", "ImpactLaw", "SweepPoint", "forced_point", "forced_sweep",
-    "settles_linear", "simulate_forced",
+    "settles_linear", "simulate_forced", "MasslessForcedFlight", "MasslessForcedTrajectory",
+    "simulate_forced_massless",
     "Interval", "KippCurve", "LinearSystem", "MASSLESS_DENSE_LIMIT", "MasslessSystem", "ModalFlight", "ModalKernel",
     "NewtonImpact", "PeriodicOrbit", "PhasedOrbit", "Spectrum", "Trajectory", "VERIFY_RTOL",
     "backbone", "bar", "bar_continuum_energy", "bisect", "branch_stability", "canonical_rotation", "chain",

@@ -25,6 +25,11 @@ mechanical energy ``E(t) = ½vᵀMv + ½xᵀKx`` (kinetic + strain; the damping 
 included), sampled at 64 points per shortest period and refined around the largest sample;
 ``mean_energy`` is its time average over the cycle.
 
+**Massless contact model** (:class:`~bladecase.nsm.massless.MasslessSystem`): the runs are
+:func:`~bladecase.nsm.forced_massless.simulate_forced_massless`; "impacts" are then the contact phases (their
+closing switches: ``k`` contact phases per ``p`` forcing periods), ``impulses`` the momentum ``∫λ dt`` each
+phase transmits, the energy ``½vᵀMv + ½xᵀSx + ½k_c max(0, y - d)²`` and the return norm ``xᵀSx + vᵀMv``.
+
 :func:`forced_sweep` visits the periods in the sweep direction, each run starting from the end state of
 the previous one (sweep ``"up"`` in forcing FREQUENCY = decreasing ``T``; ``"down"`` = increasing ``T``),
 with a progress bar; with ``continuation=False`` every period starts from the same state and the pure
@@ -43,9 +48,11 @@ from scipy.optimize import minimize_scalar
 
 from ..progress import progress_bar
 from .forced import Damping, ForcedTrajectory, simulate_forced
+from .forced_massless import MasslessForcedTrajectory, simulate_forced_massless
+from .massless import MasslessSystem
 from .system import LinearSystem
 
-__all__ = ["SWEEP_TOL", "SweepPoint", "forced_point", "forced_sweep", "settles_linear"]
+__all__ = ["SWEEP_TOL", "SweepPoint", "forced_point", "forced_sweep", "rate_max", "settles_linear"]
 
 #: Default relative tolerance of the stroboscopic return of a periodic steady state.
 SWEEP_TOL = 1e-6
@@ -127,7 +134,7 @@ def _cycle_energy(tr: ForcedTrajectory, a: float, b: float) -> tuple[float, floa
     and of the largest sample refined by Brent's bounded search inside its own flight (where ``E`` is
     smooth)."""
     fl = tr.flight
-    h = 2 * np.pi / (ENERGY_SAMPLES * fl.modes.rate_max)
+    h = 2 * np.pi / (ENERGY_SAMPLES * rate_max(tr))
     n = max(2, int(np.ceil((b - a) / h)) + 1)
     t = np.linspace(a, b, n)
     E = tr.energy_at(t)
@@ -141,28 +148,35 @@ def _cycle_energy(tr: ForcedTrajectory, a: float, b: float) -> tuple[float, floa
         res = minimize_scalar(lambda s: -float(tr.energy_at(s)[0]), bounds=(lo, hi), method="bounded",
                               options={"xatol": 1e-12 * max(1.0, b)})
         best = max(best, -float(res.fun))
-    if hits.size:
+    if hits.size and isinstance(tr, ForcedTrajectory):  # the massless model's E has no corner
         k = np.searchsorted(tr.impact_times, hits)
         p_pre = tr._p[:, k] + fl.b[:, None] * tr.impulses[k][None, :]
         best = max(best, float(fl.energy(tr._q[:, k], p_pre).max()))
     return best, float(np.trapezoid(E, t) / (b - a))
 
 
-def settles_linear(tr: ForcedTrajectory) -> bool:
+def rate_max(tr: ForcedTrajectory | MasslessForcedTrajectory) -> float:
+    """Highest angular rate of a forced run's flights (sets the sampling steps)."""
+    return tr.flight.rate_max if isinstance(tr, MasslessForcedTrajectory) else tr.flight.modes.rate_max
+
+
+def settles_linear(tr: ForcedTrajectory | MasslessForcedTrajectory) -> bool:
     """Whether the motion after the end of ``tr`` provably never reaches the obstacle again.
 
     Every mode damped (``σ_j > 0``): ``wᵀx = Σ b_j q_j`` is the steady state ``Re(P e^{iΩt})`` plus the
     homogeneous deviation, whose mode-wise amplitude ``√(q_h'² + ω²q_h²)/ω`` never grows; so
     ``wᵀx(t) <= |P| + Σ |b_j| R_j/ω_j`` for all later ``t``, and if that is below ``d`` there is no further
-    impact: the motion converges to the linear (non-impacting) steady state.
+    impact: the motion converges to the linear (non-impacting) steady state.  The massless model likewise in
+    its open-phase modes (``y = ŵᵀx + gF₀cos Ωt``: the contact load's term joins the steady state).
     """
     fl = tr.flight
-    m = fl.modes
+    massless = isinstance(tr, MasslessForcedTrajectory)
+    m = fl.open.modes if massless else fl.modes
     if not np.all(m.sigma > 0):
         return False
     q, p = fl.encode(tr.x_end, tr.v_end)
     qp, pp = m.particular(tr.t_end)
-    amp = abs(complex(fl.b @ np.where(m.split, m.amplitude, 0j)))
+    amp = abs(complex(fl.b @ np.where(m.split, m.amplitude, 0j)) + (fl.g if massless else 0.0))
     drift = float(np.abs(fl.b) @ (np.hypot(p - pp, m.omega * (q - qp)) / m.omega))
     return amp + drift < fl.gap
 
@@ -178,12 +192,27 @@ def _returns(tr: ForcedTrajectory, s0: float, T: float, max_p: int) -> np.ndarra
     return np.array(r)
 
 
-def forced_point(system: LinearSystem, T: float, *, damping: Damping | None = None, amplitude: float = 1.0,
-                 load=None, n_periods: int = 500, x0=None, v0=None, restitution: float = 1.0,
-                 tol: float = SWEEP_TOL, max_p: int = 4) -> SweepPoint:
+def _run(system, T: float, n_periods: int, x0, v0, kw: dict, restitution: float, contact_load: float):
+    """The forced run of ``n_periods`` periods of either contact model."""
+    if isinstance(system, MasslessSystem):
+        if restitution != 1.0:
+            raise ValueError(f"restitution applies to Newton's contact model only; the massless model has no "
+                             f"impact law (got restitution={restitution!r})")
+        return simulate_forced_massless(system, x0, v0, n_periods * T, period=T, contact_load=contact_load, **kw)
+    if contact_load != 0.0:
+        raise ValueError(f"contact_load is for the massless contact model only, got {contact_load!r}")
+    return simulate_forced(system, x0, v0, n_periods * T, period=T, restitution=restitution, **kw)
+
+
+def forced_point(system: LinearSystem | MasslessSystem, T: float, *, damping: Damping | None = None,
+                 amplitude: float = 1.0, load=None, n_periods: int = 500, x0=None, v0=None, restitution: float = 1.0,
+                 tol: float = SWEEP_TOL, max_p: int = 4, contact_load: float = 0.0) -> SweepPoint:
     """Integrate ``n_periods`` forcing periods from ``(x0, v0)`` (default: rest) and classify the end.
 
-    A pure function of its arguments (a study executor may map it over periods).
+    A pure function of its arguments (a study executor may map it over periods).  A
+    :class:`~bladecase.nsm.massless.MasslessSystem` is run by
+    :func:`~bladecase.nsm.forced_massless.simulate_forced_massless` (``contact_load``: its ``g``; module
+    docstring: contact phases are counted instead of impacts).
 
     The paper's 2-dof chain forced at ``T = 4.5`` settles on one impact per forcing period; its energy peaks
     at the impact:
@@ -211,8 +240,8 @@ def forced_point(system: LinearSystem, T: float, *, damping: Damping | None = No
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", message="simulate stopped", category=RuntimeWarning)
         try:
-            tr = simulate_forced(system, x0, v0, n_periods * T, period=T, amplitude=amplitude, damping=damping,
-                                 load=load, restitution=restitution)
+            tr = _run(system, T, n_periods, x0, v0, dict(amplitude=amplitude, damping=damping, load=load),
+                      restitution, contact_load)
         except RuntimeError:  # the event loop's "would slide along the obstacle": the end of chattering
             return stopped
     if not tr.complete:
@@ -235,19 +264,21 @@ def forced_point(system: LinearSystem, T: float, *, damping: Damping | None = No
                       tr.impulses[sel], tr.x_end, tr.v_end, n_periods, settles_linear(tr))
 
 
-def forced_sweep(system: LinearSystem, periods, damping: Damping | None = None, amplitude: float = 1.0,
-                 load=None, n_periods: int = 500, direction: str = "up", tol: float = SWEEP_TOL, max_p: int = 4,
-                 restitution: float = 1.0, x0=None, v0=None, continuation: bool = True, executor=None,
-                 progress: bool = False) -> list[SweepPoint]:
+def forced_sweep(system: LinearSystem | MasslessSystem, periods, damping: Damping | None = None,
+                 amplitude: float = 1.0, load=None, n_periods: int = 500, direction: str = "up", tol: float = SWEEP_TOL,
+                 max_p: int = 4, restitution: float = 1.0, x0=None, v0=None, continuation: bool = True,
+                 executor=None, progress: bool = False, contact_load: float = 0.0) -> list[SweepPoint]:
     """Steady states of the forced response over forcing ``periods`` (seed paper Figs. 9–10).
 
     Parameters
     ----------
-    system : LinearSystem
+    system : LinearSystem or MasslessSystem
+        Either contact model (:func:`forced_point`).
     periods : sequence of float
         Forcing periods ``T = 2π/Ω`` (any order; visited in the sweep direction).
-    damping, amplitude, load, restitution
-        As :func:`~bladecase.nsm.forced.simulate_forced` (``amplitude`` is ``F₀``).
+    damping, amplitude, load, restitution, contact_load
+        As :func:`~bladecase.nsm.forced.simulate_forced` (``amplitude`` is ``F₀``; ``restitution``: Newton's
+        model only) and :func:`~bladecase.nsm.forced_massless.simulate_forced_massless` (``contact_load``).
     n_periods : int
         Forcing periods integrated at each ``T`` (the paper: 500).
     direction : {"up", "down"}
@@ -284,7 +315,8 @@ def forced_sweep(system: LinearSystem, periods, damping: Damping | None = None, 
     if direction == "up":
         order = order[::-1]
     run = functools.partial(forced_point, system, damping=damping, amplitude=amplitude, load=load,
-                            n_periods=n_periods, restitution=restitution, tol=tol, max_p=max_p)
+                            n_periods=n_periods, restitution=restitution, tol=tol, max_p=max_p,
+                            contact_load=contact_load)
     if not continuation:
         task = functools.partial(run, x0=x0, v0=v0)
         if executor is None:

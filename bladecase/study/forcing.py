@@ -14,8 +14,10 @@ Engine order ``EO`` (:class:`bladecase.reduction.loads.EngineOrderLoad`): a sing
 ``f = EO × rpm / 60`` with a phase that only shifts time, so the sweep is a frequency sweep; with
 ``frequency_unit = "rpm"`` the range is given in rotation speeds, and the CSV and figure show both.
 
-The massless contact model has no forced simulation yet: the stage refuses it (``[forcing] needs [contact]
-model = 'newton' for now``).
+Either contact model: with ``[contact] model = "massless"`` the sweeps run
+:func:`bladecase.nsm.forced_massless.simulate_forced_massless` (``k`` then counts contact phases, ``restitution``
+must stay 1), and a load on the massless contact dofs enters exactly through its static contact displacement
+``g = w_cᵀK_cc⁻¹f_c`` (:func:`contact_load`).
 """
 
 from __future__ import annotations
@@ -29,14 +31,16 @@ from scipy.optimize import minimize_scalar
 
 from .. import log
 from ..io import save_figure, write_text
+from ..nsm import MasslessSystem
 from ..nsm.forced import Damping, ForcedTrajectory, simulate_forced
-from ..nsm.sweep import ENERGY_SAMPLES, SweepPoint, forced_sweep
+from ..nsm.forced_massless import MasslessForcedTrajectory, simulate_forced_massless
+from ..nsm.sweep import ENERGY_SAMPLES, SweepPoint, forced_sweep, rate_max
 from ..post.forced_plots import forced_response_plot
 from ..reduction import ReducedModel
 from ..reduction.loads import engine_order_load, nodal_load, pressure_load, project_load
 
-__all__ = ["COLUMNS", "DEFAULTS", "ForcedOrbit", "build_load", "forced_response", "forced_scene", "forcing_frequencies",
-           "steady_orbit"]
+__all__ = ["COLUMNS", "DEFAULTS", "ForcedOrbit", "build_load", "contact_load", "forced_response", "forced_scene",
+           "forcing_frequencies", "steady_orbit"]
 
 #: What ``[forcing]`` may hold, with the defaults of the keys that have one (``amplitude`` and one of
 #: ``rayleigh`` / ``ratio`` must be given).
@@ -121,6 +125,19 @@ def _load(reduced: ReducedModel, s: dict) -> tuple[np.ndarray, str]:
     return f, words
 
 
+def contact_load(reduced: ReducedModel, f_free) -> float:
+    """``g = w_cᵀK_cc⁻¹f_c``: the open-phase contact displacement that the load ``f_free`` puts on the massless
+    contact dofs by itself (0 for Newton's model, or when the contact dofs are not loaded).
+
+    ``closed_shape = −K_cc⁻¹w_c`` on the contact dofs (:class:`~bladecase.reduction.massless.MasslessReducedModel`),
+    so ``g = −closed_shapeᵀf``.
+    """
+    shape = getattr(reduced, "closed_shape", None)
+    if shape is None or not isinstance(reduced.system, MasslessSystem):
+        return 0.0
+    return -float(np.asarray(shape, dtype=float) @ np.asarray(f_free, dtype=float).reshape(-1))
+
+
 def forcing_frequencies(reduced: ReducedModel, forcing: dict) -> np.ndarray:
     """The forcing frequencies (Hz) of the sweep: ``points`` values evenly spaced over ``frequencies`` in
     ``frequency_unit`` (``"Hz"``; ``"f1"``: × the first linear frequency of the reduced model that sees the
@@ -147,7 +164,7 @@ class ForcedOrbit:
     the re-simulation finds in it; ``label`` the sweep's class.
     """
 
-    trajectory: ForcedTrajectory = field(repr=False)
+    trajectory: ForcedTrajectory | MasslessForcedTrajectory = field(repr=False)
     forcing_period: float
     p: int
     label: str
@@ -164,7 +181,7 @@ class ForcedOrbit:
 
     @property
     def k(self) -> int:
-        """Impacts in the cycle ``(0, T]``."""
+        """Impacts (massless model: contact phases begun) in the cycle ``(0, T]``."""
         return int(self.trajectory.impact_times.size)
 
     @property
@@ -179,35 +196,46 @@ class ForcedOrbit:
         """``(x, v)`` at times ``t`` (taken modulo ``T``), shape ``(n, len(t))``."""
         return self.trajectory.state(np.mod(np.atleast_1d(np.asarray(t, dtype=float)), self.T))
 
+    def _contact(self, t) -> np.ndarray:
+        """Contact displacement at times ``t``: ``wᵀx``; massless model: ``min(ŵᵀx + gF₀cos Ωt, d)``."""
+        tr = self.trajectory
+        if isinstance(tr, MasslessForcedTrajectory):
+            t = np.atleast_1d(np.asarray(t, dtype=float))
+            return np.minimum(tr.flight.contact(tr.modal_state(t)[0], t), tr.flight.gap)
+        return self.system.w @ tr.state(t)[0]
+
     def contact_range(self) -> tuple[float, float]:
-        """``(min, max)`` of the contact displacement ``wᵀx`` over the cycle (sampled, then refined)."""
-        tr, w = self.trajectory, self.system.w
-        h = 2 * np.pi / (ENERGY_SAMPLES * tr.flight.modes.rate_max)
+        """``(min, max)`` of the contact displacement over the cycle (sampled, then refined)."""
+        tr = self.trajectory
+        h = 2 * np.pi / (ENERGY_SAMPLES * rate_max(tr))
         t = np.linspace(0.0, self.T, max(3, int(np.ceil(self.T / h)) + 1))
-        c = w @ tr.state(t)[0]
+        c = self._contact(t)
         out = []
         for sign, i in ((-1.0, int(np.argmin(c))), (1.0, int(np.argmax(c)))):
             lo, hi = t[max(i - 1, 0)], t[min(i + 1, t.size - 1)]
             hits = tr.impact_times[(tr.impact_times > lo) & (tr.impact_times < hi)]
             best = float(c[i])
             if hits.size == 0 and hi > lo:
-                res = minimize_scalar(lambda s, sign=sign: -sign * float(w @ tr.state(s)[0][:, 0]), bounds=(lo, hi),
+                res = minimize_scalar(lambda s, sign=sign: -sign * float(self._contact(s)[0]), bounds=(lo, hi),
                                       method="bounded", options={"xatol": 1e-12 * self.T})
                 best = sign * max(sign * best, -float(res.fun))
             out.append(best)
-        if self.k:
-            out[1] = max(out[1], float(np.max(w @ tr.x)))
+        if self.k:  # at an impact / a closing switch the contact displacement is d
+            out[1] = max(out[1], float(np.max(self._contact(tr.impact_times))))
         return out[0], out[1]
 
 
 def steady_orbit(system, point: SweepPoint, *, damping: Damping, amplitude: float, load,
-                 restitution: float = 1.0) -> ForcedOrbit:
+                 restitution: float = 1.0, contact_load: float = 0.0) -> ForcedOrbit:
     """Re-simulate one cycle (``p`` forcing periods; one period when not periodic) of a sweep point from its
-    end state (forcing phase 0: a sweep point's run lasts a whole number of periods)."""
+    end state (forcing phase 0: a sweep point's run lasts a whole number of periods); either contact model."""
     p = point.p if point.periodic else 1
     T = point.T
-    tr = simulate_forced(system, point.x_end, point.v_end, p * T, period=T, amplitude=amplitude, damping=damping,
-                         load=load, restitution=restitution)
+    kw = dict(period=T, amplitude=amplitude, damping=damping, load=load)
+    if isinstance(system, MasslessSystem):
+        tr = simulate_forced_massless(system, point.x_end, point.v_end, p * T, contact_load=contact_load, **kw)
+    else:
+        tr = simulate_forced(system, point.x_end, point.v_end, p * T, restitution=restitution, **kw)
     fl = tr.flight
     z0 = np.concatenate(fl.encode(point.x_end, point.v_end))
     z1 = np.concatenate(fl.encode(tr.x_end, tr.v_end))
@@ -249,7 +277,8 @@ def forced_response(reduced: ReducedModel, families: list, forcing: dict, *, fol
     sweeps of ``direction = "both"`` are mapped by ``executor``.  The record of each steady state
     (:class:`ForcedOrbit`) is kept under the key ``"orbits"`` (not for JSON: the caller pops it).
 
-    Raises ``ValueError`` for the massless contact model and for bad ``[forcing]`` values.
+    Either contact model (the massless one: ``k`` counts contact phases, ``restitution`` must be 1).  Raises
+    ``ValueError`` for bad ``[forcing]`` values.
 
     Examples
     --------
@@ -270,20 +299,22 @@ def forced_response(reduced: ReducedModel, families: list, forcing: dict, *, fol
     >>> out["words"].split(". ")[0]
     '3 steady state(s) over 1573–1922 Hz (up sweep): 0 periodic with impacts, 3 without contact'
     """
-    if getattr(reduced.system, "contact_model", "newton") == "massless":
-        raise ValueError("[forcing] needs [contact] model = 'newton' for now (no forced simulation of the massless "
-                         "contact model: a load on its massless contact dofs acts on them statically)")
     s = _settings(forcing)
+    massless = isinstance(reduced.system, MasslessSystem)
+    if massless and float(s["restitution"]) != 1.0:
+        raise ValueError(f"[forcing] restitution: Newton's contact model only (the massless model has no impact "
+                         f"law), got {s['restitution']!r}")
     f_free, load_words = build_load(reduced, s)
     f_r = project_load(reduced, f_free)
-    if not np.any(f_r):
+    g = contact_load(reduced, f_free)
+    if not np.any(f_r) and g == 0.0:
         raise ValueError(f"[forcing] load: its projection on the {reduced.method} reduced model is zero (no reduced "
                          "mode feels it): load another place, or reduce with another method or size")
     eo = engine_order_load(f_free, s["engine_order"]) if s["engine_order"] is not None else None
     freqs = forcing_frequencies(reduced, s)
     damping = _damping(s)
     run = dict(damping=damping, amplitude=float(s["amplitude"]), load=f_r, n_periods=int(s["periods"]),
-               max_p=int(s["max_p"]), restitution=float(s["restitution"]), progress=progress)
+               max_p=int(s["max_p"]), restitution=float(s["restitution"]), progress=progress, contact_load=g)
     directions = ["up", "down"] if s["direction"] == "both" else [s["direction"]]
     task = functools.partial(_sweep, system=reduced.system, periods=1.0 / freqs, run=run)
     swept = executor.map(task, directions, desc="forced sweeps", progress=progress) if executor is not None \
@@ -293,7 +324,7 @@ def forced_response(reduced: ReducedModel, families: list, forcing: dict, *, fol
         for pt in points:
             orbit = None if not pt.complete else steady_orbit(
                 reduced.system, pt, damping=damping, amplitude=run["amplitude"], load=f_r,
-                restitution=run["restitution"])
+                restitution=run["restitution"], contact_load=g)
             rows.append(_row(direction, pt, orbit, eo))
             orbits.append(orbit)
     columns = {name: [r[name] for r in rows] for name, _ in COLUMNS}
@@ -303,7 +334,7 @@ def forced_response(reduced: ReducedModel, families: list, forcing: dict, *, fol
                "periods_per_point": int(s["periods"]), "points": columns,
                "classes": _classes(columns["label"]), "files": {}}
     section["peak"] = _peak(columns, families)
-    section["words"] = _words(section, eo)
+    section["words"] = _words(section, eo, "contact phases" if massless else "impacts")
     if folder is not None:
         section["files"].update(_write(folder, columns, families, figures, title, reduced.system.gap, eo))
     log.info("forced response: %s", section["words"])
@@ -357,15 +388,15 @@ def _peak(c: dict, families: list) -> dict | None:
     return peak
 
 
-def _words(section: dict, eo) -> str:
+def _words(section: dict, eo, events: str = "impacts") -> str:
     c, classes = section["points"], section["classes"]
     n = len(c["label"])
     periodic = {k: v for k, v in classes.items() if "/" in k and not k.startswith("0/")}
     free = sum(v for k, v in classes.items() if k.startswith("0/")) + classes.get("linear", 0)
     parts = [f"{n} steady state(s) over {min(c['frequency_hz']):.4g}–{max(c['frequency_hz']):.4g} Hz "
-             f"({section['direction']} sweep): {sum(periodic.values())} periodic with impacts"]
+             f"({section['direction']} sweep): {sum(periodic.values())} periodic with {events}"]
     if periodic:
-        parts[-1] += " (" + ", ".join(f"{v} × {k}" for k, v in periodic.items()) + " impacts per forcing periods)"
+        parts[-1] += " (" + ", ".join(f"{v} × {k}" for k, v in periodic.items()) + f" {events} per forcing periods)"
     if free:
         parts.append(f"{free} without contact")
     for key, text in (("non-periodic", "non-periodic"),

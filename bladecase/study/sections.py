@@ -49,7 +49,7 @@ FORCING_KEYS: dict[str, Key] = {
 
 def forcing_checks(c: dict) -> None:
     """``[forcing]`` (when its amplitude is given): one damping, the keys of its load kind, enough periods,
-    Newton's contact model."""
+    no restitution with the massless contact model."""
     f = c["forcing"]
     if f["amplitude"] is None:
         given = sorted(k for k, spec in FORCING_KEYS.items() if f[k] != spec.default)
@@ -69,9 +69,9 @@ def forcing_checks(c: dict) -> None:
                          "face's normal)")
     if f["periods"] < 2 * f["max_p"] + 1:
         raise StudyError(f"[forcing] periods: at least 2 × max_p + 1 = {2 * f['max_p'] + 1}, got {f['periods']}")
-    if c["contact"]["model"] != "newton":
-        raise StudyError("[forcing]: needs [contact] model = 'newton' for now (the massless contact model has no "
-                         "forced simulation)")
+    if c["contact"]["model"] == "massless" and f["restitution"] != 1.0:
+        raise StudyError(f"[forcing] restitution: Newton's contact model only (the massless contact model has no "
+                         f"impact law), got {f['restitution']!r}")
 
 
 #: ``[execution]``: key → :class:`~bladecase.study.keys.Key`.
