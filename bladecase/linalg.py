@@ -419,7 +419,9 @@ def _sparse_modes(K, M, count: int, factor: Factor, method: str) -> tuple[np.nda
         found = block_lanczos(K, M, factor.solve, count, block=block)
         if found is not None:
             return found
-    lam, phi = spla.eigsh(K, k=count, M=M, sigma=0.0, which="LM", OPinv=factor.operator())
+    # a fixed start vector: the same modes (signs, and the basis of repeated eigenvalues) on every run
+    v0 = np.random.default_rng(0).standard_normal(K.shape[0])
+    lam, phi = spla.eigsh(K, k=count, M=M, sigma=0.0, which="LM", OPinv=factor.operator(), v0=v0)
     order = np.argsort(lam)
     return lam[order], phi[:, order]
 

@@ -193,16 +193,19 @@ def closing_residual(system: MasslessSystem, alpha: float, beta: float, gradient
 
 def orbit_at_period(system: MasslessSystem, T: float, beta0: float, maxiter: int = 60) -> SymmetricOrbit | None:
     """The symmetric one-phase orbit of period ``T`` reached by Newton from contact half-time ``beta0``."""
-    b = float(beta0)
+    b, prev = float(beta0), np.inf
     for _ in range(maxiter):
         _, r, g = closing_residual(system, T / 2 - b, b, True)
         step = r / (g[1] - g[0])
         b -= step
         if not 0 < b < T / 2:
             return None
-        if abs(step) <= 1e-14 * T:
+        # converged, or stagnating at round-off (next to grazing the steps cycle at ~1e-16 s)
+        stalled = abs(step) <= 1e-10 * T and abs(step) >= 0.5 * abs(prev) and abs(r) <= 1e-9 * system.gap
+        if abs(step) <= 1e-14 * T or stalled:
             a, _ = closing_residual(system, T / 2 - b, b)
             return SymmetricOrbit(system, T / 2 - b, b, a)
+        prev = step
     return None
 
 

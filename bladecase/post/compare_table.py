@@ -45,8 +45,13 @@ _TAIL = ("convergence", "convergence_delta")
 
 
 def energy_column(fraction: float) -> str:
-    """The column of the energy at ``fraction`` × T1, e.g. ``"energy_0.95T1"``."""
-    return f"energy_{float(fraction):g}T1"
+    """The column of the energy at ``fraction`` × T1, e.g. ``"energy_0.95T1"`` (10 significant digits: periods
+    next to grazing, 0.99999889 and 0.9999993, keep their own columns).
+
+    >>> energy_column(0.95), energy_column(0.99999889)
+    ('energy_0.95T1', 'energy_0.99999889T1')
+    """
+    return f"energy_{float(fraction):.10g}T1"
 
 
 def _none(x) -> float | None:
