@@ -103,3 +103,13 @@ def test_the_grid_on_a_dask_local_cluster_gives_the_serial_results(result, tmp_p
         arcs = [(a.T_lo, a.T_hi) for b in m.branches for a in b.arcs]
         assert np.allclose(arcs, [(a.T_lo, a.T_hi) for b in mine.branches for a in b.arcs], rtol=1e-12), name
         assert all(b.system is m.reduced.system for b in m.branches)
+
+
+def test_comparison_periods_are_a_study_key(result, tmp_path):
+    """[reduction] compare_periods: the energy columns at the asked periods (× FE T1), distinct near 1."""
+    text = GRID.replace("sizes = [6, 12]\n", "sizes = [6, 12]\ncompare_periods = [0.6, 0.99999889, 0.9999993]\n")
+    other = run(loads(text, base=ROOT), out=tmp_path / "p", progress=False)
+    cols = [c for c in other.comparison if c.startswith("energy_")]
+    assert cols == ["energy_0.6T1", "energy_0.99999889T1", "energy_0.9999993T1"]
+    with pytest.raises(StudyError, match=r"\[reduction\] compare_periods: periods repeat"):
+        loads(GRID.replace("sizes = [6, 12]\n", "sizes = [6, 12]\ncompare_periods = [0.9, 0.9]\n"), base=ROOT)

@@ -21,7 +21,8 @@ def test_demo_study_defaults():
     st = demo_study()
     assert st.name == "demo" and st.parametric
     assert st["contact"]["clearance"] == 1e-4
-    assert st["reduction"] == {"method": "massless", "size": 8, "compare": [], "methods": [], "sizes": []}
+    assert st["reduction"] == {"method": "massless", "size": 8, "compare": [], "methods": [], "sizes": [],
+                               "compare_periods": [0.9, 0.95, 0.99]}
     assert st["contact"]["model"] == "massless" and st["contact"]["face"] == "tip" and st["search"]["ipp"] == [1]
     assert st["output"]["frames"] == 40 and st["output"]["scale"] == "auto"
     # every schema key of the present sections has a value (defaults filled in)

@@ -21,11 +21,12 @@ FIGURES = {"overlay": "comparison_frequency_energy.png", "convergence": "compari
 
 
 def compare_models(fe: FEReference, entries: list[ModelResult], folder: Path, *, title: str = "",
-                   figures: bool = True) -> dict:
+                   figures: bool = True, fractions=(0.9, 0.95, 0.99)) -> dict:
     """Write ``comparison.csv`` and (``figures``: PNG) the comparison figures of ``entries`` against the FE
     model ``fe`` (:func:`~bladecase.post.compare.fe_reference`) into ``folder``; return the summary section:
-    ``{"csv", "figures", "rows", "diagnostics"}`` (diagnostics: sentences, empty when the models agree)."""
-    rows = comparison_rows(entries, fe)
+    ``{"csv", "figures", "rows", "diagnostics"}`` (diagnostics: sentences, empty when the models agree);
+    ``fractions``: the periods (× FE T1) where every model's energy is read."""
+    rows = comparison_rows(entries, fe, fractions=fractions)
     write_comparison_csv(rows, folder / "comparison.csv")
     words = diagnose(rows, fe)
     for line in words:

@@ -219,7 +219,8 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         files.update(FORMATS.write(o["formats"], "run", scene, staging))
         comparison = None
         if compares:
-            comparison = compare_models(fe, models, staging, title=study.name, figures="png" in o["formats"])
+            comparison = compare_models(fe, models, staging, title=study.name, figures="png" in o["formats"],
+                                        fractions=study["reduction"]["compare_periods"])
             files["comparison"] = comparison["csv"]
             files["comparison_figures"] = comparison["figures"]
     with stage("render"):

@@ -33,6 +33,7 @@ from .values import (  # noqa: F401  (RANGES, LIMITS: part of the schema's docum
     LIMITS,
     RANGES,
     _clamp_spec,
+    _compare_periods,
     _direction,
     _formats,
     _in_range,
@@ -131,6 +132,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
                        "through the same search, compared in comparison.csv and the report.", _method_names),
         "sizes": Key(_LIST, [], "Sizes of the comparison grid (default: [size]), e.g. [8, 16, 32, 64].",
                      _size_list),
+        "compare_periods": Key(_LIST, [0.9, 0.95, 0.99], "Periods (× the FE model's first period) at which the "
+                               "comparison reads each model's energy, e.g. [0.99999, 0.999999] for arcs next to "
+                               "grazing.", _compare_periods),
     },
     "search": {
         "ipp": Key(_LIST, [1, 2], "Impacts per period of the families to look for.", _ipp),

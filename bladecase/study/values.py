@@ -175,3 +175,12 @@ def _clamp_spec(v) -> str | None:
         return (f"must hold exactly one of {', '.join(CLAMP_RULES)} (and optionally tol)"
                 + (f"; unknown keys {unknown}" if unknown else ""))
     return None
+
+
+def _compare_periods(v) -> str | None:
+    """1 to 8 distinct finite periods in (0, 100] (× the FE first period)."""
+    if not 1 <= len(v) <= 8 or not all(_num(x) and math.isfinite(x) and 0 < x <= 100 for x in v):
+        return "must be a list of 1 to 8 numbers in (0, 100] (× the FE model's first period)"
+    if len(set(v)) != len(v):
+        return "periods repeat"
+    return None
