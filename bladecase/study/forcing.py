@@ -457,11 +457,41 @@ def forced_scene(study, reduced: ReducedModel, orbit: ForcedOrbit, stem: str):
     impact[0] = bool(np.any((phases < 1e-9) | (phases > 1 - 1e-9)))  # frame_times marks t = 0 for an autonomous orbit
     x, v = orbit.state(times)
     model = reduced.model
-    u = nodal_field(model, reduced.free_dofs(x))
-    vel = nodal_field(model, reduced.free_velocities(x, v))
+    x_free, v_free = reduced.free_dofs(x), reduced.free_velocities(x, v)
+    if isinstance(orbit.trajectory, MasslessForcedTrajectory):
+        x_free, v_free = _massless_contact_dofs(study, reduced, orbit, times, x, v, x_free, v_free)
+    u = nodal_field(model, x_free)
+    vel = nodal_field(model, v_free)
     mesh = fe_grid(model)
     scale = animation.auto_scale(mesh, u, o["auto_fraction"]) if o["scale"] == "auto" else float(o["scale"])
     title = (f"{study.name}: forced steady state {orbit.label} at {1 / orbit.forcing_period:.5g} Hz")
     return OrbitScene(stem=stem, title=title, mesh=mesh, orbit=orbit, times=times, u=u, v=vel, impact=impact,
                       contact_node=int(grid_index(model, reduced.contact.node)),
                       normal=reduced.contact.normal_for(model), scale=scale, options=o, branch=None)
+
+
+def _massless_contact_dofs(study, reduced: ReducedModel, orbit: ForcedOrbit, times, x, v, x_free, v_free):
+    """The massless contact dofs of a forced steady state: ``reduced.free_dofs`` slaves them to the interior with
+    the unforced multiplier; a load ``F(t) f_c`` on them adds ``F K_cc⁻¹f_c`` and moves the multiplier to
+    ``λ = k_c max(0, ŵᵀx + gF − d)`` (:func:`contact_load`). Returns the corrected ``(x_free, v_free)``."""
+    shape = np.asarray(reduced.closed_shape, dtype=float)  # −K_cc⁻¹w_c on the contact dofs c
+    c = np.flatnonzero(shape)
+    f_free, _ = build_load(reduced, study["forcing"])
+    f_c = np.asarray(f_free, dtype=float)[c]
+    if not np.any(f_c):
+        return x_free, v_free
+    K_cc = reduced.model.K[c][:, c]
+    K_cc = K_cc.toarray() if hasattr(K_cc, "toarray") else np.asarray(K_cc)
+    load_c = np.linalg.solve(K_cc, f_c)  # K_cc⁻¹f_c
+    s, amp = reduced.system, float(study["forcing"]["amplitude"])
+    Om = 2 * np.pi / orbit.forcing_period
+    F, dF = amp * np.cos(Om * times), -amp * Om * np.sin(Om * times)
+    g = contact_load(reduced, f_free)
+    y0, dy0 = s.w @ x - s.gap, s.w @ v  # what free_dofs used (no load)
+    y, dy = y0 + g * F, dy0 + g * dF
+    lam0, lam = s.kc * np.maximum(y0, 0.0), s.kc * np.maximum(y, 0.0)
+    dlam0, dlam = s.kc * np.where(y0 > 0, dy0, 0.0), s.kc * np.where(y > 0, dy, 0.0)
+    x_free, v_free = np.array(x_free, dtype=float), np.array(v_free, dtype=float)
+    x_free[c] += np.outer(load_c, F) + np.outer(shape[c], lam - lam0)
+    v_free[c] += np.outer(load_c, dF) + np.outer(shape[c], dlam - dlam0)
+    return x_free, v_free
