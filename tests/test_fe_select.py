@@ -122,3 +122,22 @@ def test_a_study_clamps_by_coordinates(tmp_path):
     bad = base.replace("thickness = 0.002", 'thickness = 0.002\nclamp = {plane = [0, 5, 0, 0, 1, 0]}')
     with pytest.raises(StudyError, match=r"\[fem\] clamp .* selects no node of mesh"):
         run(loads(bad, base=ROOT), out=tmp_path / "c", progress=False)
+
+
+def test_a_study_takes_its_contact_face_by_coordinates():
+    """[contact] face = {plane = ...} selects the same nodes as the plate's 'tip' group: the same constraint."""
+    from _studies import PLATE, ROOT
+
+    from bladecase.study.schema import StudyError, loads
+    from bladecase.study.stages import build_contact, build_mesh, build_model
+
+    def contact(face):
+        text = PLATE.replace("clearance = 1e-4", f"clearance = 1e-4\nface = {face}\nweights = \"area\"")
+        study = loads(text, base=ROOT)
+        model = build_model(study, build_mesh(study))
+        return build_contact(study, model).w(model)
+
+    w_group, w_plane = contact('"tip"'), contact("{plane = [0, 0.1, 0, 0, 1, 0]}")
+    assert np.count_nonzero(w_group) > 2 and np.allclose(w_group, w_plane, rtol=0, atol=1e-15)
+    with pytest.raises(StudyError, match=r"\[contact\] face .*selects no node"):
+        contact("{plane = [0, 0.5, 0, 0, 1, 0]}")

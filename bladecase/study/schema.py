@@ -109,8 +109,10 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "farthest": Key(_LIST, None, "Pick the free node of 'group' (default 'tip') farthest along this "
                         "direction, e.g. [-1, 0, 0].", _direction),
         "nearest": Key(_LIST, None, "Pick the free node nearest this point (within 'group' if given).", _vector),
-        "face": Key(_STR, None, "Contact on a whole face instead of one node: the mean normal displacement of "
-                    "the free nodes of this mesh group (e.g. 'tip'), one constraint all the same."),
+        "face": Key((str, dict), None, "Contact on a whole face instead of one node: the mean normal displacement "
+                    "of the free nodes of this mesh group (e.g. 'tip'), one constraint all the same; or the face's "
+                    "nodes by coordinates: {plane = [x0, y0, z0, nx, ny, nz]}, {box = [[..], [..]]} or "
+                    "{sphere = [x, y, z, r]}, with an optional tol (m).", _clamp_spec),
         "normal": Key(_LIST, None, "Casing normal, from the blade towards the casing; default: radial "
                       "(+z in 3-D, +y in 2-D).", _direction),
         "weights": Key(_STR, None, "With 'face': how the face's nodes are weighted in the mean normal "

@@ -47,6 +47,7 @@ def build_mesh(study: Study, path: str | os.PathLike | None = None) -> Mesh:
             from ..fe import save_mesh
 
             save_mesh(mesh, path)
+    mesh = _with_selections(study, mesh)
     for key, name in need:
         if name not in mesh.groups:
             have = ", ".join(sorted(mesh.groups)) or "none"
@@ -80,11 +81,31 @@ def build_model(study: Study, mesh: Mesh) -> FEModel:
         raise
 
 
+#: The mesh group made from a ``[contact] face`` given by coordinates (a plane, box or sphere table).
+SELECTED_FACE = "contact_face_selected"
+
+
+def _with_selections(study: Study, mesh: Mesh) -> Mesh:
+    """``mesh`` with the node sets the study selects by coordinates as named groups (``[contact] face``)."""
+    face = study["contact"]["face"]
+    if not isinstance(face, dict):
+        return mesh
+    from dataclasses import replace
+
+    from ..fe import select_nodes
+
+    try:
+        nodes = select_nodes(mesh, face, what="[contact] face")
+    except ValueError as exc:
+        raise StudyError(str(exc) if str(exc).startswith("[contact]") else f"[contact] face: {exc}") from None
+    return replace(mesh, groups={**mesh.groups, SELECTED_FACE: nodes})
+
+
 def contact_group(study: Study) -> str | None:
     """The mesh group ``[contact]`` selects from (``None``: a node index, or every free node)."""
     c = study["contact"]
     if c["face"] is not None:
-        return c["face"]
+        return c["face"] if isinstance(c["face"], str) else SELECTED_FACE
     if c["node"] is not None:
         return None
     if c["farthest"] is not None:
@@ -107,7 +128,7 @@ def build_contact(study: Study, model: FEModel) -> Contact:
     group = contact_group(study)
     try:
         if c["face"] is not None:
-            return Contact.face(model, c["face"], normal, gap, weights=c["weights"] or "equal")
+            return Contact.face(model, group, normal, gap, weights=c["weights"] or "equal")
         if c["node"] is not None:
             return Contact.at(model, c["node"], normal, gap)
         if c["farthest"] is not None:
