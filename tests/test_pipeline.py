@@ -379,9 +379,9 @@ def test_search_resolution_reaches_the_start_search(plate_study, monkeypatch):
     seen = []
     real = continuation.orbits_kipp
 
-    def spy(system, T, k, resolution=None):
+    def spy(system, T, k, resolution=None, **kw):
         seen.append(resolution)
-        return real(system, T, k, resolution=resolution)
+        return real(system, T, k, resolution=resolution, **kw)
 
     monkeypatch.setattr(continuation, "orbits_kipp", spy)
     raw = copy.deepcopy(loads(PLATE, base=ROOT).config)

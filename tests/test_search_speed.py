@@ -2,8 +2,9 @@
 
 Correctness only (timings: ``benchmarks/bench_search.py``): the vectorised pieces against their scalar
 counterparts (stacked least squares, kernel sums, the closed-form k = 2 residual, fixed-period solves,
-continuation of many curves at once), the start-coverage lookup against the start-by-start test, the whole
-search against a plain sequential reference, and the geometric de-duplication of the families.
+continuation of many curves at once, the certification of many orbits, the bisection of many arc ends, the
+half-angle sine and cosine), the start-coverage lookup against the start-by-start test, the whole search
+against a plain sequential reference, and the geometric de-duplication of the families.
 """
 
 from __future__ import annotations
@@ -13,10 +14,20 @@ import pytest
 
 import bladecase as bc
 from bladecase.nsm import continuation, modes
-from bladecase.nsm.families import ARC_RTOL, KippCurve, KippCurves, _arcs, polished_orbit, trace_families
+from bladecase.nsm.arc_ends import _bisect_end, bisect_ends
+from bladecase.nsm.families import (
+    ARC_RTOL,
+    KippCurve,
+    KippCurves,
+    _arcs,
+    polished_orbit,
+    polished_orbits,
+    trace_families,
+)
 from bladecase.nsm.kipp import canonical_rotation
 from bladecase.nsm.modal import ModalKernel, impact_kernels, solve_times, solve_times_stack
-from bladecase.nsm.orbits import REPEAT_RTOL
+from bladecase.nsm.orbits import REPEAT_RTOL, make_orbit, make_orbits
+from bladecase.nsm.signals import TrigSum, certified_max, certified_max_stack, sincos
 
 
 @pytest.fixture(scope="module")
@@ -124,6 +135,85 @@ def test_batch_driver_on_another_curve():
     for r, (pts, _) in zip(radii, traced):
         np.testing.assert_allclose([np.hypot(*p) for p in pts], r, rtol=1e-9)
         assert len(pts) > 2 * np.pi * r / 0.2 - 2
+
+
+def test_sincos_is_sin_and_cos():
+    rng = np.random.default_rng(3)
+    x = np.concatenate([rng.uniform(-1e4, 1e4, 200_000), rng.uniform(-3, 3, 100_000),
+                        np.arange(1, 20_000) * np.pi, (np.arange(1, 20_000) + 0.5) * np.pi, [0.0, -0.0]])
+    s, c = sincos(x)
+    assert np.abs(s - np.sin(x)).max() <= 3e-16 and np.abs(c - np.cos(x)).max() <= 3e-16
+    assert np.abs(s * s + c * c - 1).max() <= 1e-15
+
+
+def test_certified_max_stack_is_certified_max():
+    """The batched proof gives each sum's verdict, sampled maximum and bound (polish=False) — sums that hold,
+    that fail by far, that just graze the tolerance, on intervals from a fraction of a period to many."""
+    rng = np.random.default_rng(4)
+    omega = np.sort(rng.uniform(0.3, 7.0, 15))
+    n = 300
+    alpha = rng.standard_normal((n, 15)) * rng.uniform(0.01, 1.0, (n, 1))
+    beta = rng.standard_normal((n, 15)) * rng.uniform(0.01, 1.0, (n, 1))
+    length = rng.uniform(0.05, 40.0, n)
+    peak = np.array([TrigSum(a, b, omega)(np.linspace(0, L, 4001))[0].max() for a, b, L in zip(alpha, beta, length)])
+    const = -peak * rng.choice([1.2, 1.0 + 1e-12, 0.9], n)  # clear, grazing, violated
+    tol = np.full(n, 1e-9)
+    got = certified_max_stack(alpha, beta, omega, const, length, tol)
+    want = [certified_max(TrigSum(a, b, omega, c), L, 1e-9, polish=False)
+            for a, b, c, L in zip(alpha, beta, const, length)]
+    assert [bool(x) for x in got[3]] == [w.certified for w in want]
+    assert 30 <= int(got[3].sum()) <= n - 30  # both verdicts are exercised
+    scale = np.abs(alpha).sum(axis=1) + np.abs(beta).sum(axis=1)
+    np.testing.assert_allclose(got[0], [w.value for w in want], rtol=0, atol=1e-12 * scale.max())
+    np.testing.assert_allclose(got[2], [w.upper for w in want], rtol=0, atol=1e-12 * scale.max())
+    # flights between impacts: both ends exactly at zero
+    ends = certified_max_stack(alpha, beta, omega, const, length, tol, ends_at_zero=True)
+    ref = [certified_max(TrigSum(a, b, omega, c), L, 1e-9, ends_at_zero=True, polish=False)
+           for a, b, c, L in zip(alpha, beta, const, length)]
+    assert [bool(x) for x in ends[3]] == [w.certified for w in ref]
+
+
+def _family_points(system, k, T, T_range):
+    starts = [o for o in bc.orbits_kipp(system, T, k) if o.repeats == 1]
+    return [(p, z) for p, zs in trace_families(system, k, starts, T_range, 0.01, 400) for z in zs]
+
+
+@pytest.mark.parametrize("k", [2, 3])
+def test_make_orbits_is_make_orbit(five_dof, k):
+    points = _family_points(five_dof, k, 7.5, (6.0, 9.0))
+    T = np.array([p.period(z) for p, z in points])
+    times = np.array([p.times(z)[1] for p, z in points])
+    lam = np.array([p.split(z)[2] for p, z in points])
+    lam[::7] *= -1  # pulling impulses: never admissible
+    many = make_orbits(five_dof, T, times, lam)
+    one = [make_orbit(five_dof, *args, polish=False) for args in zip(T, times, lam)]
+    assert [o.admissible for o in many] == [o.admissible for o in one]
+    assert 10 <= sum(o.admissible for o in many) <= len(many) - 10
+    assert [o.repeats for o in many] == [o.repeats for o in one]
+    np.testing.assert_allclose([o.energy for o in many], [o.energy for o in one], rtol=1e-12)
+    np.testing.assert_allclose([o.max_violation for o in many], [o.max_violation for o in one], rtol=1e-12,
+                               atol=1e-14)
+    unchecked = make_orbits(five_dof, T, times, lam, certify=False)
+    assert not any(o.admissible for o in unchecked) and all(np.isnan(o.max_violation) for o in unchecked)
+    assert make_orbits(five_dof, [], np.zeros((0, k)), np.zeros((0, k))) == []
+
+
+def test_bisect_ends_is_bisect_end(five_dof):
+    """Every admissibility change of the families through the starts at one period, bisected all together and
+    one by one: the same periods (to 10 ARC_RTOL) and the same convergence flags."""
+    points = _family_points(five_dof, 2, 7.5, (6.0, 9.0))
+    orbits = polished_orbits(points)
+    ends = []
+    for n, ((p, z), o) in enumerate(zip(points, orbits)):
+        for m in (n - 1, n + 1):
+            if 0 <= m < len(points) and points[m][0] is p and o is not None and orbits[m] is not None:
+                if o.admissible and not orbits[m].admissible:
+                    ends.append((p, z, points[m][1]))
+    assert len(ends) >= 4
+    together = bisect_ends(ends, ARC_RTOL)
+    alone = [_bisect_end(p, a, b, None, ARC_RTOL) for p, a, b in ends]
+    assert [d for _, d in together] == [d for _, d in alone]
+    np.testing.assert_allclose([T for T, _ in together], [T for T, _ in alone], rtol=10 * ARC_RTOL)
 
 
 # ---------------------------------------------------------------------------------------------------------

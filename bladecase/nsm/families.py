@@ -8,8 +8,9 @@ times and in ``T``, :meth:`bladecase.nsm.modal.ModalKernel.dT`); :mod:`bladecase
 :class:`KippCurves` evaluates many such curves at once, so that :class:`FamilyTracer` and :func:`trace_families`
 follow many families together (the same algorithm on each, its numerical work vectorised over the families).
 :func:`follow_family` and :func:`complete_families` give the families' certified orbits
-(:func:`polished_orbits`: the fixed-period Newton polish vectorised) and admissible arcs, whose ends are refined
-by bisection along the curve.
+(:func:`polished_orbits`: the fixed-period Newton polish and the certification vectorised,
+:func:`~bladecase.nsm.orbits.make_orbits`) and admissible arcs, whose ends are refined by bisection along the
+curve (all ends of a batch of families together, :func:`~bladecase.nsm.arc_ends.bisect_ends`).
 """
 
 from __future__ import annotations
@@ -20,8 +21,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import continuation
-from .modal import ModalKernel, check_period, impact_kernels, solve_stack, solve_times, solve_times_stack
-from .orbits import PeriodicOrbit, make_orbit
+from .arc_ends import _bisect_end, bisect_ends
+from .modal import ModalKernel, impact_kernels, solve_stack, solve_times, solve_times_stack
+from .orbits import PeriodicOrbit, make_orbit, make_orbits
 from .system import LinearSystem
 
 #: Relative precision in ``T`` of the refined ends of admissible arcs.
@@ -366,14 +368,22 @@ def complete_families(traced: list[tuple[KippCurve, list]], T_range: tuple[float
     for (f, _), orbit in zip(todo, polished_orbits([(traced[f][0], z) for f, z in todo])):
         if orbit is not None:
             orbits[f].append(orbit)
-    out = []
-    for (problem, zs), found in zip(traced, orbits):
-        pieces = []
+    parts = []  # (family, the stretch's orbits, their curve points)
+    for f, ((problem, _), found) in enumerate(zip(traced, orbits)):
         for run in (runs(found) if runs is not None else [list(range(len(found)))]):
             part = [found[i] for i in run]
-            arcs = _arcs(problem, [problem.join(o.impact_times) for o in part], part, refine)
-            pieces.append(FollowedFamily(problem, zs, part, arcs))
-        out.append(pieces)
+            parts.append((f, part, [problem.join(o.impact_times) for o in part]))
+    ends: dict[tuple[int, int, int], tuple] = {}  # (stretch, end, outside neighbour) → the bracket to bisect
+    if refine:  # every end of every stretch's arcs, bisected together
+        for n, (f, part, zp) in enumerate(parts):
+            admissible_arcs(part, lambda i, out, n=n, p=traced[f][0], zp=zp:
+                            ends.setdefault((n, i, out), (p, zp[i], zp[out])) and None)
+    refined = dict(zip(ends, bisect_ends(list(ends.values()), ARC_RTOL)))
+    out: list[list[FollowedFamily]] = [[] for _ in traced]
+    for n, (f, part, _) in enumerate(parts):
+        problem, zs = traced[f]
+        arcs = admissible_arcs(part, lambda i, o, n=n: refined.get((n, i, o)))
+        out[f].append(FollowedFamily(problem, zs, part, arcs))
     return out
 
 
@@ -403,19 +413,18 @@ def polished_orbits(points: list[tuple[KippCurve, np.ndarray]]) -> list[Periodic
     lam = d * solve_stack(-impact_kernels(omega, b, times)[0], np.ones(times.shape))  # Λ = d Σ⁻¹1: NaN if singular
     rows = np.flatnonzero(np.all(np.isfinite(lam), axis=1))
     for i, sol in zip(rows, solve_times_stack(system, T[rows], times[rows], d)):
-        t, lam_i = times[i], lam[i]
-        if sol is not None and np.abs(sol[0] - t).max() < 1e-6 * T[i]:
-            t, lam_i = sol
-        try:
-            out[i] = make_orbit(system, T[i], t, lam_i, polish=False)
-        except ValueError:
-            pass
+        if sol is not None and np.abs(sol[0] - times[i]).max() < 1e-6 * T[i]:
+            times[i], lam[i] = sol
+    rows = rows[np.all(np.isfinite(times[rows]), axis=1) & np.all(np.isfinite(lam[rows]), axis=1)]
+    for i, orbit in zip(rows, make_orbits(system, T[rows], times[rows], lam[rows])):  # certified all together
+        out[i] = orbit
     return out
 
 
 def _arcs(problem: KippCurve, zs, orbits, refine: bool) -> list[tuple]:
     """``(start, stop, T_lo, T_hi, refined_lo, refined_hi)`` of every maximal admissible run of ``orbits``."""
-    return admissible_arcs(orbits, lambda i, out: _bisect_end(problem, zs[i], zs[out], orbits[out]) if refine else None)
+    return admissible_arcs(orbits, lambda i, out: _bisect_end(problem, zs[i], zs[out], orbits[out], ARC_RTOL)
+                           if refine else None)
 
 
 def admissible_arcs(orbits, refine_end) -> list[tuple]:
@@ -446,58 +455,3 @@ def admissible_arcs(orbits, refine_end) -> list[tuple]:
                      bool((hi == T_a and ref_a) or (hi == T_b and ref_b))))
         i = j + 1
     return arcs
-
-
-def _bisect_end(problem: KippCurve, z_in, z_out, orbit_out: PeriodicOrbit | None = None) -> tuple[float, bool]:
-    """Period where admissibility is lost between curve points ``z_in``
-    (admissible) and ``z_out`` (the orbit ``orbit_out``): bisection along the curve.
-
-    The midpoint is solved at fixed ``T = (T_in + T_out)/2`` by Newton from
-    the interpolated impact times (robust near resonances, where the
-    eliminated-impulse residual is stiff), else by the arclength corrector
-    orthogonal to the chord (turning points); a midpoint that leaves the
-    bracket is rejected.  A midpoint's admissibility is checked first where
-    the last non-admissible orbit of the bracket violated the constraint (the
-    same verdict, found sooner).  Returns the admissible end and whether the
-    bracket was narrowed to ``ARC_RTOL``.
-    """
-    system = problem.system
-    probe = [None if orbit_out is None else _violation_phase(orbit_out)]
-
-    def midpoint(z_a, z_b):
-        T_a, T_b = problem.period(z_a), problem.period(z_b)
-        if T_a == T_b:
-            return None
-        Tm = 0.5 * (T_a + T_b)
-        try:
-            md = ModalKernel.of(system, check_period(system, Tm))
-            guess = 0.5 * (problem.times(z_a)[1] / T_a + problem.times(z_b)[1] / T_b) * Tm
-            sol = solve_times(md, guess, problem.d)
-        except ValueError:
-            return None
-        return None if sol is None else problem.join(sol[0])
-
-    def admissible(z) -> bool:
-        try:
-            Tm, times, lam = problem.split(z)
-            where = None if probe[0] is None else probe[0] * Tm
-            orbit = make_orbit(system, Tm, times, lam, polish=False, probe=where)
-        except (ValueError, np.linalg.LinAlgError):
-            return False
-        if not orbit.admissible and _violation_phase(orbit) is not None:
-            probe[0] = _violation_phase(orbit)
-        return orbit.admissible
-
-    def converged(z_a, z_b) -> bool:
-        T_a = problem.period(z_a)
-        return abs(problem.period(z_b) - T_a) <= ARC_RTOL * abs(T_a)
-
-    z_in, _, done = continuation.bisect(problem.curve(), z_in, z_out, admissible, converged=converged,
-                                        midpoint=midpoint)
-    return problem.period(z_in), done
-
-
-def _violation_phase(orbit: PeriodicOrbit) -> float | None:
-    """Where (as a fraction of the period) a non-admissible orbit was seen to violate the constraint."""
-    phase = orbit.max_violation_time / orbit.T
-    return float(phase) if np.isfinite(phase) and orbit.max_violation > 0 else None

@@ -7,8 +7,9 @@ open-phase modes at grazing (:mod:`~bladecase.nsm.massless_branches`). All are :
 
 The k-ipp search, in this module: the families of many starts traced together in start order, a start skipped
 when an earlier family passes it — each crossing of a family with a scan period solved once and the starts
-matched by lookup (:func:`starts_passed`) — and, by geometry (:func:`on_curve`), each stretch of a branch
-listed once (:func:`distinct_runs`; a family lying on another is dropped).
+matched by lookup (:func:`starts_passed`, :mod:`~bladecase.nsm.coverage`) — and, by geometry
+(:func:`on_curve`), each stretch of a branch listed once (:func:`distinct_runs`; a family lying on another is
+dropped).  The starts themselves are not certified (only the families' orbits are).
 """
 
 from __future__ import annotations
@@ -17,7 +18,17 @@ import numpy as np
 
 from ..progress import progress_bar, progress_counter
 from .branches import Arc, Branch
-from .families import FamilyTracer, KippCurve, complete_families
+from .coverage import (  # noqa: F401 (PASS_GATE, passes, phase_distance(s), starts_passed: lived here)
+    PASS_GATE,
+    _passed,
+    _resolve,
+    _StartIndex,
+    passes,
+    phase_distance,
+    phase_distances,
+    starts_passed,
+)
+from .families import FamilyTracer, complete_families
 from .kipp import canonical_rotation, check_k, orbits_kipp
 from .modal import ModalKernel, solve_times
 from .orbits import REPEAT_RTOL, PeriodicOrbit
@@ -28,13 +39,8 @@ __all__ = ["MASSLESS_MIN_POINTS", "nonsmooth_mode"]
 #: Least point budget of a massless branch: its steps are short where the contact time grows fast.
 MASSLESS_MIN_POINTS = 4000
 
-#: A start orbit is only re-solved from a crossing segment of a followed curve
-#: when the interpolated impact times lie within ``PASS_GATE·T`` of its own
-#: (under every re-anchoring); farther crossings are other orbits of that period.
-PASS_GATE = 0.05
-
 #: Families traced at once (their continuation steps are vectorised together).
-TRACE_WINDOW = 64
+TRACE_WINDOW = 256
 
 #: Two orbits at one period are the same when their canonically rotated impact times agree to ``SAME_RTOL·T``.
 SAME_RTOL = REPEAT_RTOL
@@ -73,7 +79,8 @@ def nonsmooth_mode(
         Periods of interest; the curves are followed until they leave it.
     scan : int
         Number of periods (evenly spaced in ``T_range``, resonant ones
-        skipped) where :func:`orbits_kipp` looks for starting orbits.
+        skipped) where :func:`orbits_kipp` looks for starting orbits (not
+        certified: they are only starting points; the families' orbits are).
         Orbits that are repetitions of shorter-period orbits (``repeats >
         1``) are not followed: they are not new modes.
     step : float
@@ -129,7 +136,7 @@ def nonsmooth_mode(
     starts = []
     for T in progress_bar(np.linspace(T_lo, T_hi, scan), f"{k}-ipp starts", enabled=progress, unit="T"):
         try:
-            sols = orbits_kipp(system, T, k, resolution=resolution)
+            sols = orbits_kipp(system, T, k, resolution=resolution, certify=False)  # starting points only
         except ValueError:
             continue
         starts.extend((T, o) for o in sols if o.repeats == 1)
@@ -144,9 +151,10 @@ def _follow_starts(system: LinearSystem, k: int, starts: list[tuple[float, Perio
     Up to ``TRACE_WINDOW`` families are traced at once (:class:`~bladecase.nsm.families.FamilyTracer`); they
     are taken in the order of their starts: the first unresolved start whose family is traced is kept and
     marks the later starts its curve passes (:func:`starts_passed`), whose traces, if begun, are dropped: the
-    same families as following the starts one by one.  Then, by geometry: a stretch a family's curve traces a
-    second time is left out (the family is cut there, :func:`distinct_runs`), and a family whose orbits all
-    lie on another family (one passing its start) is dropped (:func:`on_curve`).
+    same families as following the starts one by one (:func:`~bladecase.nsm.coverage._resolve`).  Then, by
+    geometry: a stretch a family's curve traces a second time is left out (the family is cut there,
+    :func:`distinct_runs`), and a family whose orbits all lie on another family (one passing its start) is
+    dropped (:func:`on_curve`).
     """
     tracer = FamilyTracer(system, k, T_range, step, max_points)
     index = _StartIndex(starts)
@@ -167,24 +175,9 @@ def _follow_starts(system: LinearSystem, k: int, starts: list[tuple[float, Perio
                 launched += 1
             tracer.add(new, [starts[n][1] for n in new])
             running.update(new)
-            while resolved < len(starts) and (covered[resolved] or (resolved in running and tracer.done(resolved))):
-                n = resolved
-                resolved += 1
+            for n in _resolve(tracer, index, covered, kept, running, same, todo, resolved):
+                resolved = n + 1
                 bar.update()
-                if covered[n]:
-                    if n in running:
-                        running.discard(n)
-                        tracer.cancel(n)
-                    continue
-                running.discard(n)
-                problem, zs = tracer.result(n)
-                wanted = kept.copy()  # the earlier families' starts (the same branch?) and the later starts left
-                wanted[n + 1:] = ~covered[n + 1:]
-                passed = np.array(_passed(problem, zs, index, wanted), dtype=int)
-                covered[passed[passed > n]] = True
-                same.extend((int(m), n) for m in passed[passed < n])
-                kept[n] = True
-                todo.append((n, (problem, zs)))
             if len(todo) >= TRACE_WINDOW or (todo and resolved == len(starts)):
                 done = complete_families([t for _, t in todo], T_range, refine, distinct_runs)
                 families.update((n, pieces) for (n, _), pieces in zip(todo, done))
@@ -353,106 +346,3 @@ def _matches(curve: list[PeriodicOrbit], orbits: list[PeriodicOrbit], allowed: n
                 hit[i] = j
                 break
     return hit
-
-
-class _StartIndex:
-    """The start orbits of each scan period sorted by their first impact time, to find those near given
-    impact times without looking at the others."""
-
-    def __init__(self, starts: list[tuple[float, PeriodicOrbit]]):
-        groups: dict[float, list[int]] = {}
-        for n, (T, _) in enumerate(starts):
-            groups.setdefault(float(T), []).append(n)
-        self.periods = np.array(list(groups), dtype=float)
-        self.groups = []
-        for members in groups.values():
-            refs = np.array([starts[m][1].impact_times for m in members])
-            order = np.argsort(refs[:, 0], kind="stable")
-            self.groups.append((np.array(members)[order], refs[order]))
-
-    def near(self, g: int, guess: np.ndarray, T: float) -> tuple[np.ndarray, np.ndarray]:
-        """The starts of period ``g`` (indices and impact times) within ``PASS_GATE·T`` of the impact times
-        ``guess`` under some re-anchoring (:func:`phase_distances`)."""
-        members, refs = self.groups[g]
-        shifted = np.mod(guess[None, :] - guess[:, None], T)
-        shifted[shifted == 0] = T
-        first = np.sort(shifted, axis=1)[:, 0]  # each re-anchoring's first impact: within the gate of the start's
-        pad = PASS_GATE * T * (1 + 1e-9)
-        lo = np.searchsorted(refs[:, 0], first - pad, side="left")
-        hi = np.searchsorted(refs[:, 0], first + pad, side="right")
-        cand = np.unique(np.concatenate([np.arange(a, b) for a, b in zip(lo, hi)]))
-        if cand.size:
-            cand = cand[phase_distances(guess, refs[cand], T) <= PASS_GATE * T]
-        return members[cand], refs[cand]
-
-
-def _passed(problem: KippCurve, zs, index: _StartIndex, wanted: np.ndarray) -> list[int]:
-    """The ``wanted`` starts (a mask) that the polyline ``zs`` passes.
-
-    Each crossing of the polyline with a start period is solved once at that period (Newton from the
-    interpolated impact times) and the starts of that period are matched to the solution by their impact
-    times, looked up in ``index``: the cost is one fixed-``T`` solve per crossing, whatever the number of
-    starts.  A crossing is only solved when some start lies within ``PASS_GATE·T`` of its interpolated impacts
-    (under every re-anchoring); a start is passed when the solution, canonically rotated, has its impact
-    times to ``1e3·REPEAT_RTOL·T``.
-    """
-    if len(zs) < 2:
-        return []
-    Ts = np.array([problem.period(z) for z in zs])
-    lo, hi = np.minimum(Ts[:-1], Ts[1:]), np.maximum(Ts[:-1], Ts[1:])
-    crossings = []  # (period, interpolated impact times, the open starts near them, their impact times)
-    for g in np.flatnonzero((index.periods >= Ts.min()) & (index.periods <= Ts.max())):
-        T_s = float(index.periods[g])
-        for i in np.flatnonzero((lo <= T_s) & (T_s <= hi) & (hi > lo)):
-            a = (T_s - Ts[i]) / (Ts[i + 1] - Ts[i])
-            ta, tb = problem.times(zs[i])[1], problem.times(zs[i + 1])[1]
-            guess = ((1 - a) * ta / Ts[i] + a * tb / Ts[i + 1]) * T_s
-            members, refs = index.near(g, guess, T_s)
-            open_ = wanted[members]
-            if open_.any():  # else no start is left near the interpolated impacts: no need to solve
-                crossings.append((T_s, guess, members[open_], refs[open_]))
-    if not crossings:
-        return []
-    passed: set[int] = set()
-    for T_s, guess, members, refs in crossings:
-        sol = solve_times(ModalKernel.of(problem.system, T_s), guess, problem.d)
-        if sol is not None:
-            passed.update(members[_distances(sol, refs, T_s) <= 1e3 * REPEAT_RTOL * T_s].tolist())
-    return sorted(passed)
-
-
-def _distances(sol: tuple[np.ndarray, np.ndarray], refs: np.ndarray, T: float) -> np.ndarray:
-    """Largest impact-time difference between the solution (canonically rotated) and each row of ``refs``."""
-    times, _ = canonical_rotation(sol[0], sol[1], T)
-    return np.abs(refs - times[None, :]).max(axis=1)
-
-
-def phase_distance(times: np.ndarray, reference: np.ndarray, T: float) -> float:
-    """``min`` over re-anchorings of ``times`` (shift by each ``t_r``) of the largest
-    distance to ``reference`` (both sets of ``k`` impact times in ``(0, T]``).
-
-    >>> phase_distance(np.array([3.0, 10.0]), np.array([7.0, 10.0]), 10.0)    # the same orbit, re-anchored
-    0.0
-    """
-    return float(phase_distances(times, np.asarray(reference)[None, :], T)[0])
-
-
-def phase_distances(times: np.ndarray, references: np.ndarray, T: float) -> np.ndarray:
-    """:func:`phase_distance` of ``times`` to each row of ``references`` (shape ``(c, k)``), vectorised."""
-    shifted = np.mod(times[None, :] - times[:, None], T)  # row r: re-anchored at impact r
-    shifted[shifted == 0] = T
-    shifted.sort(axis=1)
-    refs = np.sort(references, axis=1)
-    return np.abs(shifted[None, :, :] - refs[:, None, :]).max(axis=2).min(axis=1)
-
-
-def passes(problem: KippCurve, zs, start: tuple[float, PeriodicOrbit]) -> bool:
-    """Does the polyline ``zs`` cross the start orbit (same period, same impacts)?"""
-    return bool(starts_passed(problem, zs, [start]))
-
-
-def starts_passed(problem: KippCurve, zs, starts: list[tuple[float, PeriodicOrbit]]) -> list[int]:
-    """Indices of the ``starts`` (``(T, orbit)`` pairs) that the polyline ``zs`` crosses (same period, same
-    impacts): each crossing of a start period solved once, the starts matched by lookup (see :func:`_passed`).
-    """
-    return _passed(problem, zs, _StartIndex(starts), np.ones(len(starts), dtype=bool)) if starts else []

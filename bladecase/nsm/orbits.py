@@ -17,12 +17,12 @@ from functools import cached_property
 import numpy as np
 
 from .modal import RESONANCE_RTOL, ModalKernel, check_period, impact_matrices
-from .signals import TrigSum, certified_max
+from .signals import TrigSum, certified_max, certified_max_stack, sincos
 from .system import LinearSystem
 
 __all__ = [
     "ADMISSIBILITY_RTOL", "REPEAT_RTOL", "RESONANCE_RTOL", "PeriodicOrbit", "check_period", "impact_matrices",
-    "make_orbit", "orbit_1ipp", "repetitions",
+    "make_orbit", "make_orbits", "orbit_1ipp", "repetitions",
 ]
 
 
@@ -309,6 +309,85 @@ def make_orbit(
         admissible=admissible, max_violation=float(worst), max_violation_time=float(worst_t),
         repeats=repetitions(times, lam, T),
     )
+
+
+def make_orbits(system: LinearSystem, T, impact_times, impulses, certify: bool = True) -> list[PeriodicOrbit]:
+    """:func:`make_orbit` with ``polish=False`` of many orbits with ``k`` impacts at once (periods ``T``
+    ``(B,)``, impact times and impulses ``(B, k)``): the energies, the flights' trigonometric sums and their
+    certification (:func:`~bladecase.nsm.signals.certified_max_stack`) computed for all orbits together.
+
+    The same records as one :func:`make_orbit` call each: admissibility proved on every flight exactly as
+    there (flight by flight, stopping at the first flight not proved admissible; ``max_violation`` of a
+    violated orbit is its largest sampled violation).
+
+    >>> from bladecase.nsm import chain, orbits_kipp
+    >>> system = chain(2, k=1.0, m=0.5, gap=1.0)
+    >>> found = orbits_kipp(system, 13.5, 2)
+    >>> again = make_orbits(system, [o.T for o in found], [o.impact_times for o in found], [o.impulses for o in found])
+    >>> [(o.admissible, o.repeats, round(o.energy, 9)) for o in again] == [(o.admissible, o.repeats,
+    ...                                                                     round(o.energy, 9)) for o in found]
+    True
+    """
+    T = np.atleast_1d(np.asarray(T, dtype=float))
+    if T.size == 0:
+        return []
+    times = np.asarray(impact_times, dtype=float).reshape(T.size, -1)
+    lam = np.asarray(impulses, dtype=float).reshape(times.shape)
+    omega, b, _ = system.spectrum.contact_modes
+    d = system.gap
+    sh = np.sin(np.multiply.outer(T / 2, omega))  # (B, m)
+    scale = b / (2 * sh)
+    cos_s, sin_s = _impulse_phases(omega, T, np.zeros(T.size), times)  # the state just after the impact at t = 0
+    q = -(scale / omega) * np.einsum("bmk,bk->bm", cos_s, lam)
+    qd = scale * np.einsum("bmk,bk->bm", sin_s, lam)
+    energy = 0.5 * (np.einsum("bm,bm->b", qd, qd) + np.einsum("bm,bm->b", omega * q, omega * q))
+    worst = np.full(T.size, np.nan if not certify else 0.0)
+    worst_t = np.zeros(T.size)
+    certified = np.full(T.size, certify) & np.all(lam >= 0, axis=1)
+    c = -b**2 / (2 * omega * sh)
+    for i in range(times.shape[1]):  # flight by flight, the orbits not yet refuted
+        rows = np.flatnonzero(certified)
+        if rows.size == 0:
+            break
+        start = np.zeros(rows.size) if i == 0 else times[rows, i - 1]
+        cs, sn = _impulse_phases(omega, T[rows], start, times[rows])
+        alpha = c[rows] * np.einsum("bmk,bk->bm", cs, lam[rows])
+        beta = -c[rows] * np.einsum("bmk,bk->bm", sn, lam[rows])
+        tol = np.maximum(ADMISSIBILITY_RTOL * d, 1e4 * np.finfo(float).eps * np.hypot(alpha, beta).sum(axis=1))
+        value, where, _, ok = certified_max_stack(alpha, beta, omega, np.full(rows.size, -d),
+                                                  times[rows, i] - start, tol, ends_at_zero=True)
+        raise_ = value > worst[rows]
+        worst[rows[raise_]], worst_t[rows[raise_]] = value[raise_], (start + where)[raise_]
+        certified[rows] = ok
+    repeats = _repetitions_stack(times, lam, T)
+    return [PeriodicOrbit(system=system, T=float(T[i]), impact_times=times[i].copy(), impulses=lam[i].copy(),
+                          energy=float(energy[i]), admissible=bool(certified[i]), max_violation=float(worst[i]),
+                          max_violation_time=float(worst_t[i]), repeats=int(repeats[i])) for i in range(T.size)]
+
+
+def _impulse_phases(omega: np.ndarray, T: np.ndarray, start: np.ndarray, times: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """``cos``, ``sin`` of ``ω_m θ_j`` ``(B, m, k)``, ``θ_j = ((start - t_j) mod T) - T/2``: the phase of each
+    impulse at ``start`` (the terms of :func:`_segment_sum` and :meth:`ModalKernel.start_state`)."""
+    theta = np.mod(start[:, None] - times, T[:, None]) - (T / 2)[:, None]
+    sn, cs = sincos(omega[None, :, None] * theta[:, None, :])
+    return cs, sn
+
+
+def _repetitions_stack(times: np.ndarray, impulses: np.ndarray, T: np.ndarray) -> np.ndarray:
+    """:func:`repetitions` of each row."""
+    k = times.shape[1]
+    scale = np.maximum(np.abs(impulses).max(axis=1), np.finfo(float).tiny)
+    out = np.ones(len(T), dtype=int)
+    for j in range(2, k + 1):  # the largest j that repeats wins
+        if k % j:
+            continue
+        shift = k // j
+        dt = np.mod(np.roll(times, -shift, axis=1) - times, T[:, None])
+        same = np.all(np.abs(dt - (T / j)[:, None]) <= REPEAT_RTOL * T[:, None], axis=1) & np.all(
+            np.abs(np.roll(impulses, -shift, axis=1) - impulses) <= REPEAT_RTOL * scale[:, None], axis=1)
+        out[same] = j
+    return out
 
 
 def repetitions(times: np.ndarray, impulses: np.ndarray, T: float) -> int:
