@@ -102,6 +102,26 @@ class Damping:
         return MP @ np.diag(2 * self.rates(sp.omega)) @ MP.T
 
 
+def forcing_inputs(n: int, period, amplitude: float, damping, load):
+    """Checked ``(period, Ω, damping, load)`` of a forced flight of ``n`` dofs (``load=None``: every dof)."""
+    if period is None:
+        if amplitude != 0:
+            raise ValueError("a forcing period is needed when the amplitude is not 0")
+        Omega = 0.0
+    else:
+        period = float(period)
+        if not np.isfinite(period) or period <= 0:
+            raise ValueError(f"period must be finite and > 0, got {period!r}")
+        Omega = 2 * np.pi / period
+    damping = Damping() if damping is None else damping
+    if not isinstance(damping, Damping):
+        raise ValueError(f"damping must be a Damping (e.g. Damping(alpha=0.005)) or None, got {damping!r}")
+    f = np.ones(n) if load is None else np.asarray(load, dtype=float).reshape(-1)
+    if f.shape != (n,) or not np.all(np.isfinite(f)):
+        raise ValueError(f"load must be a finite vector of {n} entries, got shape {f.shape}")
+    return period, Omega, damping, f
+
+
 class ForcedFlight(ModalFlight):
     """Damped, harmonically forced free flight, exact in modal coordinates ``(q, p) = (ΦᵀMx, ΦᵀMv)``.
 
@@ -125,21 +145,7 @@ class ForcedFlight(ModalFlight):
         amplitude = float(amplitude)
         if not np.isfinite(amplitude):
             raise ValueError(f"amplitude must be finite, got {amplitude!r}")
-        if period is None:
-            if amplitude != 0:
-                raise ValueError("a forcing period is needed when the amplitude is not 0")
-            Omega = 0.0
-        else:
-            period = float(period)
-            if not np.isfinite(period) or period <= 0:
-                raise ValueError(f"period must be finite and > 0, got {period!r}")
-            Omega = 2 * np.pi / period
-        damping = Damping() if damping is None else damping
-        if not isinstance(damping, Damping):
-            raise ValueError(f"damping must be a Damping (e.g. Damping(alpha=0.005)) or None, got {damping!r}")
-        f = np.ones(system.n) if load is None else np.asarray(load, dtype=float).reshape(-1)
-        if f.shape != (system.n,) or not np.all(np.isfinite(f)):
-            raise ValueError(f"load must be a finite vector of {system.n} entries, got shape {f.shape}")
+        period, Omega, damping, f = forcing_inputs(system.n, period, amplitude, damping, load)
         self.period, self.amplitude, self.damping, self.load = period, amplitude, damping, f
         self.horizon = float(horizon)
         self.modes = DampedModes(self.omega, damping.rates(self.omega), amplitude * (self.phi.T @ f), Omega)

@@ -52,7 +52,7 @@ from functools import cached_property
 import numpy as np
 
 from .damped_signals import DampedModes, DampedSignal
-from .forced import QUAD_NODES, Damping, EnergyBalance
+from .forced import QUAD_NODES, Damping, EnergyBalance, forcing_inputs
 from .massless import MasslessSystem, _leave_surface
 from .signals import POINTS_PER_PERIOD, first_upcrossing
 
@@ -224,21 +224,7 @@ class MasslessForcedFlight:
         amplitude, g = float(amplitude), float(contact_load)
         if not (np.isfinite(amplitude) and np.isfinite(g)):
             raise ValueError(f"amplitude and contact_load must be finite, got {amplitude!r} and {contact_load!r}")
-        if period is None:
-            if amplitude != 0:
-                raise ValueError("a forcing period is needed when the amplitude is not 0")
-            Omega = 0.0
-        else:
-            period = float(period)
-            if not np.isfinite(period) or period <= 0:
-                raise ValueError(f"period must be finite and > 0, got {period!r}")
-            Omega = 2 * np.pi / period
-        damping = Damping() if damping is None else damping
-        if not isinstance(damping, Damping):
-            raise ValueError(f"damping must be a Damping (e.g. Damping(alpha=0.005)) or None, got {damping!r}")
-        f = np.ones(system.n) if load is None else np.asarray(load, dtype=float).reshape(-1)
-        if f.shape != (system.n,) or not np.all(np.isfinite(f)):
-            raise ValueError(f"load must be a finite vector of {system.n} entries, got shape {f.shape}")
+        period, Omega, damping, f = forcing_inputs(system.n, period, amplitude, damping, load)
         self.system, self.period, self.amplitude, self.damping, self.load = system, period, amplitude, damping, f
         self.contact_load, self.Omega = g, Omega
         o, d = system.open, system.gap
