@@ -445,3 +445,22 @@ def test_simulate_bounds_the_memory_of_its_stored_impacts():
     with pytest.warns(RuntimeWarning, match=r"max_impacts = 3 reached"):
         tr = bc.simulate(s, x0, v0, 100.0, max_impacts=3)
     assert tr.impact_times.size == 3 and not tr.complete and tr.t_end == pytest.approx(18.0, rel=1e-9)
+
+
+def test_a_k_ipp_start_search_out_of_proportion_is_announced_or_refused(caplog):
+    """`ipp = [4]` with `scan = 2` on the plate ran 4 minutes in silence (2 × 16 215 start cells): the study now
+    announces the estimate first, and refuses a grid estimated at more than 6 hours."""
+    from bladecase.study.schema import StudyError
+    from bladecase.study.stages import _check_start_grid
+
+    system = bc.chain(10, k=1.0, m=0.1, gap=1.0)
+    T = 0.9999 * 2 * np.pi / system.spectrum.omega[0]
+    with caplog.at_level("WARNING", logger="bladecase"):
+        _check_start_grid(system, 4, T, 2, None, "modal 10")
+        _check_start_grid(system, 3, T, 2, 16, "")  # 2 × 105 cells: seconds, nothing said
+    assert re.search(r"modal 10: 4-ipp start search: 2 periods × 16215 cells \(resolution 48\) on 10 dofs, "
+                     r"estimated 3\.5 min", caplog.text)
+    assert caplog.text.count("start search") == 1
+    with pytest.raises(StudyError, match=r"\[search\] ipp: 5-ipp start search: 200 periods × 178365 cells .* "
+                                         r"valid: a smaller \[search\] resolution or scan"):
+        _check_start_grid(system, 5, T, 200, 48)
