@@ -8,6 +8,10 @@ Reference systems
 * ``random_sys`` — a dense, non-diagonal SPD ``M`` and ``K`` (n = 6, seeded) with a generic,
   non-unit constraint vector ``w`` (exercises the Moreau impact law beyond the paper).
 
+Engines
+-------
+* ``dask_executor`` — one 2-worker Dask ``LocalCluster`` for the whole session (its start-up is seconds).
+
 Independent references (numpy / scipy only, never bladecase) live in ``_util.py``.
 """
 
@@ -52,3 +56,12 @@ def chain10_backbone(chain10) -> bc.Backbone:
 @pytest.fixture(scope="session")
 def random_backbone(random_sys) -> bc.Backbone:
     return bc.backbone(random_sys, np.linspace(0.6, 4.7, 301))
+
+
+@pytest.fixture(scope="session")
+def dask_executor():
+    pytest.importorskip("distributed")
+    from bladecase.study import DaskExecutor
+
+    with DaskExecutor(workers=2) as ex:
+        yield ex

@@ -89,13 +89,10 @@ def test_reference_model_is_a_row_of_the_comparison(tmp_path):
     assert "craig-bampton-40 (reference)" in (result.directory / "report.md").read_text()
 
 
-def test_the_grid_on_a_dask_local_cluster_gives_the_serial_results(result, tmp_path):
+def test_the_grid_on_a_dask_local_cluster_gives_the_serial_results(result, tmp_path, dask_executor):
     """The models' searches shipped to a 2-worker Dask LocalCluster come back with the same families and arcs
     (records without their system, bound again on return)."""
-    from bladecase.study import DaskExecutor
-
-    with DaskExecutor(workers=2) as executor:
-        remote = run(loads(GRID, base=ROOT), out=tmp_path / "dask", progress=False, executor=executor)
+    remote = run(loads(GRID, base=ROOT), out=tmp_path / "dask", progress=False, executor=dask_executor)
     assert list(remote.models) == list(result.models)
     for name, m in remote.models.items():
         mine = result.models[name]

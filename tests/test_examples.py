@@ -95,12 +95,40 @@ def test_example_writes_pngs(ex, name, tmp_path):
     assert not list(tmp_path.glob(".*")), "temporary files left behind (atomic write)"
 
 
-@pytest.mark.parametrize("name", NAMES)
-def test_example_cli_help(name):
-    r = subprocess.run([sys.executable, str(EXAMPLES / f"{name}.py"), "--help"], capture_output=True, text=True,
-                       timeout=60)
+_HELP_ALL = """
+import contextlib, io, json, runpy, sys
+out = {}
+for path in sys.argv[1:]:
+    sys.argv = [path, "--help"]
+    buf = io.StringIO()
+    code = None
+    with contextlib.redirect_stdout(buf):
+        try:
+            runpy.run_path(path, run_name="__main__")
+        except SystemExit as exc:
+            code = exc.code
+    out[path] = [code, buf.getvalue()]
+print(json.dumps(out))
+"""
+
+
+@pytest.fixture(scope="module")
+def cli_help():
+    """``example.py --help`` of every example, each run as ``__main__`` in one fresh interpreter (one import of
+    bladecase for all of them)."""
+    import json
+
+    paths = [str(EXAMPLES / f"{name}.py") for name in NAMES]
+    r = subprocess.run([sys.executable, "-c", _HELP_ALL, *paths], capture_output=True, text=True, timeout=120)
     assert r.returncode == 0, r.stderr
-    assert "--out" in r.stdout and "--low" in r.stdout
+    return json.loads(r.stdout.strip().splitlines()[-1])
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_example_cli_help(name, cli_help):
+    code, text = cli_help[str(EXAMPLES / f"{name}.py")]
+    assert code in (0, None), text
+    assert "--out" in text and "--low" in text
 
 
 # --- the paper's mode (examples/_paper.py) ----------------------------------

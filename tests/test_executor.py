@@ -29,13 +29,6 @@ FORCING = {"damping": Damping(alpha=0.05), "amplitude": 0.6, "n_periods": 150}
 PERIODS = [5.1, 4.5, 4.2, 4.8]  # not sorted: the order of the items is the order of the results
 
 
-@pytest.fixture(scope="module")
-def dask_executor():
-    pytest.importorskip("distributed")
-    with DaskExecutor(workers=2) as ex:
-        yield ex
-
-
 @pytest.fixture(params=["processes", "dask"])
 def parallel(request):
     if request.param == "processes":
