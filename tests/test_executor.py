@@ -71,12 +71,12 @@ def _families(branches, system) -> list[str]:
     return [json.dumps(b.bind(system).to_dict(), sort_keys=True) for b in branches]
 
 
-def test_nonsmooth_modes_identical(parallel):
+def test_nonsmooth_modes_identical(dask_executor):
     """2-ipp nonsmooth modes of chains of two sizes: the same families and orbits; light records come back."""
     systems = [chain(2, k=1.0, m=1.0, gap=1.0), chain(3, k=1.0, m=1.0, gap=1.0)]
     task = functools.partial(nonsmooth_mode, k=2, T_range=(2.0, 12.0), scan=6)
     serial = SerialExecutor().map(task, systems)
-    remote = parallel.map(task, systems, desc="models")
+    remote = dask_executor.map(task, systems, desc="models")
     assert [len(f) for f in serial] == [3, 2]
     assert all(b.system is None for fams in remote for b in fams)  # orbits pickle without their system
     for s, a, b in zip(systems, serial, remote):
