@@ -359,7 +359,8 @@ def _odd(rng):
 
 
 def test_random_study_edits_give_a_study_or_one_line_naming_the_key():
-    """(hypothesis is not installed: a seeded random search over the schema's keys and odd values.)"""
+    """A seeded random search over the schema's keys and fixed odd values (hypothesis generates more:
+    tests/test_properties.py)."""
     from bladecase.study.schema import SCHEMA
 
     rng = np.random.default_rng(15)
