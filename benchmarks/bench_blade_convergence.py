@@ -35,7 +35,7 @@ from scipy.optimize import brentq
 
 import bladecase as bc
 from bladecase.nsm import MASSLESS_DENSE_LIMIT
-from bladecase.nsm.massless_orbits import SymmetricOrbit, closing_residual
+from bladecase.nsm.massless_orbits import SymmetricOrbit, closing_residual, orbit_at_period
 from bladecase.post.compare import ModelResult, contact_spectrum
 from bladecase.post.compare_table import convergence_verdict
 from bladecase.study import demo_study, stages
@@ -71,31 +71,10 @@ def grazing_energy(system) -> float:
     return 0.5 * (sp.omega[0] * system.gap / sp.b[0]) ** 2
 
 
-def massless_orbit(system, T: float, beta: float, maxiter: int = 60):
-    """The one-contact-phase orbit of period ``T`` by Newton on the contact half-time from ``beta``.
-
-    As ``bladecase.nsm.massless_orbits.orbit_at_period``, but the iteration also stops at its round-off floor
-    (a step no smaller than half the previous one, below 1e-10 T): near grazing (β ~ 1e-6 s) the library's
-    absolute test ``|step| <= 1e-14 T`` is below the residual's noise and the Newton steps cycle (measured:
-    ±4.9e-17 s against 4.75e-17 s), so ``Branch.orbit_at`` returns nothing at periods inside an admissible arc.
-    """
-    prev = np.inf
-    for _ in range(maxiter):
-        _, r, g = closing_residual(system, T / 2 - beta, beta, True)
-        step = r / (g[1] - g[0])
-        beta -= step
-        if not 0 < beta < T / 2:
-            return None
-        if abs(step) <= 1e-14 * T or (abs(step) >= 0.5 * abs(prev) and abs(step) <= 1e-10 * T):
-            a, _ = closing_residual(system, T / 2 - beta, beta)
-            return SymmetricOrbit(system, T / 2 - beta, beta, a)
-        prev = step
-    return None
-
-
 def orbits_at(branch, T: float) -> list:
-    """The branch's orbits of period ``T``: ``Branch.orbit_at`` (Newton) or, massless, :func:`massless_orbit`
-    from the interpolated contact half-time of each pair of neighbours that brackets ``T``."""
+    """The branch's orbits of period ``T``: ``Branch.orbit_at`` (Newton) or, massless,
+    ``bladecase.nsm.massless_orbits.orbit_at_period`` from the interpolated contact half-time of each pair of
+    neighbours that brackets ``T``."""
     system = branch.system
     if getattr(system, "contact_model", "newton") != "massless":
         return branch.orbit_at(T)
@@ -104,7 +83,7 @@ def orbits_at(branch, T: float) -> list:
         if o1 is None or o2 is None or o1.T == o2.T or not min(o1.T, o2.T) <= T <= max(o1.T, o2.T):
             continue
         s = (T - o1.T) / (o2.T - o1.T)
-        orbit = massless_orbit(system, T, (1 - s) * o1.beta + s * o2.beta)
+        orbit = orbit_at_period(system, T, (1 - s) * o1.beta + s * o2.beta)
         out += [] if orbit is None else [orbit]
     return out
 
