@@ -172,6 +172,16 @@ def _repeated_seeds(md: ModalKernel, k: int, d: float, resolution: int | None) -
     return seeds
 
 
+def default_resolution(T: float, omega_max: float) -> int:
+    """Grid points per impact time of the k >= 3 start search at period ``T``: 4 per period of the highest
+    contact mode, clipped to [16, 48].
+
+    >>> default_resolution(10.0, 2.0), default_resolution(10.0, 5.0), default_resolution(10.0, 20.0)
+    (16, 32, 48)
+    """
+    return int(np.clip(np.ceil(4 * T * omega_max / (2 * np.pi)), 16, 48))
+
+
 def _multistart(md: ModalKernel, k: int, d: float, resolution: int | None) -> list[tuple[np.ndarray, np.ndarray]]:
     """Solutions for k >= 3: Levenberg–Marquardt from the equally spaced
     pattern, from every repeated lower-order solution (period ``T/j``,
@@ -180,7 +190,7 @@ def _multistart(md: ModalKernel, k: int, d: float, resolution: int | None) -> li
     from every grid cell."""
     T = md.T
     if resolution is None:
-        resolution = int(np.clip(np.ceil(4 * T * md.omega.max() / (2 * np.pi)), 16, 48))
+        resolution = default_resolution(T, md.omega.max())
     grid = T * (np.arange(1, resolution) / resolution)
     idx = np.array(list(combinations(range(grid.size), k - 1)))
     starts = np.column_stack([grid[idx], np.full(len(idx), T)])

@@ -217,7 +217,9 @@ def _check_start_grid(system, k: int, T: float, scan: int, resolution: int | Non
         return
     from math import comb
 
-    res = resolution or int(np.clip(np.ceil(4 * T * system.spectrum.contact_modes[0].max() / (2 * np.pi)), 16, 48))
+    from ..nsm.kipp import default_resolution
+
+    res = resolution or default_resolution(T, float(system.spectrum.contact_modes[0].max()))
     cells = comb(res - 1, k - 1) * scan
     est = START_CELL_SECONDS * cells * system.n * k * k
     what = (f"{label + ': ' if label else ''}{k}-ipp start search: {scan} periods × {comb(res - 1, k - 1)} cells "
