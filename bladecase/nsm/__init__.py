@@ -47,17 +47,24 @@ from .floquet import FLOQUET_TOL, Floquet, branch_stability, floquet, stable_arc
 from .forced import Damping, EnergyBalance, ForcedFlight, ForcedTrajectory, simulate_forced
 from .forced_massless import MasslessForcedFlight, MasslessForcedTrajectory, simulate_forced_massless
 from .kipp import canonical_rotation, orbits_kipp
-from .massless import MASSLESS_DENSE_LIMIT, MasslessSystem, condense, redistribute_mass, simulate_massless
+from .massless import (
+                       MASSLESS_DENSE_LIMIT,
+                       MasslessSystem,
+                       condense,
+                       redistribute_mass,
+                       series_stiffness,
+                       simulate_massless,
+)
 from .massless_branches import massless_mode
 from .massless_phases import PhasedOrbit
 from .modal import (
-    ModalKernel,
-    check_period,
-    impact_matrices,
-    kipp_jacobian,
-    kipp_residual,
-    newton_times,
-    solve_times,
+                       ModalKernel,
+                       check_period,
+                       impact_matrices,
+                       kipp_jacobian,
+                       kipp_residual,
+                       newton_times,
+                       solve_times,
 )
 from .modes import nonsmooth_mode
 from .orbits import PeriodicOrbit, make_orbit, orbit_1ipp
@@ -77,5 +84,6 @@ __all__ = [
     "backbone", "bar", "bar_continuum_energy", "bisect", "branch_stability", "canonical_rotation", "chain",
     "check_period", "condense", "floquet", "impact_matrices", "integrate", "kipp_jacobian", "kipp_residual",
     "make_orbit", "massless_mode", "newton_times", "nonsmooth_mode", "orbit_1ipp", "orbits_kipp",
-    "redistribute_mass", "simulate", "simulate_massless", "solve_times", "stable_arcs", "trace", "verify",
+    "redistribute_mass", "series_stiffness", "simulate", "simulate_massless", "solve_times", "stable_arcs", "trace",
+    "verify",
 ]

@@ -37,13 +37,14 @@ def _positive(name: str, value) -> float:
 
 
 def bar(n: int, gap: float, length: float = 1.0, EA: float = 1.0, rhoA: float = 1.0,
-        contact: str = "massless") -> LinearSystem | MasslessSystem:
+        contact: str = "massless", casing: float = float("inf")) -> LinearSystem | MasslessSystem:
     """A bar of ``n`` linear elements, fixed at ``x = 0``, contact at ``x = length`` with clearance ``gap``.
 
     Lumped (row-sum) mass. ``contact="newton"``: the seed's model, a spring–mass chain whose end node (mass
     ``ρA h/2``) impacts (:class:`~bladecase.nsm.LinearSystem`). ``contact="massless"``: the end node's mass is moved
     to the two nodes before it (total mass and centre of mass kept: ``+ρA h`` at ``L - h``, ``-ρA h/2`` at
-    ``L - 2h``), and the model is condensed (:class:`~bladecase.nsm.massless.MasslessSystem`).
+    ``L - 2h``), and the model is condensed (:class:`~bladecase.nsm.massless.MasslessSystem`); ``casing``: the
+    stiffness of a compliant casing in series with the end (``inf``: rigid; the massless model only).
     """
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 3:
         raise ValueError(f"n (elements) must be an integer >= 3, got {n!r}")
@@ -55,13 +56,16 @@ def bar(n: int, gap: float, length: float = 1.0, EA: float = 1.0, rhoA: float = 
     masses = np.full(n, rhoA * h)
     masses[-1] = rhoA * h / 2
     if contact == "newton":
+        if float(casing) != float("inf"):
+            raise ValueError(f"casing = {casing!r}: Newton's impact law needs a rigid casing (casing=inf); a compliant "
+                             "casing is taken by contact='massless'")
         return chain(n, k=EA / h, m=masses, gap=gap)
     coords = h * np.arange(1, n + 1)
     masses = redistribute_mass(masses, coords, n - 1, np.array([n - 3, n - 2]))
     K = chain(n, k=EA / h, m=1.0, gap=gap).K
     w = np.zeros(n)
     w[-1] = 1.0
-    return condense(np.diag(masses), K.toarray() if hasattr(K, "toarray") else K, w, gap)
+    return condense(np.diag(masses), K.toarray() if hasattr(K, "toarray") else K, w, gap, casing)
 
 
 def bar_continuum_energy(T, gap: float, length: float = 1.0, EA: float = 1.0, rhoA: float = 1.0):

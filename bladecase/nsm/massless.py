@@ -7,7 +7,16 @@ With the contact dofs ``c`` (where ``w ≠ 0``) massless, static condensation of
 
 - ``S = K_ii - K_ic K_cc⁻¹ K_ci``: the open-phase stiffness (contact dofs free, statically condensed);
 - ``ŵ = -K_ic K_cc⁻¹ w_c``: while open, the contact displacement is ``wᵀx_full = ŵᵀx``;
-- ``k_c = 1 / (w_cᵀ K_cc⁻¹ w_c)``: the static stiffness of the contact dofs alone.
+- ``k_c = 1 / (w_cᵀ K_cc⁻¹ w_c)``: the static stiffness of the contact dofs alone — in series with the casing's
+  stiffness ``k_casing`` when the casing is compliant (:func:`series_stiffness`; ``inf``: a rigid casing).
+
+A compliant casing (a spring ``k_casing`` between the contact and the rigid casing at ``d``, the casing's local
+flexibility and its abradable coating) changes nothing else: with ``λ = k_casing (w_cᵀx_c - d)`` in the closed
+phase, ``λ = k (ŵᵀx - d)`` with ``k = k_c k_casing / (k_c + k_casing)``, both switches are still at ``ŵᵀx = d``,
+and the contact dofs sit ``λ / k_casing`` beyond ``d`` (the casing yields). The same model with a rigid casing is
+the limit ``k_casing → ∞``. A casing stiffness well below ``k_c`` keeps the closed phase's dynamics in the low modes
+that every model of the blade resolves: the nonsmooth modes then converge under refinement
+(docs/massless.md, "A compliant casing").
 
 Open phase: ``y = ŵᵀx <= d``, ``λ = 0``. Closed phase: ``w_cᵀx_c = d`` held by the multiplier
 ``λ = k_c (y - d) >= 0``. Both switches happen at ``y = d`` (closing when ``y`` reaches ``d`` from below, opening
@@ -90,11 +99,15 @@ class MasslessSystem:
     w : (n,) ndarray
         ``ŵ``: the contact displacement is ``ŵᵀx`` while open.
     kc : float
-        Contact stiffness ``1 / (w_cᵀ K_cc⁻¹ w_c)``.
+        Stiffness of the unilateral spring: ``1 / (w_cᵀ K_cc⁻¹ w_c)``, in series with ``casing``
+        (:func:`series_stiffness`).
     gap : float
         Clearance ``d > 0``.
     expand : (n_full, n) ndarray or None
         Open-phase displacement of every dof of the full model from the interior ones (``None``: not kept).
+    casing : float
+        The casing's stiffness already included in ``kc`` (``inf``: rigid casing, the default). Kept as a record:
+        the closed phase's contact displacement is ``d + λ / casing``.
     """
 
     M: np.ndarray
@@ -103,6 +116,7 @@ class MasslessSystem:
     kc: float
     gap: float
     expand: np.ndarray | None = None
+    casing: float = float("inf")
 
     contact_model = "massless"
 
@@ -115,6 +129,8 @@ class MasslessSystem:
             raise ValueError(f"gap must be finite and > 0, got {self.gap!r}")
         if not (np.isfinite(self.kc) and self.kc > 0):
             raise ValueError(f"contact stiffness kc must be finite and > 0, got {self.kc!r}")
+        if not (self.casing > 0 and not np.isnan(self.casing)):
+            raise ValueError(f"casing stiffness must be > 0 (inf: a rigid casing), got {self.casing!r}")
 
     @property
     def n(self) -> int:
@@ -154,7 +170,20 @@ class MasslessSystem:
         return self.kc * max(0.0, float(self.w @ np.asarray(x, float)) - self.gap)
 
     def __repr__(self) -> str:
-        return f"MasslessSystem(n={self.n}, gap={self.gap:g}, kc={self.kc:.4g})"
+        casing = "" if np.isinf(self.casing) else f", casing={self.casing:.4g}"
+        return f"MasslessSystem(n={self.n}, gap={self.gap:g}, kc={self.kc:.4g}{casing})"
+
+
+def series_stiffness(kc: float, casing: float) -> float:
+    """Stiffness of the contact dofs (``kc``) in series with the casing (``casing``; ``inf``: rigid).
+
+    >>> series_stiffness(3.0, float("inf")), series_stiffness(3.0, 6.0)
+    (3.0, 2.0)
+    """
+    casing = float(casing)
+    if not (casing > 0 and not np.isnan(casing)):
+        raise ValueError(f"casing stiffness must be > 0 N/m (inf: a rigid casing), got {casing!r}")
+    return float(kc) if np.isinf(casing) else float(kc) * casing / (float(kc) + casing)
 
 
 class BoundOrbit:
@@ -185,8 +214,10 @@ class BoundOrbit:
         return dataclasses.replace(self, system=system)
 
 
-def condense(M, K, w, gap: float) -> MasslessSystem:
+def condense(M, K, w, gap: float, casing: float = float("inf")) -> MasslessSystem:
     """The massless model of a full system ``(M, K, w, d)`` whose mass is zero on the contact dofs.
+
+    ``casing``: the casing's stiffness (N/m; ``inf``, the default: rigid), in series with the contact dofs'.
 
     ``M`` must have zero rows and columns on the contact dofs ``c = {j : w_j ≠ 0}`` (move their mass to the
     neighbours first, e.g. with :func:`redistribute_mass`); ``K`` must be SPD. Dense arrays (a reduced model or
@@ -212,8 +243,8 @@ def condense(M, K, w, gap: float) -> MasslessSystem:
     expand = np.zeros((n, i.size))
     expand[i, np.arange(i.size)] = 1.0
     expand[c] = -X[:, :-1]
-    return MasslessSystem(M[np.ix_(i, i)], 0.5 * (S + S.T), -Kci.T @ X[:, -1], 1.0 / float(w[c] @ X[:, -1]),
-                          float(gap), expand)
+    kc = series_stiffness(1.0 / float(w[c] @ X[:, -1]), casing)
+    return MasslessSystem(M[np.ix_(i, i)], 0.5 * (S + S.T), -Kci.T @ X[:, -1], kc, float(gap), expand, float(casing))
 
 
 def redistribute_mass(masses: np.ndarray, coords: np.ndarray, contact: int, neighbours: np.ndarray) -> np.ndarray:

@@ -169,6 +169,9 @@ class Contact:
     #: The weights ``ω_k >= 0`` of ``nodes`` (``Σ ω_k = 1``; less when the face touches the clamp), e.g. the
     #: tributary areas of ``Contact.face(..., weights="area")``; empty: equal weights ``1/len(nodes)``.
     weights: tuple[float, ...] = field(default=(), repr=False)
+    #: The casing's stiffness (N/m) against the contact, in series with the blade's (``inf``: a rigid casing, the
+    #: seed's model). Only the massless contact model takes a compliant casing (:meth:`with_casing`).
+    casing: float = field(default=float("inf"), repr=False)
 
     def __post_init__(self) -> None:
         node = self.node
@@ -191,6 +194,28 @@ class Contact:
                 raise ValueError(f"weights of a face contact must be one finite value >= 0 per node of nodes "
                                  f"({len(nodes)}), summing to at most 1 and more than 0, got {self.weights!r}")
         object.__setattr__(self, "weights", weights)
+        try:
+            casing = float(self.casing)
+        except (TypeError, ValueError):
+            casing = float("nan")
+        if not casing > 0:
+            raise ValueError(f"casing stiffness must be a number > 0 in N/m (inf: a rigid casing), got {self.casing!r}")
+        object.__setattr__(self, "casing", casing)
+
+    def with_casing(self, stiffness: float) -> Contact:
+        """This contact against a compliant casing of ``stiffness`` N/m (``inf``: rigid).
+
+        The casing — its local flexibility, its abradable coating — acts as a spring between the contact and the
+        rigid casing at ``gap``: with the massless contact model the closed phase's stiffness is the contact's in
+        series with the casing's (:func:`bladecase.nsm.massless.series_stiffness`), and the contact moves
+        ``λ / stiffness`` beyond the gap. Newton's impact law needs a rigid casing.
+
+        >>> Contact(3, (0.0, 1.0), 1e-4).with_casing(2e6)
+        Contact(node=3, normal=(0.0, 1.0), gap=0.0001, casing=2e+06 N/m)
+        """
+        import dataclasses
+
+        return dataclasses.replace(self, casing=stiffness)
 
     # ------------------------------------------------------------------ helpers to pick the node
 
@@ -318,12 +343,20 @@ class Contact:
         is dense and limited to :data:`bladecase.nsm.system.DENSE_LIMIT` dofs; reduce
         larger models first (:func:`bladecase.lanczos_chain`).
         """
+        self.rigid("Newton's impact law (the full model's LinearSystem)")
         return LinearSystem(model.M, model.K, self.w(model), self.gap)
+
+    def rigid(self, what: str) -> None:
+        """``ValueError`` naming ``what`` unless the casing is rigid (a compliant casing needs the massless model)."""
+        if np.isfinite(self.casing):
+            raise ValueError(f"{what} needs a rigid casing, got casing stiffness {self.casing:g} N/m: a compliant "
+                             "casing is taken by the massless contact model only (methods 'massless', "
+                             "'massless-lanczos', 'massless-modal'; study key [contact] model = \"massless\")")
 
     def _resolved(self, model: FEModel) -> Contact:
         """This contact with its normal made explicit for ``model``, after checking the node."""
         self.dofs(model)
-        return Contact(self.node, tuple(self.normal_for(model)), self.gap, self.nodes, self.weights)
+        return Contact(self.node, tuple(self.normal_for(model)), self.gap, self.nodes, self.weights, self.casing)
 
     @classmethod
     def face(cls, model: FEModel, group: str = "tip", normal: Sequence[float] | None = None,
@@ -368,7 +401,8 @@ class Contact:
         where = f"face of {len(self.nodes)} nodes around node={self.node}" if self.nodes else f"node={self.node}"
         if self.weights:
             where = "area-weighted " + where
-        return f"Contact({where}, normal={self.normal}, gap={self.gap})"
+        casing = "" if np.isinf(self.casing) else f", casing={self.casing:.4g} N/m"
+        return f"Contact({where}, normal={self.normal}, gap={self.gap}{casing})"
 
 
 #: Boundary facets of each cell family (corner indices, cyclic order), grouped by their number of corners.

@@ -61,7 +61,7 @@ import scipy.sparse as sp
 from ..checks import integer
 from ..fe import FEModel
 from ..linalg import DENSE_LIMIT, SPDFactor, check_factor, lowest_modes, spd_factor
-from ..nsm import MASSLESS_DENSE_LIMIT, MasslessSystem, redistribute_mass
+from ..nsm import MASSLESS_DENSE_LIMIT, MasslessSystem, redistribute_mass, series_stiffness
 from .contact import Contact
 from .model import ReducedModel
 
@@ -102,7 +102,8 @@ class MasslessReducedModel(ReducedModel):
     def free_dofs(self, x_r) -> np.ndarray:
         """Free-dof displacements of reduced states, the closed phase's contact correction included.
 
-        ``V_full q + λ(q)·closed_shape``: ``wᵀx = d`` holds where ``λ > 0``; ``V_full q`` where open.
+        ``V_full q + λ(q)·closed_shape``: ``wᵀx = d`` holds where ``λ > 0`` (``d + λ / casing`` against a compliant
+        casing); ``V_full q`` where open.
         """
         x = super().free_dofs(x_r)
         lam = self.multiplier(x_r)
@@ -309,8 +310,8 @@ def massless_model(model: FEModel, contact: Contact, size: int | None = None,
         V[split.i], V[split.c] = V_i, split.slave(V_i)
         M_r = V_i.T @ (masses[split.i][:, None] * V_i)
     S_r = split.schur() if size is None else V.T @ (split.K @ V)
-    system = MasslessSystem(0.5 * (M_r + M_r.T), 0.5 * (S_r + S_r.T), np.asarray(V.T @ split.w), split.kc,
-                            contact.gap)
+    system = MasslessSystem(0.5 * (M_r + M_r.T), 0.5 * (S_r + S_r.T), np.asarray(V.T @ split.w),
+                            series_stiffness(split.kc, contact.casing), contact.gap, casing=contact.casing)
     method = "massless" if size is None else BASES[basis]
     return MasslessReducedModel(method, size, system, V, model, contact, closed_shape=split.closed_shape(),
                                 masses=masses)

@@ -171,6 +171,8 @@ def reduce(
         raise ValueError(f"the model is not clamped: {model.rigid_modes} rigid-body motion(s) are free, so K is "
                          f"singular; clamp a face of every part (every reduction, {method!r} included, needs a "
                          "clamped model)")
+    if not method.startswith("massless"):
+        contact.rigid(f"method {method!r} (Newton's impact law)")
     factor = check_factor(factor, model.K, "this model's K", "bladecase.fe.stiffness_factor(model)")
     if entry.sized:
         if size is None:

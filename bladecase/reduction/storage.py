@@ -31,6 +31,8 @@ def save_reduced(reduced: ReducedModel, path) -> None:
            "contact/node": np.array(c.node), "contact/gap": np.array(c.gap),
            "contact/normal": np.array([] if c.normal is None else c.normal, dtype=float),
            "contact/nodes": np.array(c.nodes, dtype=np.int64), "contact/weights": np.array(c.weights, dtype=float)}
+    if np.isfinite(c.casing):
+        out["contact/casing"] = np.array(c.casing)
     if getattr(s, "contact_model", "newton") == "massless":  # MasslessSystem: S and kc instead of K
         out.update({"contact_model": np.array("massless"), "Mr": s.M, "Sr": s.S, "kc": np.array(s.kc),
                     "closed_shape": reduced.closed_shape, "masses": reduced.masses})
@@ -72,8 +74,9 @@ def _reduced_from_arrays(data: dict, source: str) -> ReducedModel:
     nodes = tuple(int(k) for k in npz_array(data, "contact/nodes", source, 1, "int")) if "contact/nodes" in data else ()
     weights = tuple(float(x) for x in npz_array(data, "contact/weights", source, 1)) if "contact/weights" in data \
         else ()
+    casing = scalar("contact/casing") if "contact/casing" in data else float("inf")
     contact = Contact(scalar("contact/node", "int"), tuple(normal) if normal.size else None, scalar("contact/gap"),
-                      nodes, weights)
+                      nodes, weights, casing)
     size = scalar("size", "int")
     w, gap, method = npz_array(data, "w", source, 1), scalar("gap"), scalar("method", "str")
     try:
@@ -82,7 +85,7 @@ def _reduced_from_arrays(data: dict, source: str) -> ReducedModel:
             from .massless import MasslessReducedModel
 
             system = MasslessSystem(npz_array(data, "Mr", source, 2), npz_array(data, "Sr", source, 2), w,
-                                    scalar("kc"), gap)
+                                    scalar("kc"), gap, casing=casing)
             return MasslessReducedModel(method=method, size=None if size < 0 else size, system=system,
                                         basis=matrix("basis"), model=model, contact=contact,
                                         closed_shape=npz_array(data, "closed_shape", source),

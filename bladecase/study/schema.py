@@ -123,6 +123,10 @@ SCHEMA: dict[str, dict[str, Key]] = {
                      "mass is moved to the neighbours; Signorini without an impact law; needs [fem] mass = "
                      "'lumped', [reduction] method = 'massless', [search] ipp = [1]).",
                      _one_of("newton", "massless")),
+        "casing_stiffness": Key(_NUM, None, "Stiffness of a compliant casing (N/m) in series with the contact "
+                                "(its local flexibility and coating); default: a rigid casing. Massless model only; "
+                                "well below the contact's own stiffness, the modes converge (docs/massless.md).",
+                                lambda v: "must be > 0 (N/m)" if not v > 0 else _in_range("casing_stiffness")(v)),
     },
     "reduction": {
         "method": Key(_STR, "lanczos-si", f"Reduced model: {', '.join(METHODS)}.", _one_of(*METHODS)),
@@ -426,6 +430,10 @@ MASSLESS_METHODS = ("massless", "massless-lanczos", "massless-modal")
 def _contact_model_checks(c: dict) -> None:
     """The massless contact model and the keys it needs go together."""
     massless = c["contact"]["model"] == "massless"
+    if c["contact"]["casing_stiffness"] is not None and not massless:
+        raise StudyError(f"[contact] casing_stiffness: a compliant casing needs model = 'massless' (Newton's impact "
+                         f"law is for a rigid casing), got {c['contact']['casing_stiffness']!r} with model = "
+                         f"{c['contact']['model']!r}")
     methods = [c["reduction"]["method"]] + [x["method"] for x in c["reduction"]["compare"]]
     if massless:
         bad = [m for m in methods if m not in MASSLESS_METHODS]
@@ -500,7 +508,8 @@ def demo_text() -> str:
 
 
 #: The seed paper's variant of the demo: Newton's impact law on the tip node, 1- and 2-ipp modes below T1.
-NEWTON_DEMO = {"contact": {"model": "newton", "face": None, "weights": None, "group": "contact"},
+NEWTON_DEMO = {"contact": {"model": "newton", "face": None, "weights": None, "group": "contact",
+                           "casing_stiffness": None},
                "reduction": {"method": "lanczos-si"}, "search": {"ipp": [1, 2], "periods": [0.9, 0.9999]}}
 
 

@@ -123,6 +123,12 @@ def build_contact(study: Study, model: FEModel) -> Contact:
     the point (within ``group`` if given); otherwise the node of the one-node
     ``group`` (default ``contact``).
     """
+    contact = _picked_contact(study, model)
+    casing = study["contact"]["casing_stiffness"]
+    return contact if casing is None else contact.with_casing(casing)
+
+
+def _picked_contact(study: Study, model: FEModel) -> Contact:
     c = study["contact"]
     normal, gap = c["normal"], c["clearance"]
     group = contact_group(study)

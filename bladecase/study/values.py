@@ -32,7 +32,8 @@ def _int_at_least(n):
 #: Physical ranges (SI) of the study's scales.  Outside them the value is a unit mistake, and double
 #: precision no longer delivers the stated tolerances (energies ``~ K d²`` overflow, eigen-solutions and
 #: impact times lose their digits): ``[contact] clearance``, ``[material] E`` and ``rho``.
-RANGES = {"clearance": (1e-9, 10.0, "m"), "E": (1e3, 1e13, "Pa"), "rho": (1e-2, 1e5, "kg/m³")}
+RANGES = {"clearance": (1e-9, 10.0, "m"), "E": (1e3, 1e13, "Pa"), "rho": (1e-2, 1e5, "kg/m³"),
+          "casing_stiffness": (1e-3, 1e15, "N/m")}
 
 #: Caps on the work a study may ask for (each is far above any useful value; beyond, a run would not end
 #: or not fit in memory).
