@@ -12,7 +12,7 @@ mesh) and between the two finest meshes (largest size), of admissible orbits onl
 where three meshes are monotone, and the verdict against the issue's goal: < 1 % between the two finest.
 
 Run: OPENBLAS_NUM_THREADS=1 nice .venv/bin/python benchmarks/bench_blade_casing.py [--fine] [--quick]
-     [--casing 1e6,inf] [--ratios 0.995,0.99,0.98] [--json FILE]
+     [--casing 1e6,inf] [--ratios 0.995,0.99,0.98] [--scales 0.7,0.5,0.35,0.25] [--json FILE]
      (default: casings 1e6 and inf, meshes ×1.4, ×1, ×0.7, sizes 8–64: about 3 min; --fine adds the 22k- and
      51k-dof meshes, about 10 min more; --quick: meshes ×1.4, ×1 and sizes 8, 16)
 """
@@ -90,12 +90,15 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--fine", action="store_true")
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--scales", help="mesh scales instead of the defaults, e.g. 0.7,0.5,0.35,0.25")
     ap.add_argument("--casing", default="1e6,inf")
     ap.add_argument("--ratios", default="0.995,0.99,0.98")
     ap.add_argument("--json")
     args = ap.parse_args()
     warnings.simplefilter("ignore", LinAlgWarning)
     scales = (1.4, 1.0) if args.quick else (1.4, 1.0, 0.7) + ((0.5, 0.35) if args.fine else ())
+    if args.scales:
+        scales = tuple(float(x) for x in args.scales.split(","))
     sizes = (8, 16) if args.quick else (8, 16, 32, 64)
     casings = [float(x) for x in args.casing.split(",")]
     ratios = [float(x) for x in args.ratios.split(",")]

@@ -27,6 +27,7 @@ def report(summary: dict) -> str:
               f"displacement), centre node {c['node']}" if len(c.get("face_nodes", [])) > 1 else f"- Node {c['node']}")
              + f" at ({', '.join(f'{x:.5g}' for x in c['position'])}) m, casing normal "
              f"({', '.join(f'{x:.4g}' for x in c['normal'])}), clearance {c['clearance_m'] * 1e3:.4g} mm.",
+             _casing_words(c.get("casing_stiffness_n_per_m")),
              "", "## Reduced model", "",
              f"- {r['method']} (size {r['size']}): {r['reduced_dofs']} reduced dofs.", "",
              "| mode | reduced f (Hz) | contact weight b² | FE counterpart (by mode shape) | rel. error |",
@@ -63,6 +64,7 @@ def report(summary: dict) -> str:
                          f"{f['frequency_range_hz'][1]:.3f} | {a['f_lo']:.4f} – {a['f_hi']:.4f} | "
                          f"{a['energy_range_j'][0]:.3e} – {a['energy_range_j'][1]:.3e} | "
                          f"{'—' if stable is None else f'{stable:.0%} of its orbits'} |")
+    lines += [w for i, f in with_arcs if (w := _resonance_words(i, f, r["frequencies_hz"]))]
     widths = [(a["f_hi"] - a["f_lo"]) / a["f_hi"] for _, f in with_arcs for a in f["admissible_arcs"] if a["f_hi"] > 0]
     if widths and max(widths) < NARROW_RTOL:
         lines += ["", f"**Narrow:** the widest admissible arc spans {max(widths):.1e} of its frequency — in this model "
@@ -102,6 +104,25 @@ def report(summary: dict) -> str:
             lines.append(f"\n  ![{a['gif']}]({a['gif']})\n")
     lines += ["", "Timings (s): " + ", ".join(f"{k} {v:.2f}" for k, v in summary["timings_s"].items()), ""]
     return "\n".join(lines)
+
+
+def _casing_words(k: float | None) -> str:
+    if k is None:
+        return "- Casing: rigid (the clearance is closed by the contact alone)."
+    return (f"- Casing: compliant, {k:.4g} N/m in series with the contact's own stiffness — the contact moves λ/k "
+            "beyond the clearance while closed (docs/massless.md, \"A compliant casing\").")
+
+
+def _resonance_words(index: int, fam: dict, modes_hz: list[float]) -> str | None:
+    """A sentence when the family's energy grows without bound into a higher mode (an internal resonance)."""
+    res = fam.get("resonance")
+    if not res:
+        return None
+    return (f"\n**Family {index} ends in an internal resonance:** its energy grows {res['growth']:.1e}-fold towards "
+            f"{res['frequency_hz']:.2f} Hz, where {res['share']:.0%} of it sits in mode {res['mode']} "
+            f"({res['mode_frequency_hz']:.1f} Hz, {res['ratio']:.2f} × the orbit's frequency: near the "
+            f"{round(res['ratio'])}:1 resonance). Read the backbone below that frequency; the energies next to it "
+            "are the exchange with that mode.")
 
 
 def _counterpart(mt: dict | None) -> str:

@@ -74,7 +74,7 @@ def _range(values: np.ndarray) -> list[float | None]:
 def family_summary(fam: Branch) -> dict:
     """Period, frequency and energy ranges of a branch, and its admissible arcs."""
     T, E = fam.T, fam.energy
-    return {
+    out = {
         "ipp": fam.k,
         "orbits": len(fam.orbits),
         "period_range_s": _range(T),
@@ -88,6 +88,30 @@ def family_summary(fam: Branch) -> dict:
              "stable_fraction": _stable_fraction(fam.orbits[a.start:a.stop + 1])} for a in fam.arcs
         ],
     }
+    out["resonance"] = _resonance(fam, E)
+    return out
+
+
+#: A family whose energy grows by more than this factor is checked for an internal resonance at its top.
+RESONANCE_GROWTH = 30.0
+
+
+def _resonance(fam: Branch, E: np.ndarray) -> dict | None:
+    """Where the energy of a family that grows without bound goes: the mode holding the largest share of its
+    most energetic orbit (time-averaged over the free flights), when that is not the family's own mode."""
+    from ..nsm.energy import modal_energy_split
+
+    if not np.isfinite(E).any() or not np.nanmax(E) > RESONANCE_GROWTH * np.nanmin(E):
+        return None
+    top = fam.orbits[int(np.nanargmax(E))]
+    split = modal_energy_split(top)
+    j = int(np.argmax(split.shares))
+    f = 1 / top.T
+    if split.frequencies[j] < 1.5 * f:
+        return None  # the family's own (lowest) mode holds it: a stiffening, not a resonance
+    return {"frequency_hz": float(f), "growth": float(np.nanmax(E) / np.nanmin(E)), "mode": j + 1,
+            "mode_frequency_hz": float(split.frequencies[j]), "share": float(split.shares[j]),
+            "ratio": float(split.frequencies[j] / f)}
 
 
 #: Most orbits of an arc whose Floquet multipliers are computed for the summary (evenly sampled beyond).
@@ -149,8 +173,9 @@ def model_summary(mesh: Mesh, model: FEModel, f_fe: np.ndarray, source: str) -> 
 
 
 def contact_summary(contact: Contact, model: FEModel) -> dict:
-    """Contact node, its position, the casing normal and the clearance."""
+    """Contact node, its position, the casing normal, the clearance and the casing's stiffness (None: rigid)."""
     return {"node": contact.node, "face_nodes": list(contact.nodes),
+            "casing_stiffness_n_per_m": None if np.isinf(contact.casing) else contact.casing,
             "face_weights": "area" if contact.weights else "equal",
             "position": model.mesh.points[contact.node].tolist(),
             "normal": contact.normal_for(model).tolist(), "clearance_m": contact.gap}
