@@ -31,7 +31,7 @@ def two_dof(k2: float, casing: float = float("inf")):
 def test_series_law_and_the_bilinear_closed_form():
     """k2 = 3 against a casing of 6 is the bilinear oscillator with k2 = 2: the same branch, to 1e-10."""
     s = two_dof(3.0, 6.0)
-    assert s.kc == pytest.approx(2.0, rel=1e-15) and s.casing == 6.0
+    assert s.kc == pytest.approx(2.0, rel=1e-15) and s.casing == 6.0 and s.kc_structure == pytest.approx(3.0, rel=1e-14)
     assert repr(s) == "MasslessSystem(n=1, gap=1, kc=2, casing=6)"
     assert two_dof(3.0).kc == 3.0 and series_stiffness(3.0, float("inf")) == 3.0
     orbits = follow_from_grazing(s, T_min=np.pi + np.pi / np.sqrt(3.0) + 0.1, ds=0.02)

@@ -159,6 +159,11 @@ class MasslessSystem:
         """``P = Φ_cᵀ M Φ_o`` (orthogonal): closed-phase modal coordinates of the open-phase modes."""
         return self.closed.phi.T @ self.M @ self.open.phi
 
+    @property
+    def kc_structure(self) -> float:
+        """The contact dofs' own stiffness ``1 / (w_cᵀ K_cc⁻¹ w_c)``, without the casing (``kc`` when it is rigid)."""
+        return self.kc if np.isinf(self.casing) else 1.0 / (1.0 / self.kc - 1.0 / self.casing)
+
     def energy(self, x, v) -> float:
         """Total energy (kinetic + strain, the contact dofs' strain included)."""
         x, v = np.asarray(x, float), np.asarray(v, float)

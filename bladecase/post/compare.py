@@ -197,7 +197,7 @@ def contact_spectrum(source, *, kc: float | None = None) -> ContactSpectrum:
         return ContactSpectrum(source.omega, np.asarray(source.b) ** 2, "newton", source.impact_mass,
                                source.static_compliance)
     if isinstance(source, MasslessSystem):
-        source, kc = source.spectrum, source.kc
+        source, kc = source.spectrum, source.kc_structure  # the structure's: the casing is not the blade's
     elif isinstance(source, LinearSystem):
         source = source.spectrum
     if not isinstance(source, Spectrum):
