@@ -133,3 +133,24 @@ def test_reduced_model_file_keeps_the_casing(plate, tmp_path):
     rigid = bc.reduce(model, face, "massless", 6)
     save_reduced(rigid, tmp_path / "rigid.npz")
     assert np.isinf(load_reduced(tmp_path / "rigid.npz").system.casing)
+
+
+def test_a_family_ending_in_an_internal_resonance_is_named():
+    """The bar (n = 20) against a casing of 1: the energy of its first mode grows ~1e7-fold towards f = 0.2735, where
+    99.9 % of it sits in mode 5 (2.184, 7.98 × the orbit's frequency): the 8:1 resonance, named in the report. The
+    bilinear oscillator's energy also grows without bound (towards its high-energy limit), but in its own mode:
+    no resonance."""
+    from bladecase.post.report import _resonance_words
+    from bladecase.study.documents import family_summary
+
+    s = bc.bar(20, 0.5, casing=1.0)
+    T1 = 2 * np.pi / s.open.omega[0]
+    (fam,) = bc.nonsmooth_mode(s, 1, (0.85 * T1, 1.001 * T1))
+    res = family_summary(fam)["resonance"]
+    assert res["mode"] == 5 and res["ratio"] == pytest.approx(7.98, abs=0.02) and res["share"] > 0.99
+    assert res["growth"] > 1e6 and res["frequency_hz"] == pytest.approx(0.2735, abs=1e-3)
+    words = _resonance_words(0, family_summary(fam), [])
+    assert "ends in an internal resonance" in words and "mode 5" in words and "the 8:1 resonance" in words
+    s2 = two_dof(3.0, 6.0)
+    (fam2,) = bc.nonsmooth_mode(s2, 1, (np.pi + np.pi / np.sqrt(3.0) + 0.05, 2 * np.pi + 0.01))
+    assert family_summary(fam2)["resonance"] is None
