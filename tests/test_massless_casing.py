@@ -154,3 +154,12 @@ def test_a_family_ending_in_an_internal_resonance_is_named():
     s2 = two_dof(3.0, 6.0)
     (fam2,) = bc.nonsmooth_mode(s2, 1, (np.pi + np.pi / np.sqrt(3.0) + 0.05, 2 * np.pi + 0.01))
     assert family_summary(fam2)["resonance"] is None
+
+
+def test_the_animation_says_contact_for_the_massless_model_and_impact_for_newton():
+    from bladecase.post.outputs.animation import _massless
+
+    s = two_dof(3.0, 6.0)
+    (fam,) = bc.nonsmooth_mode(s, 1, (5.0, 2 * np.pi + 0.01))
+    assert _massless(fam.orbits[1])
+    assert not _massless(bc.orbit_1ipp(bc.chain(2, k=1.0, m=0.5, gap=1.0), 6.0))

@@ -83,6 +83,7 @@ def animate(
     title: str = "",
     window_size: tuple[int, int] = (800, 600),
     fps: float = 20.0,
+    contact_label: str = "IMPACT",
 ) -> dict[str, Path]:
     """Render the blade over one period of an impact orbit to a looping GIF (and an MP4).
 
@@ -91,7 +92,7 @@ def animate(
     undeformed outline, the contact node, and the casing: the plane normal to
     ``normal`` through ``points[contact_node] + scale * gap * normal`` (drawn
     at the same scale, so the contact node touches it exactly at impact); it
-    turns red, with the word IMPACT, on the impact frames.  Text gives the
+    turns red, with the word ``contact_label`` (IMPACT), on the impact frames.  Text gives the
     title, frame number, ``t/T``, ``T``, ``f`` and the scale.  The camera is
     fixed and frames every warped position.
 
@@ -130,6 +131,9 @@ def animate(
         Pixel size of every frame.
     fps : float
         Frames per second.
+    contact_label : str
+        The word shown on the frames of ``impact_frames``: ``"IMPACT"`` (Newton's law), ``"CONTACT"`` for the
+        frames inside a contact phase of the massless model.
 
     Returns
     -------
@@ -166,7 +170,7 @@ def animate(
         f"displacements \u00d7 {scale:.4g} (casing at clearance {_length(gap)}, same scale)",
     ]
     frames = _render(pts, mesh, dim, u3, scale, warped, umax, corners, contact_node, impact, times / period, title,
-                     texts, window_size, size, bounds, normal, e1)
+                     texts, window_size, size, bounds, normal, e1, contact_label)
     out = {"gif": Path(gif)}
     with atomic_path(gif) as tmp:
         _write_gif(tmp, frames, impact, fps)
@@ -282,7 +286,7 @@ def _surface(pts: np.ndarray, mesh: Mesh, dim: int, u3: np.ndarray):
 
 
 def _render(pts, mesh, dim, u3, scale, warped, umax, corners, contact_node, impact, phase, title, texts,
-            window_size, size, bounds, normal, e1):
+            window_size, size, bounds, normal, e1, contact_label="IMPACT"):
     """The ``(F, h, w, 3)`` uint8 frames, rendered with one plotter whose actors are updated in place."""
     if not os.environ.get("DISPLAY"):  # headless: go straight to EGL rather than failing over from X11 noisily
         os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
@@ -312,7 +316,7 @@ def _render(pts, mesh, dim, u3, scale, warped, umax, corners, contact_node, impa
         pl.add_mesh(marker, color="magenta", lighting=False)
         pl.add_text(title, position="upper_left", font_size=11)
         clock = pl.add_text("", position="lower_left", font_size=8)
-        hit = pl.add_text("IMPACT", position="upper_right", font_size=12, color="red")
+        hit = pl.add_text(str(contact_label), position="upper_right", font_size=12, color="red")
         _camera(pl, dim, normal, e1, bounds)
         frames = []
         for i in range(nframes):

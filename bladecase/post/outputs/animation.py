@@ -23,7 +23,13 @@ def write(scene: OrbitScene, folder: Path, formats: set[str]) -> dict[str, str]:
                               contact_node=scene.contact_node, normal=scene.normal, gap=scene.gap,
                               scale=scene.scale, gif=folder / "animations" / f"{scene.stem}.gif",
                               mp4=folder / "animations" / f"{scene.stem}.mp4" if want_mp4 else None,
-                              title=scene.title, window_size=tuple(o["window"]), fps=o["fps"])
+                              title=scene.title, window_size=tuple(o["window"]), fps=o["fps"],
+                              contact_label="CONTACT" if _massless(scene.orbit) else "IMPACT")
     if "gif" not in formats:
         paths.pop("gif").unlink()
     return {k: f"animations/{p.name}" for k, p in paths.items()}
+
+
+def _massless(orbit) -> bool:
+    """An orbit of the massless contact model (contact phases, not impacts)."""
+    return getattr(getattr(orbit, "system", None), "contact_model", "newton") == "massless"
