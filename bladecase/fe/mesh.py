@@ -126,7 +126,8 @@ def load_mesh(path: str | os.PathLike, require: Sequence[str] = ()) -> Mesh:
     Parameters
     ----------
     path : path-like
-        ``.msh`` (gmsh 2.2/4.1), ``.vtu``/``.vtk``, ``.inp`` (Abaqus), ``.med``, …
+        ``.msh`` (gmsh 2.2/4.1), ``.vtu``/``.vtk``, ``.inp`` (Abaqus), ``.med``, ``.bdf`` (Nastran), ``.cdb``
+        (ANSYS archive, :mod:`bladecase.fe.cdb`: node and element components become groups), …
     require : sequence of str
         Group names that must exist and be non-empty (e.g. ``("root", "tip")``).
 
@@ -197,13 +198,17 @@ def _read_quietly(meshio, path, file_format):
             return meshio.read(path, file_format=file_format), None
     except (Exception, SystemExit) as exc:  # meshio raises ReadError, KeyError, …, or exits
         said = " ".join(out.getvalue().split())
-        text = "" if isinstance(exc, SystemExit) else f"{type(exc).__name__}: {exc}".rstrip(": ")
+        from .cdb import CdbError
+
+        text = ("" if isinstance(exc, SystemExit) else str(exc) if isinstance(exc, CdbError)  # names file and line
+                else f"{type(exc).__name__}: {exc}".rstrip(": "))
         return None, " ".join(filter(None, [text, said])) or type(exc).__name__
 
 
 def _register_types() -> None:
-    """Teach meshio's Abaqus reader the types it lacks, and meshio 5.3 the dimension of the 15/18-node wedges
-    (its gmsh reader fails on them without it); never overrides an entry."""
+    """Teach meshio's Abaqus reader the types it lacks, meshio 5.3 the dimension of the 15/18-node wedges (its gmsh
+    reader fails on them without it) and the ANSYS archive format (``.cdb``, :mod:`bladecase.fe.cdb`); never
+    overrides an entry."""
     from meshio import _mesh
     from meshio.abaqus import _abaqus
 
@@ -211,6 +216,9 @@ def _register_types() -> None:
         _abaqus.abaqus_to_meshio_type.setdefault(key, value)
     for key in ("wedge15", "wedge18"):
         _mesh.topological_dimension.setdefault(key, 3)
+    from .cdb import register
+
+    register()  # ANSYS archives (.cdb), which meshio does not read
 
 
 def from_meshio(m, source: str = "", require: Sequence[str] = ()) -> Mesh:
