@@ -10,7 +10,8 @@ hex8 (1st order) 20×2×2: +19.8 %, 40×4×4: +5.4 %; hex20 10×1×1: +1.02 %; h
 hex8 mesh with serendipity order 2, 20×2×2: +0.30 % (vs Euler–Bernoulli, whose own shear/rotary-inertia
 error here is −0.20 %); stubby hex20 10×2×2: +1.37 % vs Timoshenko (+1.02 % at 20×4×4: the 3-D root,
 which blocks the Poisson contraction, stiffens it), −1.65 % vs Euler–Bernoulli; wedges (2 per hexahedron,
-order 1) 20×2×2: +19.5 %, 40×4×4: +5.5 %; P2 tetrahedra (6 per hexahedron) 20×2×2: +0.36 % (hex +0.30 %);
+order 1) 20×2×2: +19.5 %, 40×4×4: +5.5 % (order 2, 15-node
+serendipity: +0.32 % at 20×2×2, tests/test_wedge2.py); P2 tetrahedra (6 per hexahedron) 20×2×2: +0.36 % (hex +0.30 %);
 plane-stress strip: quad 20×2: +18.7 %, 80×8: +1.16 %; quad8 10×1: +0.39 %; quad9 10×1: +0.10 %.
 """
 
@@ -22,7 +23,7 @@ from scipy.optimize import brentq
 
 from bladecase import log
 from bladecase.fe import Material, assemble, load_mesh, natural_frequencies, node_operator, save_mesh
-from bladecase.fe.cells import GMSH_WEDGE18, KINDS
+from bladecase.fe.cells import GMSH_WEDGE18, KINDS, element_name
 from bladecase.fe.mesh import from_meshio
 from bladecase.fe.quality import corner_jacobians
 
@@ -281,10 +282,14 @@ def test_mixed_body_types_are_refused_with_counts():
         from_meshio(meshio.Mesh(hexa.points, [hexa.cells[0], ("pyramid", np.array([[0, 1, 2, 3, 4]]))]))
 
 
-def test_wedges_have_order_one_only_and_dropped_cells_are_logged():
+def test_wedges_take_order_two_and_dropped_cells_are_logged():
+    """Wedges were order 1 only (scikit-fem has no quadratic wedge); bladecase's ElementWedgeS2 now gives order 2:
+    3 dofs per vertex and per edge (tests/test_wedge2.py checks it)."""
     mesh = from_meshio(split(hex_beam(0.02, 0.01, (2, 1, 1)), WEDGES))
-    with pytest.raises(ValueError, match=r"order 2 is not available for wedge cells.*valid: order=1"):
-        assemble(mesh, STEEL, order=2, clamp=ROOT)
+    p1, p2 = (assemble(mesh, STEEL, order=o, clamp=ROOT) for o in (1, 2))
+    assert p1.n_dofs == 3 * 8 and p2.n_dofs == 3 * (8 + 20)  # free: 8 vertices, 20 of the 24 edges (4 on the root)
+    with pytest.raises(ValueError, match=r"order 3 is not available for wedge cells.*valid: order=1 or 2"):
+        element_name("wedge", 3)
     hexa = hex_beam(0.02, 0.01, (2, 1, 1))
     with log.transcript() as lines:
         from_meshio(meshio.Mesh(hexa.points, [hexa.cells[0], ("polygon", np.array([[0, 1, 2, 3, 4]]))]), source="p")
@@ -327,7 +332,7 @@ def test_hex27_cannot_be_written_for_abaqus(tmp_path):
 
 
 @pytest.mark.parametrize("btype, order, parts", [("hexahedron", 1, None), ("hexahedron20", 2, None),
-                                                 ("wedge", 1, WEDGES)])
+                                                 ("wedge", 1, WEDGES), ("wedge", 2, WEDGES)])
 def test_hex_and_wedge_models_are_drawn_on_their_corner_nodes(tmp_path, btype, order, parts):
     """fe_grid/nodal_field draw hexahedra and wedges on their vertices (the vertex dofs come first); a mode shape
     written to VTK reads back with the cell type and the field of the model."""

@@ -12,12 +12,17 @@ The discretisation is scikit-fem's: the mesh's vertices make a
 trilinear or prismatic cells; the extra nodes of second-order cells are not used),
 the scalar element of :data:`~bladecase.fe.cells.SKFEM_ELEMENTS` (``ElementTetP1/P2``,
 ``ElementTriP1/P2``, ``ElementHex1``, ``ElementHexS2`` — ``ElementHex2`` on 27-node
-meshes —, ``ElementWedge1``, ``ElementQuad1``, ``ElementQuadS2`` — ``ElementQuad2`` on
-9-node meshes) gives the basis functions, ``skfem.models.elasticity.lame_parameters``
-the Lamé constants.  Simplices use scikit-fem's default quadrature; hexahedra and
+meshes —, ``ElementWedge1``, ``ElementWedgeS2`` — ``ElementWedge2`` on 18-node meshes —,
+``ElementQuad1``, ``ElementQuadS2`` — ``ElementQuad2`` on 9-node meshes) gives the basis
+functions (the second-order wedges are :mod:`~bladecase.fe.wedge_element`'s: scikit-fem has
+none), ``skfem.models.elasticity.lame_parameters`` the Lamé constants.  Every scalar dof sits
+at a vertex, an edge midpoint or a face (cell) centre of the straight cell
+(``DofMap.coords``); :func:`~bladecase.fe.node_operator` finds there the extra nodes of
+quadratic mesh cells.  Simplices use scikit-fem's default quadrature; hexahedra and
 quadrilaterals the ``(p+1)``-point Gauss rule per direction (exact mass and stiffness
-on parallelepipeds), wedges a triangle × line product rule built here (scikit-fem
-12.0's wedge rule does not integrate the reference prism: weights summing to 1/4, not 1/2).
+on parallelepipeds), wedges a triangle × line product rule of degree ``2p+1`` in each
+built here (exact on right prisms; scikit-fem 12.0's wedge rule does not integrate the
+reference prism: weights summing to 1/4, not 1/2).
 The weak forms are those of ``skfem.models.elasticity.linear_elasticity``
 (``σ(u):ε(v)``) and of the mass ``ρ u·v`` on
 ``ElementVector(ElementTetP1/P2)``; they are integrated here by one batched
@@ -43,6 +48,7 @@ from skfem import CellBasis, ElementTetP1, ElementTetP2, ElementTriP1, ElementTr
 from skfem.quadrature import get_quadrature_line, get_quadrature_tri
 
 from ..checks import positive
+from . import wedge_element
 from .cells import KINDS, SKFEM_MESHES, element_name
 from .eigen import natural_frequencies
 from .material import AL6061T6, ALUMINIUM, INCONEL718, PLANE_KINDS, PRESETS, STEEL, TI6AL4V, Material
@@ -112,8 +118,8 @@ def assemble(
         Element order: 2 (default; P2, serendipity or full quadratic
         hexahedra and quadrilaterals, accurate in bending) or 1 (P1,
         trilinear, bilinear, prismatic: they lock in bending and need fine
-        meshes).  Wedges have order 1 only (scikit-fem has no second-order
-        wedge).
+        meshes).  Wedges: 15-node serendipity at order 2 (18-node Lagrange
+        on ``wedge18`` meshes).
     mass : {"consistent", "lumped"}
         Consistent mass, or lumped: row sum for P1, HRZ (diagonal scaled to
         the element mass, Hinton–Rock–Zienkiewicz 1976) for P2.  Both keep the
@@ -237,15 +243,22 @@ def _basis(mesh: Mesh, points: np.ndarray, dim: int, order: int):
         fe_mesh = getattr(skfem, SKFEM_MESHES[kind.family])(np.ascontiguousarray(points[used, :dim].T),
                                                            np.ascontiguousarray(local.T))
         return CellBasis(fe_mesh, _ELEMENTS[dim, order]()), fe_mesh, used
-    element = getattr(skfem, element_name(body_type, order))()
+    element = _element(element_name(body_type, order))
     t = np.ascontiguousarray(local[:, list(kind.skfem_corners)].T)
     fe_mesh = getattr(skfem, SKFEM_MESHES[kind.family])(np.ascontiguousarray(points[used, :dim].T), t)
     if kind.family == "wedge":
         X, W = get_quadrature_tri(2 * order + 1)
         Z, V = get_quadrature_line(2 * order + 1)
         quadrature = (np.vstack([np.tile(X, Z.shape[1]), np.repeat(Z, X.shape[1], axis=1)]), np.outer(V, W).ravel())
-        return CellBasis(fe_mesh, element, quadrature=quadrature), fe_mesh, used
+        dofs = wedge_element.WedgeFaceDofs(fe_mesh, element) if isinstance(element, wedge_element.ElementWedge2) \
+            else None
+        return CellBasis(fe_mesh, element, quadrature=quadrature, dofs=dofs), fe_mesh, used
     return CellBasis(fe_mesh, element, intorder=2 * order + 1), fe_mesh, used
+
+
+def _element(name: str) -> skfem.element.Element:
+    """An instance of the element called ``name``: bladecase's wedges, else scikit-fem's."""
+    return (getattr(wedge_element, name, None) or getattr(skfem, name))()
 
 
 def _clamped_dofs(basis: CellBasis, fe_mesh, vertex_clamped: np.ndarray) -> np.ndarray:
@@ -253,7 +266,7 @@ def _clamped_dofs(basis: CellBasis, fe_mesh, vertex_clamped: np.ndarray) -> np.n
     clamped = np.zeros(basis.N, dtype=bool)
     clamped[basis.nodal_dofs[0]] = vertex_clamped
     elem = basis.elem
-    entities = [("facet_dofs", fe_mesh.facets)]
+    entities = [("facet_dofs", fe_mesh.facets[:, getattr(basis.dofs, "facet_index", slice(None))])]
     if fe_mesh.dim() == 3:
         entities.insert(0, ("edge_dofs", fe_mesh.edges))
     for name, ends in entities:

@@ -7,7 +7,8 @@ VTK order).  From the parents follow the midside-node checks, the order-1 interp
 (:func:`bladecase.fe.node_operator`) and the node permutation that reverses a cell (:attr:`CellKind.flip`).
 
 The assembly uses the corners only (straight-sided, trilinear or prismatic cells) with the scikit-fem
-element of :data:`SKFEM_ELEMENTS`; :attr:`CellKind.skfem_corners` reorders meshio's corners to the
+element of :data:`SKFEM_ELEMENTS` (the second-order wedges are bladecase's own,
+:mod:`~bladecase.fe.wedge_element`); :attr:`CellKind.skfem_corners` reorders meshio's corners to the
 numbering of ``skfem.MeshHex1`` (``skfem.io.meshio.HEX_MAPPING``), the other families need no reordering.
 
 >>> KINDS["hexahedron20"].family, KINDS["hexahedron20"].corners, KINDS["hexahedron20"].parents[16]
@@ -124,15 +125,16 @@ BODY_TYPES = {d: tuple(n for n, k in KINDS.items() if k.dim == d) for d in (2, 3
 #: Boundary (lower-dimensional) cell types kept with a body, by dimension.
 BOUNDARY_TYPES = {0: ("vertex",), 1: ("line", "line3"), 2: ("triangle", "triangle6", "quad", "quad8", "quad9")}
 
-#: scikit-fem element names by (family, element order, mesh body type or None): the 27-node hexahedron and
-#: 9-node quadrilateral meshes get the full quadratic elements, other meshes the serendipity ones.  There is
-#: no second-order wedge in scikit-fem.
+#: scikit-fem element names by family or mesh body type, and element order: the 27-node hexahedron, 18-node
+#: wedge and 9-node quadrilateral meshes get the full quadratic elements, other meshes the serendipity ones.
+#: scikit-fem has no second-order wedge: ``ElementWedgeS2`` (15 nodes) and ``ElementWedge2`` (18 nodes) are
+#: :mod:`bladecase.fe.wedge_element`'s.
 SKFEM_ELEMENTS = {
     ("tetra", 1): "ElementTetP1", ("tetra", 2): "ElementTetP2",
     ("triangle", 1): "ElementTriP1", ("triangle", 2): "ElementTriP2",
     ("hexahedron", 1): "ElementHex1", ("hexahedron", 2): "ElementHexS2", ("hexahedron27", 2): "ElementHex2",
     ("quad", 1): "ElementQuad1", ("quad", 2): "ElementQuadS2", ("quad9", 2): "ElementQuad2",
-    ("wedge", 1): "ElementWedge1",
+    ("wedge", 1): "ElementWedge1", ("wedge", 2): "ElementWedgeS2", ("wedge18", 2): "ElementWedge2",
 }
 #: scikit-fem mesh class names by family.
 SKFEM_MESHES = {"tetra": "MeshTet1", "triangle": "MeshTri1", "hexahedron": "MeshHex1", "quad": "MeshQuad1",
@@ -143,13 +145,17 @@ GMSH_WEDGE18 = (0, 1, 2, 3, 4, 5, 6, 9, 7, 12, 14, 13, 8, 10, 11, 15, 17, 16)
 
 
 def element_name(body_type: str, order: int) -> str:
-    """The scikit-fem element used for ``body_type`` cells at Lagrange ``order``; ``ValueError`` if none."""
+    """The scikit-fem element used for ``body_type`` cells at Lagrange ``order``; ``ValueError`` if none.
+
+    >>> element_name("wedge15", 2), element_name("wedge18", 2), element_name("hexahedron27", 2)
+    ('ElementWedgeS2', 'ElementWedge2', 'ElementHex2')
+    """
     family = KINDS[body_type].family
     name = SKFEM_ELEMENTS.get((body_type, order)) or SKFEM_ELEMENTS.get((family, order))
     if name is None:
         have = sorted(o for f, o in SKFEM_ELEMENTS if f == family)
-        raise ValueError(f"order {order} is not available for {body_type} cells: scikit-fem has no second-order "
-                         f"{family} element; valid: order={' or '.join(map(str, have))} (or a tetra/hexahedron mesh)")
+        raise ValueError(f"order {order} is not available for {body_type} cells (no order-{order} {family} "
+                         f"element); valid: order={' or '.join(map(str, have))}")
     return name
 
 
