@@ -284,6 +284,7 @@ def blade_mesh(
     tip_size: float | None = None,
     order: int = 1,
     path: str | os.PathLike | None = None,
+    cells: str = "simplex",
 ) -> Mesh:
     """Mesh a blade with gmsh; write the ``.msh`` if ``path`` is given; return the mesh.
 
@@ -302,6 +303,13 @@ def blade_mesh(
     path : path-like or None
         Where to write the mesh (gmsh MSH 4.1, binary, suffix ``.msh``),
         atomically.
+    cells : {"simplex", "hexahedron"}
+        ``"hexahedron"``: every tetrahedron (triangle) of the mesh split into
+        four hexahedra (three quadrilaterals) by gmsh
+        (``Mesh.SubdivisionAlgorithm``), order 1 only, so the mesh has about
+        four times the cells; the hexahedra are checked like any mesh's, and
+        at coarse sizes on thin curved blades a few come out folded, which is
+        refused (try a smaller ``size``).
 
     Returns
     -------
@@ -350,6 +358,11 @@ def blade_mesh(
         raise ValueError(f"tip_size = {tip_size!r} must not exceed size = {size!r} (it refines the tip)")
     if isinstance(order, bool) or order not in (1, 2):
         raise ValueError(f"order must be 1 or 2, got {order!r}")
+    if cells not in ("simplex", "hexahedron"):
+        raise ValueError(f"cells must be 'simplex' or 'hexahedron', got {cells!r}")
+    if cells == "hexahedron" and order != 1:
+        raise ValueError(f"cells = 'hexahedron' makes order-1 cells (order=1), got order={order!r}; the FE order is "
+                         "chosen when assembling (assemble(mesh, ..., order=2))")
     if path is not None and Path(path).suffix.lower() != ".msh":
         raise ValueError(
             f"blade_mesh writes gmsh .msh files, got path {str(path)!r}; "
@@ -368,6 +381,7 @@ def blade_mesh(
         "Mesh.MshFileVersion": 4.1,
         "Mesh.Binary": 1,  # exact coordinates (ASCII MSH keeps 16 digits only)
         "Mesh.SaveAll": 0,
+        "Mesh.SubdivisionAlgorithm": 0 if cells == "simplex" else dim - 1,  # 2: all hexahedra, 1: all quads
     }
     target_cm = _scratch_path() if path is None else atomic_path(path)
     with target_cm as target:
