@@ -6,7 +6,9 @@ element components), HexBeam185.cdb (the same 1 × 1 × 5 beam with 40 SOLID185 
 out), all_solid_cells.cdb (degenerate SOLID186 forms, a pyramid among them). Checked: counts and component sizes
 (the ranges expanded), the cantilever's first frequency against Timoshenko (+1.37 % ± 0.3 %, the figure of the
 same 10 × 2 × 2 hex20 discretisation in test_fe_elements.py), the SOLID185 and SOLID186 archives and the .vtu
-round trip giving the same frequency (1e-9), degenerate bricks in VTK order, and errors naming file and line.
+round trip giving the same frequency (1e-9), a hand-written SOLID186 cantilever with ROOT/TIP components
+(clamp="ROOT", Euler–Bernoulli +1.02 %, .vtu identical), degenerate bricks and PLANE183 in VTK order, and errors
+naming file and line.
 """
 
 from __future__ import annotations
@@ -15,7 +17,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_fe_elements import STEEL, timoshenko
+from test_fe_elements import STEEL, euler_bernoulli, hex_beam, timoshenko
+from test_fe_elements import first_frequency as beam_frequency
 
 import bladecase as bc
 from bladecase.fe import load_mesh, natural_frequencies, save_mesh
@@ -62,6 +65,8 @@ def test_workbench_archive_with_surface_elements(caplog):
         raw = read_cdb(DATA / "ErnoRadiation.cdb")
         m = load_mesh(DATA / "ErnoRadiation.cdb")
     assert raw.field_data["ansys:types"] == {"70": 27, "152": 9}
+    # pymapdl-reader's own test_rlblock_prior_to_nblock: n_node == 65, n_elem == 36
+    assert len(raw.points) == 65 and sum(raw.field_data["ansys:types"].values()) == 36
     assert "left out 9 element(s) of type 152" in caplog.text
     assert m.body_type == "hexahedron" and len(m.cells["hexahedron"]) == 27 and len(m.points) == 65
     assert m.points[27].tolist() == [0.0, 0.0, 0.0]  # node 28: "0.0E+000" alone, y and z left out
@@ -138,3 +143,49 @@ def test_bad_archives_are_named_with_their_line(tmp_path, text, message):
     with pytest.raises(ValueError, match=message) as err:
         load_mesh(path)
     assert "bad.cdb" in str(err.value)
+
+
+def cmblock(name: str, kind: str, entries) -> str:
+    """A CMBLOCK in ANSYS's (8i10) layout; ``entries`` as ANSYS writes them (a negative number closes a range)."""
+    rows = [entries[k:k + 8] for k in range(0, len(entries), 8)]
+    return (f"CMBLOCK,{name},{kind},{len(entries):8d}\n(8i10)\n"
+            + "".join("".join(f"{v:10d}" for v in row) + "\n" for row in rows))
+
+
+def test_hand_written_solid186_cantilever_clamped_by_its_root_component(tmp_path):
+    """A 10 × 1 × 1 SOLID186 cantilever (L/h = 20) with a ROOT and a TIP node component given as ranges and a
+    TIPEL element component: clamp="ROOT" by name, f1 against Euler–Bernoulli (+1.02 % ± 0.2 %, inside the 0…1.25 %
+    band of this hex20 discretisation in test_fe_elements.py, and equal to the same mesh built there) and identical
+    to the same mesh written as .vtu."""
+    L, h = 0.1, 0.005
+    beam = hex_beam(L, h, (10, 1, 1), "hexahedron20")  # VTK order, which is ANSYS's I…P, Q…T, U…X, Y…B
+    x = beam.points[:, 0]
+    root, tip = np.flatnonzero(x == 0) + 1, np.flatnonzero(np.isclose(x, L)) + 1
+    assert np.all(np.diff(root) == 1) and np.all(np.diff(tip) == 1)  # contiguous: written as ranges
+    last = int(np.argmax(beam.points[beam.cells[0].data].mean(axis=1)[:, 0])) + 1
+    path = archive(tmp_path, 186, beam.points, beam.cells[0].data + 1, "cantilever.cdb")
+    path.write_text(path.read_text() + cmblock("ROOT", "NODE", [root[0], -root[-1]])
+                    + cmblock("TIP", "NODE", [tip[0], -tip[-1]]) + cmblock("TIPEL", "ELEM", [last]))
+    m = load_mesh(path, require=("ROOT", "TIP", "TIPEL"))
+    assert m.body_type == "hexahedron20" and m.cells["hexahedron20"].tolist() == beam.cells[0].data.tolist()
+    assert len(m.group("ROOT")) == len(root) == 8 and np.all(m.points[m.group("TIP"), 0] == pytest.approx(L))
+    assert len(m.group("TIPEL")) == 20 and set(m.group("TIP")) < set(m.group("TIPEL"))
+    f = natural_frequencies(bc.assemble(m, STEEL, order=2, clamp="ROOT"), 3)
+    assert f[0] / euler_bernoulli(L, h) - 1 == pytest.approx(0.0102, abs=0.002)
+    assert f[0] == pytest.approx(beam_frequency(beam, 2), rel=1e-9)  # = the mesh built in numpy, plane-clamped
+    assert f[1] == pytest.approx(f[0], rel=1e-6)  # square section: the two bending modes coincide
+    save_mesh(m, tmp_path / "cantilever.vtu")
+    back = load_mesh(tmp_path / "cantilever.vtu", require=("ROOT", "TIP"))
+    np.testing.assert_allclose(natural_frequencies(bc.assemble(back, STEEL, order=2, clamp="ROOT"), 3), f,
+                               rtol=1e-12)
+
+
+def test_plane183_quadrilaterals_and_their_triangles(tmp_path):
+    """PLANE183 I J K L M N O P (corners, then mid-edges IJ JK KL LI): an 8-node quadrilateral as it is; with
+    K = L = O the 6-node triangle I J K with mid-edges M, N, P."""
+    square = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0.5, 0, 0), (1, 0.5, 0), (0.5, 1, 0), (0, 0.5, 0)]
+    m = load_mesh(archive(tmp_path, 183, square, [range(1, 9)]))
+    assert m.dim == 2 and m.body_type == "quad8" and m.cells["quad8"].tolist() == [list(range(8))]
+    tri = [(0, 0, 0), (1, 0, 0), (0, 1, 0), (0.5, 0, 0), (0.5, 0.5, 0), (0, 0.5, 0)]
+    m = read_cdb(archive(tmp_path, 183, tri, [(1, 2, 3, 3, 4, 5, 3, 6)], "t.cdb"))
+    assert m.cells[0].type == "triangle6" and m.cells[0].data.tolist() == [[0, 1, 2, 3, 4, 5]]
