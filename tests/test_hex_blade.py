@@ -36,3 +36,18 @@ def test_plate_quadrilaterals_and_bad_requests():
         blade_mesh(plate, size=0.004, cells="prism")
     with pytest.raises(ValueError, match="makes order-1 cells"):
         blade_mesh(plate, size=0.004, order=2, cells="hexahedron")
+
+
+def test_study_key_geometry_cells(tmp_path):
+    from bladecase.study import stages
+    from bladecase.study.schema import StudyError, validate
+
+    raw = {"geometry": {"kind": "plate", "span": 0.1, "chord": 0.02, "size": 0.004, "cells": "hexahedron"},
+           "contact": {"clearance": 1e-4, "face": "tip"}}
+    assert stages.build_mesh(validate(raw)).body_type == "quad"
+    raw["geometry"]["mesh_order"] = 2
+    with pytest.raises(StudyError, match=r"\[geometry\] cells = 'hexahedron' makes order-1 cells"):
+        stages.build_mesh(validate(raw))
+    raw["geometry"]["cells"] = "prism"
+    with pytest.raises(StudyError, match=r"\[geometry\] cells: must be one of 'simplex', 'hexahedron'"):
+        validate(raw)

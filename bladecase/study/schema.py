@@ -77,6 +77,8 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "size": Key(_NUM, None, "Target element size (m); default: the geometry's own default.", _positive),
         "tip_size": Key(_NUM, None, "Element size at the tip (m, <= size); default: uniform.", _positive),
         "mesh_order": Key(_INT, 1, "Geometric order of the gmsh mesh (1 or 2).", _one_of(1, 2)),
+        "cells": Key(_STR, "simplex", "'simplex' (tetrahedra, triangles) or 'hexahedron' (gmsh splits each into "
+                     "hexahedra / quadrilaterals; mesh_order 1).", _one_of("simplex", "hexahedron")),
     },
     "mesh": {
         "path": Key(_STR, REQUIRED, "Mesh file (any meshio format with named groups), relative to the study file."),

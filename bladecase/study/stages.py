@@ -35,7 +35,7 @@ def build_mesh(study: Study, path: str | os.PathLike | None = None) -> Mesh:
         g = study["geometry"]
         try:
             mesh = blade_mesh(study.geometry(), size=g["size"], tip_size=g["tip_size"], order=g["mesh_order"],
-                              path=path)
+                              path=path, cells=g["cells"])
         except ValueError as exc:
             raise StudyError(f"[geometry] {exc}") from None
     else:
