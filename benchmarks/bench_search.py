@@ -34,7 +34,11 @@ certification and arc ends (``make_orbits``, ``bisect_ends``), uncertified start
 chain10 2.1 -> 1.6, chain20 7.5 -> 4.2, chain50 20.3 -> 9.6, demo8 2.65 -> 2.1, demo16 19.3 -> 12.5,
 demo32 84 -> 82; the same families and arcs, but for demo16's one arc: its upper end, unrefined either way, is
 a certified orbit 4e-6 T1 further (a near-grazing end, Λ ≈ 4e-6 d, where one fixed-period Newton solve of the
-bisection passes its 1e-9 d residual test only in the stacked evaluation).
+bisection passes its 1e-9 d residual test only in the stacked evaluation).  Then the coverage lookup of all
+crossings of a period at once (the same families and arcs; gain within the machine's noise). Half-angle sines in
+the batched kernel sums (chain50 median 11.5 -> 9.8, demo32 84 -> 78) were not kept: one chain50 family longer
+(0.9276 -> 0.9307 T1, the corrector's 1e-10 residual test at a point whose round-off floor is 6.6e-10) and
+demo32 one family fewer; docs/performance.md has the analysis.
 """
 
 from __future__ import annotations

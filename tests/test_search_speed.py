@@ -195,6 +195,10 @@ def test_make_orbits_is_make_orbit(five_dof, k):
                                atol=1e-14)
     unchecked = make_orbits(five_dof, T, times, lam, certify=False)
     assert not any(o.admissible for o in unchecked) and all(np.isnan(o.max_violation) for o in unchecked)
+    alone = [make_orbit(five_dof, *args, certify=False) for args in zip(T, times, lam)]  # no flight looked at
+    assert not any(o.admissible for o in alone) and all(np.isnan(o.max_violation) for o in alone)
+    assert [o.repeats for o in alone] == [o.repeats for o in one]
+    np.testing.assert_allclose([o.energy for o in alone], [o.energy for o in one], rtol=0, atol=0)
     assert make_orbits(five_dof, [], np.zeros((0, k)), np.zeros((0, k))) == []
 
 
@@ -261,6 +265,36 @@ def test_coverage_lookup_is_the_start_by_start_test(five_dof):
         assert by_lookup == one_by_one
         n_passed += len(by_lookup)
     assert n_passed >= len(traced)  # each family passes at least its own start
+
+
+@pytest.mark.parametrize("k", [2, 3])
+def test_start_index_near_many_is_near_of_each(k):
+    """The lookup of the starts near many interpolated crossings at once: for each crossing, exactly the starts
+    of that period within PASS_GATE·T of it under some re-anchoring (phase_distances over all of them), in the
+    index's order; none missed at the edges of the sorted first-impact ranges."""
+    from types import SimpleNamespace
+
+    from bladecase.nsm.coverage import _StartIndex
+
+    rng = np.random.default_rng(7 + k)
+    T = 10.0
+    refs = np.sort(rng.uniform(0.01, T, (400, k)), axis=1)
+    refs[:, -1] = T
+    starts = [(T, SimpleNamespace(impact_times=r)) for r in refs]
+    index = _StartIndex(starts)
+    guesses = refs[rng.integers(0, len(refs), 60)] + rng.normal(0.0, 0.3, (60, k))
+    guesses[:, -1] = T
+    members, sorted_refs = index.groups[0]
+    got = index.near_many(0, guesses, T)
+    assert len(got) == len(guesses)
+    found = 0
+    for guess, (m, r) in zip(guesses, got):
+        keep = modes.phase_distances(guess, sorted_refs, T) <= modes.PASS_GATE * T
+        assert m.tolist() == members[keep].tolist() and np.array_equal(r, sorted_refs[keep])
+        one = index.near(0, guess, T)
+        assert one[0].tolist() == m.tolist()
+        found += m.size
+    assert found >= len(guesses)  # each guess is near the start it was drawn from (noise 0.3 < gate 0.5)
 
 
 def _reference_search(system, k, T_range, scan):

@@ -41,17 +41,30 @@ class _StartIndex:
     def near(self, g: int, guess: np.ndarray, T: float) -> tuple[np.ndarray, np.ndarray]:
         """The starts of period ``g`` (indices and impact times) within ``PASS_GATE·T`` of the impact times
         ``guess`` under some re-anchoring (:func:`phase_distances`)."""
+        return self.near_many(g, guess[None, :], T)[0]
+
+    def near_many(self, g: int, guesses: np.ndarray, T: float) -> list[tuple[np.ndarray, np.ndarray]]:
+        """:meth:`near` of each row of ``guesses`` ``(C, k)``, all at once (the same arithmetic)."""
         members, refs = self.groups[g]
-        shifted = np.mod(guess[None, :] - guess[:, None], T)
+        C, k = guesses.shape
+        shifted = np.mod(guesses[:, None, :] - guesses[:, :, None], T)  # (C, r, k): re-anchored at impact r
         shifted[shifted == 0] = T
-        first = np.sort(shifted, axis=1)[:, 0]  # each re-anchoring's first impact: within the gate of the start's
+        shifted.sort(axis=2)
+        first = shifted[:, :, 0]  # each re-anchoring's first impact: within the gate of the start's
         pad = PASS_GATE * T * (1 + 1e-9)
-        lo = np.searchsorted(refs[:, 0], first - pad, side="left")
-        hi = np.searchsorted(refs[:, 0], first + pad, side="right")
-        cand = np.unique(np.concatenate([np.arange(a, b) for a, b in zip(lo, hi)]))
+        lo = np.searchsorted(refs[:, 0], first - pad, side="left").ravel()
+        hi = np.searchsorted(refs[:, 0], first + pad, side="right").ravel()
+        width = np.maximum(hi - lo, 0)
+        owner = np.repeat(np.repeat(np.arange(C), k), width)  # (crossing, candidate) pairs, every range
+        cand = np.repeat(lo, width) + np.arange(width.sum()) - np.repeat(np.cumsum(width) - width, width)
+        key = np.unique(owner * len(refs) + cand)
+        owner, cand = key // len(refs), key % len(refs)
         if cand.size:
-            cand = cand[phase_distances(guess, refs[cand], T) <= PASS_GATE * T]
-        return members[cand], refs[cand]
+            dist = np.abs(shifted[owner] - np.sort(refs[cand], axis=1)[:, None, :]).max(axis=2).min(axis=1)
+            keep = dist <= PASS_GATE * T
+            owner, cand = owner[keep], cand[keep]
+        cut = np.searchsorted(owner, np.arange(C + 1))
+        return [(members[cand[a:b]], refs[cand[a:b]]) for a, b in zip(cut[:-1], cut[1:])]
 
 
 def _passed(problem: KippCurve, zs, index: _StartIndex, wanted: np.ndarray) -> list[int]:
@@ -74,15 +87,17 @@ def _crossings(problem: KippCurve, zs, index: _StartIndex, wanted: np.ndarray) -
     if len(zs) < 2:
         return []
     Ts = np.array([problem.period(z) for z in zs])
+    times = np.array([problem.times(z)[1] for z in zs])
     lo, hi = np.minimum(Ts[:-1], Ts[1:]), np.maximum(Ts[:-1], Ts[1:])
     crossings = []
     for g in np.flatnonzero((index.periods >= Ts.min()) & (index.periods <= Ts.max())):
         T_s = float(index.periods[g])
-        for i in np.flatnonzero((lo <= T_s) & (T_s <= hi) & (hi > lo)):
-            a = (T_s - Ts[i]) / (Ts[i + 1] - Ts[i])
-            ta, tb = problem.times(zs[i])[1], problem.times(zs[i + 1])[1]
-            guess = ((1 - a) * ta / Ts[i] + a * tb / Ts[i + 1]) * T_s
-            members, refs = index.near(g, guess, T_s)
+        seg = np.flatnonzero((lo <= T_s) & (T_s <= hi) & (hi > lo))
+        if seg.size == 0:
+            continue
+        a = ((T_s - Ts[seg]) / (Ts[seg + 1] - Ts[seg]))[:, None]
+        guesses = ((1 - a) * times[seg] / Ts[seg, None] + a * times[seg + 1] / Ts[seg + 1, None]) * T_s
+        for guess, (members, refs) in zip(guesses, index.near_many(g, guesses, T_s)):
             open_ = wanted[members]
             if open_.any():  # else no start is left near the interpolated impacts: no need to solve
                 crossings.append((T_s, guess, members[open_], refs[open_]))

@@ -278,15 +278,16 @@ def make_orbit(
     d = system.gap
     q, qd = md.start_state(times, lam)  # energy from the post-impact modal state at t = 0
     energy = 0.5 * float(qd @ qd + (md.omega * q) @ (md.omega * q))
+    if not certify:  # not checked: marked non-admissible, no flight looked at
+        return PeriodicOrbit(system=system, T=T, impact_times=times, impulses=lam, energy=energy, admissible=False,
+                             max_violation=np.nan, max_violation_time=0.0, repeats=repetitions(times, lam, T))
     # Admissibility, flight by flight.
     starts = np.concatenate([[0.0], times[:-1]])
     segments = [_segment_sum(md, T, times, lam, i, d) for i in range(times.size)]
     tols = [max(ADMISSIBILITY_RTOL * d, 1e4 * np.finfo(float).eps * f.magnitude) for f in segments]
     worst, worst_t, certified = 0.0, 0.0, True
     quick = not polish
-    if not certify:
-        worst, certified, segments = np.nan, False, []
-    elif quick and np.any(lam < 0):
+    if quick and np.any(lam < 0):
         certified, segments = False, []
     elif quick and probe is not None:
         i = min(int(np.searchsorted(times, np.mod(probe, T), side="right")), times.size - 1)
