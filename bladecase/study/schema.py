@@ -516,9 +516,10 @@ NEWTON_DEMO = {"contact": {"model": "newton", "face": None, "weights": None, "gr
 
 
 def demo_study(contact_model: str = "massless") -> Study:
-    """The embedded demo study: a twisted, leaned 3-D blade of a few thousand dofs, its tip face rubbing the
-    casing with the massless contact model; ``contact_model="newton"``: the seed paper's variant
-    (:data:`NEWTON_DEMO`: Newton's impact law on the tip node, lanczos-si, 1- and 2-ipp).
+    """The embedded demo study: a twisted, leaned 3-D blade of a few thousand dofs, its tip face rubbing a
+    compliant casing (1e6 N/m) with the massless contact model; ``contact_model="newton"``: the seed paper's
+    variant (:data:`NEWTON_DEMO`: Newton's impact law on the tip node against a rigid casing, lanczos-si, 1- and
+    2-ipp).
 
     >>> study = demo_study()
     >>> blade = study.geometry()
@@ -526,6 +527,8 @@ def demo_study(contact_model: str = "massless") -> Study:
     ('BladeGeometry', '2412', 0.15, 40.0, 0.03, (0.0, 0.03, 0.15))
     >>> study["material"]["preset"], study["fem"]["order"], study["contact"]["face"], study["contact"]["model"]
     ('Ti-6Al-4V', 2, 'tip', 'massless')
+    >>> study["contact"]["casing_stiffness"], demo_study("newton")["contact"]["casing_stiffness"]
+    (1000000.0, None)
     >>> study["search"]["ipp"], study["search"]["periods"], study["output"]["formats"]
     ([1], [0.95, 1.0001], ['gif', 'mp4', 'vtu', 'png'])
     >>> newton = demo_study("newton")
