@@ -31,6 +31,7 @@ import bladecase as bc
 from bladecase.fe import stiffness_factor
 from bladecase.nsm import series_stiffness
 from bladecase.nsm.massless_orbits import orbits_at_period, smoothest
+from bladecase.post.compare_plots import observed_order as observed_order_of
 from bladecase.study import demo_study, stages
 
 GOAL = 0.01
@@ -66,18 +67,13 @@ def rel(a, b) -> float:
 
 
 def observed_order(q, h) -> float:
-    """Order p from three values on meshes of sizes ``h`` (ratios possibly unequal): ``|q3-q2|/|q2-q1|``."""
-    d1, d2 = q[1] - q[0], q[2] - q[1]
-    if not (np.isfinite(d1) and np.isfinite(d2)) or d1 * d2 <= 0 or abs(d2) >= abs(d1):
+    """Order p of values ``q`` on meshes of sizes ``h`` (the library's, in the resolution ``1/h``); NaN unless the
+    changes keep their sign and shrink."""
+    d = np.diff(q)
+    if not np.all(np.isfinite(d)) or np.any(d[1:] * d[:-1] <= 0) or np.any(np.abs(d[1:]) >= np.abs(d[:-1])):
         return float("nan")
-    r1, r2 = h[0] / h[1], h[1] / h[2]
-    from scipy.optimize import brentq
-
-    f = lambda p: abs(d2) / abs(d1) - (1 - r2 ** -p) / (r1 ** p - 1) * 1.0  # noqa: E731
-    try:
-        return brentq(f, 0.05, 10.0)
-    except ValueError:
-        return float("nan")
+    p = observed_order_of(1 / np.asarray(h, dtype=float), q)
+    return float("nan") if p is None else p
 
 
 def value(rec, i, key):

@@ -149,7 +149,7 @@ def test_a_family_ending_in_an_internal_resonance_is_named():
     res = family_summary(fam)["resonance"]
     assert res["mode"] == 5 and res["ratio"] == pytest.approx(7.98, abs=0.02) and res["share"] > 0.99
     assert res["growth"] > 1e6 and res["frequency_hz"] == pytest.approx(0.2735, abs=1e-3)
-    words = _resonance_words(0, family_summary(fam), [])
+    words = _resonance_words(0, family_summary(fam))
     assert "ends in an internal resonance" in words and "mode 5" in words and "the 8:1 resonance" in words
     s2 = two_dof(3.0, 6.0)
     (fam2,) = bc.nonsmooth_mode(s2, 1, (np.pi + np.pi / np.sqrt(3.0) + 0.05, 2 * np.pi + 0.01))

@@ -64,7 +64,7 @@ def report(summary: dict) -> str:
                          f"{f['frequency_range_hz'][1]:.3f} | {a['f_lo']:.4f} – {a['f_hi']:.4f} | "
                          f"{a['energy_range_j'][0]:.3e} – {a['energy_range_j'][1]:.3e} | "
                          f"{'—' if stable is None else f'{stable:.0%} of its orbits'} |")
-    lines += [w for i, f in with_arcs if (w := _resonance_words(i, f, r["frequencies_hz"]))]
+    lines += [w for i, f in with_arcs if (w := _resonance_words(i, f))]
     widths = [(a["f_hi"] - a["f_lo"]) / a["f_hi"] for _, f in with_arcs for a in f["admissible_arcs"] if a["f_hi"] > 0]
     if widths and max(widths) < NARROW_RTOL:
         lines += ["", f"**Narrow:** the widest admissible arc spans {max(widths):.1e} of its frequency — in this model "
@@ -113,7 +113,7 @@ def _casing_words(k: float | None) -> str:
             "beyond the clearance while closed (docs/massless.md, \"A compliant casing\").")
 
 
-def _resonance_words(index: int, fam: dict, modes_hz: list[float]) -> str | None:
+def _resonance_words(index: int, fam: dict) -> str | None:
     """A sentence when the family's energy grows without bound into a higher mode (an internal resonance)."""
     res = fam.get("resonance")
     if not res:

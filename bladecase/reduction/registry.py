@@ -67,12 +67,15 @@ Builder = Callable[..., ReducedModel]
 
 @dataclass(frozen=True)
 class Entry:
-    """One registered method: its ``name``, ``builder``, one-line ``summary``, and whether it takes a ``size``."""
+    """One registered method: its ``name``, ``builder``, one-line ``summary``, whether it takes a ``size``, and
+    whether it takes a compliant casing (``casing``: a contact law without impacts; the others model Newton's
+    impact law, which :func:`reduce` refuses against a compliant casing)."""
 
     name: str
     builder: Builder
     summary: str
     sized: bool = True
+    casing: bool = False
 
 
 class Registry(BaseRegistry[Entry]):
@@ -84,20 +87,21 @@ class Registry(BaseRegistry[Entry]):
         What an entry is, for messages (``"reduction method"``).
     """
 
-    def register(self, name: str, builder: Builder, summary: str, *, sized: bool = True) -> Entry:
+    def register(self, name: str, builder: Builder, summary: str, *, sized: bool = True,
+                 casing: bool = False) -> Entry:
         """Add an entry; ``ValueError`` for an empty or taken name or a builder that is not callable."""
         if not callable(builder):
             raise ValueError(f"the builder of {self.kind} {name!r} must be callable, got {builder!r}")
-        return self.add(Entry(name, builder, str(summary), bool(sized)))
+        return self.add(Entry(name, builder, str(summary), bool(sized), bool(casing)))
 
 
 #: The reduction methods of :func:`reduce`, by name (filled by :mod:`bladecase.reduction.methods`).
 METHODS = Registry("reduction method")
 
 
-def register(name: str, builder: Builder, summary: str, *, sized: bool = True) -> Entry:
+def register(name: str, builder: Builder, summary: str, *, sized: bool = True, casing: bool = False) -> Entry:
     """Register a reduction method in :data:`METHODS` (see the module docstring)."""
-    return METHODS.register(name, builder, summary, sized=sized)
+    return METHODS.register(name, builder, summary, sized=sized, casing=casing)
 
 
 def reduce(
@@ -171,7 +175,7 @@ def reduce(
         raise ValueError(f"the model is not clamped: {model.rigid_modes} rigid-body motion(s) are free, so K is "
                          f"singular; clamp a face of every part (every reduction, {method!r} included, needs a "
                          "clamped model)")
-    if not method.startswith("massless"):
+    if not entry.casing:
         contact.rigid(f"method {method!r} (Newton's impact law)")
     factor = check_factor(factor, model.K, "this model's K", "bladecase.fe.stiffness_factor(model)")
     if entry.sized:

@@ -58,8 +58,8 @@ register("lanczos-si", lanczos.build_shift_invert, "size shift-invert Lanczos st
          "the contact sees, as a chain")
 register("craig-bampton", craig_bampton.build, "the contact node's dofs plus size fixed-interface modes")
 register("massless", massless.build, "massless contact dofs (mass moved to their neighbours, no impact law): size "
-         "modes of the massless structure plus the contact's attachment vector (None: exact)", sized=False)
+         "modes of the massless structure plus the contact's attachment vector (None: exact)", sized=False, casing=True)
 register("massless-lanczos", massless.build_krylov, "massless contact dofs, the interior reduced by size "
-         "shift-invert Lanczos steps on the redistributed mass from the attachment vector (size + 1 dofs)")
+         "shift-invert Lanczos steps on the redistributed mass from the attachment vector (size + 1 dofs)", casing=True)
 register("massless-modal", massless.build_modal, "massless contact dofs, the interior reduced to the size lowest "
-         "modes of the massless structure (no attachment vector: the static compliance is truncated)")
+         "modes of the massless structure (no attachment vector: the static compliance is truncated)", casing=True)

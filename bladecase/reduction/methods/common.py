@@ -20,9 +20,7 @@ SUGGEST = "use method 'modal', 'lanczos', 'lanczos-si' or 'craig-bampton' with a
 
 
 def constraint(model: FEModel, contact: Contact) -> np.ndarray:
-    """The contact's constraint vector ``w`` on the free dofs of ``model`` (checked; a rigid casing: these methods
-    model Newton's impact law)."""
-    contact.rigid("a reduction for Newton's impact law")
+    """The contact's constraint vector ``w`` on the free dofs of ``model`` (checked)."""
     w = np.asarray(contact.w(model), dtype=float).reshape(-1)
     if w.shape != (model.n_dofs,):
         raise ValueError(f"contact.w(model) has {w.size} entries, expected {model.n_dofs} (one per free dof)")
