@@ -138,6 +138,11 @@ def same_arcs(a: list, b: list, rtol: float) -> bool:
     return len(a) == len(b) and all(abs(x[0] - y[0]) <= rtol and abs(x[1] - y[1]) <= rtol for x, y in zip(a, b))
 
 
+def uncovered(arcs: list, by: list, rtol: float) -> list:
+    """The arcs of ``arcs`` that no arc of ``by`` contains (ends within ``rtol``): periods lost."""
+    return [a for a in arcs if not any(b[0] <= a[0] + rtol and a[1] - rtol <= b[1] for b in by)]
+
+
 def report(res: dict, before: dict | None, rtol: float) -> None:
     goal = GOALS_S.get(res["case"])
     line = (f"{res['case']:<8} n={res['n']:<4d} wall {res['wall_s']:8.2f} s  cpu {res['cpu_s']:8.2f} s  "
@@ -156,6 +161,9 @@ def report(res: dict, before: dict | None, rtol: float) -> None:
           f"cpu x{before['cpu_s'] / res['cpu_s']:.1f};  same families and arcs (rtol {rtol:g}): "
           f"{'YES' if same else 'NO'}; same family spans: {'YES' if spans else 'NO'}; same distinct arcs: "
           f"{'YES' if distinct else 'NO'}", flush=True)
+    lost, gained = uncovered(before["arcs"], res["arcs"], rtol), uncovered(res["arcs"], before["arcs"], rtol)
+    print(f"         arcs of before inside none of after: {len(lost)} (of {len(before['arcs'])}); arcs of after inside "
+          f"none of before: {len(gained)} (of {len(res['arcs'])})", flush=True)
     if not same:
         old, new = set(map(tuple, before["arcs"])), set(map(tuple, res["arcs"]))
         print(f"         arcs only before: {sorted(old - new)[:8]}\n         arcs only after: {sorted(new - old)[:8]}")

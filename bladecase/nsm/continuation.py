@@ -66,7 +66,8 @@ class Curve:
         Whether the step ``z_a → z_b`` crosses something that ends the curve (a branch point): the step is
         then shortened, so the last point lands close to it.
     tol : float
-        Largest ``max|R|`` of a converged point.
+        Largest ``max|R|`` of a converged point — or the residual's round-off floor there, if larger
+        (:func:`roundoff_floor`).
     step_tol : float
         The corrector stops when its step is below this (max norm).
     """
@@ -88,21 +89,38 @@ def tangent(J: np.ndarray, previous: Vector | None = None) -> Vector:
     return t
 
 
+def roundoff_floor(J: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """The smallest residual ``max|R|`` a point ``z`` can be expected to reach in floating point:
+    ``4 ε max_i Σ_j |J_ij z_j|`` — what rounding ``z`` to the nearest doubles moves ``R`` by (``J`` the Jacobian
+    ``∂R/∂z`` there; a stack ``(B, m, n)`` with ``z`` ``(B, n)`` gives one floor per row).
+
+    The corrector accepts a converged point when ``max|R| < max(tol, floor)``: where the curve is stiff (near a
+    resonance ``|J|`` reaches 1e6 and more) a fixed ``tol`` below the floor would accept or reject the same point
+    by the last bits of ``z``, and a family would end by round-off.
+
+    >>> J = np.array([[3e6, 1.0]])
+    >>> float(roundoff_floor(J, np.array([1.0, 0.5]))) > 1e-10     # no residual below 1e-10 is representable
+    True
+    """
+    return 4 * np.finfo(float).eps * (np.abs(J) @ np.abs(z)[..., None])[..., 0].max(axis=-1)
+
+
 def correct(curve: Curve, zp: Vector, direction: Vector, J: np.ndarray | None = None,
             maxiter: int = 10) -> tuple[Vector | None, int]:
     """Newton on ``[R(z) ; direction·(z - zp)] = 0`` from ``zp``; with ``J`` given, the chord method (that
-    Jacobian kept for every iteration).  Returns ``(z or None, iterations)``."""
+    Jacobian kept for every iteration).  Converged: a step below ``step_tol``, then ``max|R|`` below ``tol`` or
+    the round-off floor (:func:`roundoff_floor`).  Returns ``(z or None, iterations)``."""
     z = zp.copy()
     for it in range(maxiter):
         r = np.append(curve.residual(z), direction @ (z - zp))
         if not np.all(np.isfinite(r)):
             return None, it
-        A = np.vstack([curve.jacobian(z) if J is None else J, direction])
-        dz, *_ = np.linalg.lstsq(A, -r, rcond=None)
+        Jz = curve.jacobian(z) if J is None else J
+        dz, *_ = np.linalg.lstsq(np.vstack([Jz, direction]), -r, rcond=None)
         z = z + dz
         if np.abs(dz).max() < curve.step_tol:
             res = np.abs(curve.residual(z)).max()
-            return (z if res < curve.tol else None), it + 1
+            return (z if res < max(curve.tol, float(roundoff_floor(Jz, z))) else None), it + 1
     return None, maxiter
 
 
@@ -296,12 +314,14 @@ def correct_stack(curve: BatchCurve, ZP: np.ndarray, D: np.ndarray, idx: np.ndar
     rows, Z, zp, d, ix = np.arange(count), ZP.copy(), ZP, D, idx
     P = None if J is None else pinv_stack(np.concatenate([J, D[:, None, :]], axis=1))
     checking = np.zeros(count, dtype=bool)
+    Jused = J  # the Jacobian of each row's last step (the round-off floor of its residual test)
     for it in range(maxiter + 1):
         R, Jz = curve.evaluate(Z, ix, P is None and it < maxiter)
         keep = ~checking
         if checking.any():  # moved less than step_tol at the last iteration: the residual test
             done = rows[checking]
-            ok[done] = np.abs(R[checking]).max(axis=1) < curve.tol
+            floor = roundoff_floor(Jused[checking], Z[checking])
+            ok[done] = np.abs(R[checking]).max(axis=1) < np.maximum(curve.tol, floor)
             iters[done] = it
             out[done] = Z[checking]
         r = np.concatenate([R, np.einsum("ij,ij->i", d, Z - zp)[:, None]], axis=1)
@@ -313,6 +333,9 @@ def correct_stack(curve: BatchCurve, ZP: np.ndarray, D: np.ndarray, idx: np.ndar
             rows, Z, zp, d, ix, r = rows[keep], Z[keep], zp[keep], d[keep], ix[keep], r[keep]
             P = None if P is None else P[keep]
             Jz = None if Jz is None else Jz[keep]
+            Jused = Jused[keep] if P is not None else Jused
+        if P is None:
+            Jused = Jz
         if P is not None:
             dz = -(P @ r[:, :, None])[:, :, 0]
         else:

@@ -24,6 +24,7 @@ from . import continuation
 from .arc_ends import _bisect_end, bisect_ends
 from .modal import ModalKernel, impact_kernels, solve_stack, solve_times, solve_times_stack
 from .orbits import PeriodicOrbit, make_orbit, make_orbits
+from .signals import sincos_half
 from .system import LinearSystem
 
 #: Relative precision in ``T`` of the refined ends of admissible arcs.
@@ -71,10 +72,9 @@ class KippCurves:
         T0 = self.T0[idx]
         T = Z[:, 1] * T0
         D = np.mod(Z[:, 0] * T0 - T, T)
-        half = np.multiply.outer(T / 2, self.omega)
-        sh = np.sin(half)
-        ph = np.multiply.outer(D - T / 2, self.omega)
-        return T0, T, D, self.b**2 / (2 * sh), sh, np.cos(half), np.cos(ph), (np.sin(ph) if sines else None)
+        sh, ch = sincos_half(np.multiply.outer(T / 4, self.omega))  # of ωT/2
+        sp, cp = sincos_half(np.multiply.outer((D - T / 2) / 2, self.omega))  # of ω(D - T/2)
+        return T0, T, D, self.b**2 / (2 * sh), sh, ch, cp, (sp if sines else None)
 
     def _evaluate2(self, Z, idx, jacobian: bool):
         """:meth:`evaluate` for k = 2 in closed form: ``n = Σ⁻¹1 ∝ (1, 1)``, so ``R = ∓s(D) (1, -1)/(√2 S)``."""
