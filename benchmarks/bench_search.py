@@ -108,11 +108,33 @@ def fingerprint(families, T1: float) -> dict:
     arcs = sorted((round(a.T_lo / T1, 8), round(a.T_hi / T1, 8)) for f in families for a in f.arcs)
     spans = sorted((round(min(o.T for o in f.orbits) / T1, 8), round(max(o.T for o in f.orbits) / T1, 8))
                    for f in families if f.orbits)
+    mids = [[o.T, *o.impact_times.tolist(), *o.impulses.tolist()]
+            for f in families for a in f.arcs for o in [f.orbits[(a.start + a.stop) // 2]]]
     return {"families": len(families), "with_arcs": sum(1 for f in families if f.arcs), "arcs": arcs,
-            "spans": spans, "orbits": sum(len(f.orbits) for f in families)}
+            "spans": spans, "orbits": sum(len(f.orbits) for f in families), "arc_orbits": mids}
 
 
-def measure(name: str, cache: Path, repeat: int) -> dict:
+def off_families(system, mids: list, families) -> int:
+    """How many of the orbits ``mids`` (``[T, times…, impulses…]`` rows, e.g. the middle orbit of each arc of
+    an earlier run) lie on none of ``families`` (re-solved from the family's curve at their period,
+    :func:`bladecase.nsm.modes.on_curve`): admissible orbits the search no longer lists."""
+    from bladecase.nsm.modes import on_curve
+    from bladecase.nsm.orbits import make_orbit
+
+    if not mids:
+        return 0
+    k = (len(mids[0]) - 1) // 2
+    orbits = [make_orbit(system, m[0], np.array(m[1:1 + k]), np.array(m[1 + k:]), polish=False) for m in mids]
+    found = np.zeros(len(orbits), dtype=bool)
+    for f in families:
+        rest = np.flatnonzero(~found)
+        if rest.size == 0 or len(f.orbits) < 2:
+            continue
+        found[rest] = on_curve(f.orbits, [orbits[i] for i in rest])
+    return int((~found).sum())
+
+
+def measure(name: str, cache: Path, repeat: int, before: dict | None = None) -> dict:
     system, T1, call = case(name, cache)
     walls, cpus, fams = [], [], None
     for _ in range(repeat):
@@ -121,6 +143,8 @@ def measure(name: str, cache: Path, repeat: int) -> dict:
         walls.append(time.perf_counter() - w0)
         cpus.append(time.process_time() - c0)
     fp = fingerprint(fams, T1)
+    if before is not None and before.get("arc_orbits"):
+        fp["off_families"] = off_families(system, before["arc_orbits"], fams)
     return {"case": name, "n": system.n, "wall_s": statistics.median(walls), "cpu_s": statistics.median(cpus),
             "walls": walls, "cpus": cpus, **fp}
 
@@ -164,6 +188,9 @@ def report(res: dict, before: dict | None, rtol: float) -> None:
     lost, gained = uncovered(before["arcs"], res["arcs"], rtol), uncovered(res["arcs"], before["arcs"], rtol)
     print(f"         arcs of before inside none of after: {len(lost)} (of {len(before['arcs'])}); arcs of after inside "
           f"none of before: {len(gained)} (of {len(res['arcs'])})", flush=True)
+    if "off_families" in res:
+        print(f"         middle orbits of the arcs of before on no family of after: {res['off_families']} "
+              f"(of {len(before['arc_orbits'])})", flush=True)
     if not same:
         old, new = set(map(tuple, before["arcs"])), set(map(tuple, res["arcs"]))
         print(f"         arcs only before: {sorted(old - new)[:8]}\n         arcs only after: {sorted(new - old)[:8]}")
@@ -195,7 +222,7 @@ def main() -> None:
     results = {}
     for name in args.cases.split(","):
         repeat = 1 if name in ("demo16", "demo32") else args.repeat
-        results[name] = measure(name, args.cache, repeat)
+        results[name] = measure(name, args.cache, repeat, before.get(name))
         report(results[name], before.get(name), args.rtol)
         if args.save:
             args.save.write_text(json.dumps(results, indent=1))

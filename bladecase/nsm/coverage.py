@@ -12,7 +12,7 @@ import numpy as np
 
 from .families import FamilyTracer, KippCurve
 from .kipp import canonical_rotation
-from .modal import ModalKernel, solve_times
+from .modal import ModalKernel, solve_times, solve_times_stack
 from .orbits import REPEAT_RTOL, PeriodicOrbit
 
 __all__ = ["PASS_GATE", "passes", "phase_distance", "phase_distances", "starts_passed"]
@@ -105,9 +105,12 @@ def _crossings(problem: KippCurve, zs, index: _StartIndex, wanted: np.ndarray) -
 
 
 def _solve_crossings(problem: KippCurve, crossings: list[tuple]) -> list:
-    """The fixed-period solutions from the crossings, one :func:`~bladecase.nsm.modal.solve_times` each (not
-    stacked: where Newton's verdict is borderline in round-off it must be the one-by-one search's); ``None``
-    where none converges."""
+    """The fixed-period solutions from the crossings (``None`` where none converges): for ``k = 2`` all of them
+    at once (:func:`~bladecase.nsm.modal.solve_times_stack`: the scalar equation ``s(t₁) = 0``), else one
+    :func:`~bladecase.nsm.modal.solve_times` each."""
+    if problem.k == 2 and crossings:
+        return solve_times_stack(problem.system, np.array([c[0] for c in crossings]),
+                                 np.array([c[1] for c in crossings]), problem.d)
     return [solve_times(ModalKernel.of(problem.system, T_s), guess, problem.d) for T_s, guess, _, _ in crossings]
 
 

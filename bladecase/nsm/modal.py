@@ -28,6 +28,7 @@ from functools import cached_property
 import numpy as np
 
 from .continuation import lstsq_stack
+from .signals import sincos_half
 from .system import LinearSystem
 
 #: ``T`` is resonant when ``|ω_j T - 2πm| <= RESONANCE_RTOL · ω_j T`` for an
@@ -246,7 +247,12 @@ def newton_times(kernel: ModalKernel, times: np.ndarray, lam: np.ndarray, d: flo
 
 def solve_times(kernel: ModalKernel, times0: np.ndarray, d: float) -> tuple[np.ndarray, np.ndarray] | None:
     """Solve for ``(t₁…t_{k-1}, Λ)`` at fixed ``T`` from impact times ``times0``: Newton with the exact
-    Jacobian, else Levenberg–Marquardt (wider basin); ``None`` if neither converges."""
+    Jacobian, else Levenberg–Marquardt (wider basin); ``None`` if neither converges.  For ``k = 2`` the
+    scalar equation ``s(t₁) = 0`` is tried first (:func:`solve_pairs`)."""
+    if times0.size == 2:
+        sol = solve_pairs(kernel.omega, kernel.b, np.array([kernel.T]), times0[None, :1], d)
+        if np.isfinite(sol[0][0, 0]):
+            return sol[0][0], sol[1][0]
     lam0 = impulses_for(kernel, times0, d)
     if lam0 is None:
         return None
@@ -254,6 +260,60 @@ def solve_times(kernel: ModalKernel, times0: np.ndarray, d: float) -> tuple[np.n
     if sol is not None:
         return sol
     return _levenberg_marquardt(kernel, times0, lam0, d)
+
+
+def solve_pairs(omega: np.ndarray, b: np.ndarray, T: np.ndarray, t1: np.ndarray, d: float,
+                maxiter: int = 12) -> tuple[np.ndarray, np.ndarray]:
+    """2-ipp orbits at fixed periods, many at once: ``(times, Λ)``, each ``(B, 2)``, NaN rows where Newton fails.
+
+    For ``k = 2`` the fixed-period equations reduce to one scalar equation (theory §4; the paper's Eq. 15):
+    ``ΠΛ = 0`` is ``s(t₁) = 0`` and ``ΣΛ = d·1`` gives ``Λ₁ = Λ₂ = -d/(g(0) + g(t₁))``.  Newton on ``s`` from
+    ``t1`` (``(B,)`` or ``(B, 1)``, periods ``T`` ``(B,)``) with the exact ``s'``, stopped as
+    :func:`newton_times` is (a step below ``1e-14·T``; a failure when a step grows tenfold), and accepted as it
+    is: distinct impacts and the residual ``[ΠΛ ; ΣΛ - d]`` within ``1e-9`` of its scale.  Where it fails,
+    :func:`solve_times` falls back on Gauss–Newton in ``(t₁, Λ)`` and Levenberg–Marquardt (wider basins).
+
+    >>> from bladecase.nsm import chain
+    >>> s2 = chain(2, k=1.0, m=0.5, gap=1.0)
+    >>> omega, b, _ = s2.spectrum.contact_modes
+    >>> times, lam = solve_pairs(omega, b, np.array([13.5, 13.5]), np.array([6.0, 6.7]), 1.0)
+    >>> times[:, 0].round(4).tolist(), bool(np.allclose(lam[:, 0], lam[:, 1]))
+    ([6.0829, 6.75], True)
+    """
+    T = np.asarray(T, dtype=float)
+    u = np.asarray(t1, dtype=float).reshape(-1).copy()
+    c = b**2 / (2 * np.sin(np.multiply.outer(T / 2, omega)))  # (B, m)
+    cw = c * omega
+    prev = np.full(u.size, np.inf)
+    live = np.ones(u.size, dtype=bool)
+    failed = np.zeros(u.size, dtype=bool)
+    for _ in range(maxiter):
+        rows = np.flatnonzero(live)
+        if rows.size == 0:
+            break
+        sn, cs = sincos_half(np.multiply.outer((u[rows] - T[rows] / 2) / 2, omega))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            step = -np.einsum("bm,bm->b", sn, c[rows]) / np.einsum("bm,bm->b", cs, cw[rows])  # -s/s'
+        u[rows] += step
+        size = np.abs(step) / T[rows]
+        bad = ~np.isfinite(step) | (size > 10 * prev[rows])
+        failed[rows[bad]] = True
+        live[rows[bad | (size < 1e-14)]] = False
+        prev[rows] = size
+    failed |= live  # not converged within maxiter
+    with np.errstate(invalid="ignore"):
+        failed |= ~((u > DISTINCT_RTOL * T) & (T - u > DISTINCT_RTOL * T))
+    sn, cs = sincos_half(np.multiply.outer((u - T / 2) / 2, omega))
+    w = c / omega
+    s_u = -np.einsum("bm,bm->b", sn, c)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        sigma = np.einsum("bm,bm->b", np.cos(np.multiply.outer(T / 2, omega)) + cs, w)  # g(0) + g(t₁)
+        lam = -d / sigma
+        scale = float(b @ b) / 2 * np.abs(lam)
+        ok = (~failed & np.isfinite(lam) & (np.abs(s_u * lam) <= 1e-9 * np.maximum(scale, d))
+              & (np.abs(-sigma * lam - d) <= 1e-9 * d))
+    times = np.where(ok[:, None], np.stack([u, T], axis=1), np.nan)
+    return times, np.where(ok[:, None], lam[:, None] * np.ones(2), np.nan)
 
 
 def _levenberg_marquardt(kernel: ModalKernel, times0: np.ndarray, lam0: np.ndarray, d: float):
@@ -374,9 +434,10 @@ def _residual_jacobian_stack(omega, b, T, times, lam, d, jacobian=True):
 
 
 def solve_times_stack(system: LinearSystem, T: np.ndarray, times0: np.ndarray,
-                      d: float) -> list[tuple[np.ndarray, np.ndarray] | None]:
+                      d: float, pairs: bool = True) -> list[tuple[np.ndarray, np.ndarray] | None]:
     """:func:`solve_times` for many periods ``T`` ``(B,)`` and starting impact times ``times0`` ``(B, k)``:
-    the Newton iterations of all of them vectorised, Levenberg–Marquardt one by one where Newton fails.
+    the Newton iterations of all of them vectorised, Levenberg–Marquardt one by one where Newton fails.  For
+    ``k = 2`` (unless ``pairs`` is false) the scalar equation of :func:`solve_pairs` first, the rest where it fails.
 
     >>> from bladecase.nsm import chain
     >>> s2 = chain(2, k=1.0, m=0.5, gap=1.0)
@@ -390,6 +451,15 @@ def solve_times_stack(system: LinearSystem, T: np.ndarray, times0: np.ndarray,
     count, k = times0.shape
     out: list[tuple[np.ndarray, np.ndarray] | None] = [None] * count
     if count == 0:
+        return out
+    if k == 2 and pairs:  # the scalar equation first, the general solve where it fails
+        pt, pl = solve_pairs(omega, b, T, times0[:, 0], d)
+        good = np.isfinite(pt[:, 0])
+        rest = np.flatnonzero(~good)
+        for i in np.flatnonzero(good):
+            out[i] = (pt[i], pl[i])
+        for i, sol in zip(rest, solve_times_stack(system, T[rest], times0[rest], d, pairs=False) if rest.size else []):
+            out[i] = sol
         return out
     Sigma = -impact_kernels(omega, b, times0, T=T)[0]
     lam0 = lstsq_stack(Sigma, np.full((count, k), d), rcond=1e-12)
