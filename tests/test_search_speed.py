@@ -25,7 +25,15 @@ from bladecase.nsm.families import (
     trace_families,
 )
 from bladecase.nsm.kipp import canonical_rotation
-from bladecase.nsm.modal import ModalKernel, impact_kernels, solve_times, solve_times_stack
+from bladecase.nsm.modal import (
+    ModalKernel,
+    impact_kernels,
+    impulses_for,
+    newton_times,
+    solve_pairs,
+    solve_times,
+    solve_times_stack,
+)
 from bladecase.nsm.orbits import REPEAT_RTOL, make_orbit, make_orbits
 from bladecase.nsm.signals import TrigSum, certified_max, certified_max_stack, sincos
 
@@ -107,6 +115,35 @@ def test_solve_times_stack_is_solve_times(five_dof):
             np.testing.assert_allclose(got[1], want[1], rtol=1e-9)
             n_found += 1
     assert n_found >= 0.8 * len(orbits)
+
+
+def test_solve_pairs_is_the_general_fixed_period_solve(five_dof):
+    """The scalar 2-ipp equation s(t1) = 0 (solve_pairs) gives the general Gauss-Newton solution (times to
+    1e-12 T, impulses to 1e-9) from the same guesses; where it fails the row is NaN, and solve_times falls
+    back on the general solve."""
+    omega, b, _ = five_dof.spectrum.contact_modes
+    rng = np.random.default_rng(3)
+    T, guesses, wants = [], [], []
+    for Tk in (5.9, 7.3, 8.6):
+        kernel = ModalKernel.of(five_dof, Tk)
+        for o in bc.orbits_kipp(five_dof, Tk, 2):
+            guess = o.impact_times * np.array([1 + 0.005 * rng.uniform(-1, 1), 1.0])
+            want = newton_times(kernel, guess, impulses_for(kernel, guess, five_dof.gap), five_dof.gap)
+            if want is not None:
+                T.append(Tk)
+                guesses.append(guess)
+                wants.append(want)
+    assert len(wants) >= 10
+    times, lam = solve_pairs(omega, b, np.array(T), np.array(guesses)[:, 0], five_dof.gap)
+    for Tk, got_t, got_l, (want_t, want_l) in zip(T, times, lam, wants):
+        np.testing.assert_allclose(got_t, want_t, rtol=0, atol=1e-12 * Tk)
+        np.testing.assert_allclose(got_l, want_l, rtol=1e-9)
+    # a guess on a maximum of |s| (s' = 0): Newton cannot start, the row is NaN
+    kernel = ModalKernel.of(five_dof, 7.3)
+    u = np.linspace(0.01, 7.29, 20001)
+    top = u[np.argmax(np.abs(kernel.g_s(u)[1]))]
+    bad, _ = solve_pairs(omega, b, np.array([7.3]), np.array([top]), five_dof.gap)
+    assert np.isnan(bad).all() or abs(bad[0, 0] - top) > 1e-3  # never "converged" where it started
 
 
 def test_many_curves_followed_as_one_by_one(five_dof):
