@@ -38,7 +38,14 @@ bisection passes its 1e-9 d residual test only in the stacked evaluation).  Then
 crossings of a period at once (the same families and arcs; gain within the machine's noise). Half-angle sines in
 the batched kernel sums (chain50 median 11.5 -> 9.8, demo32 84 -> 78) were not kept: one chain50 family longer
 (0.9276 -> 0.9307 T1, the corrector's 1e-10 residual test at a point whose round-off floor is 6.6e-10) and
-demo32 one family fewer; docs/performance.md has the analysis.
+demo32 one family fewer; docs/performance.md has the analysis.  Third pass: the corrector's round-off floor
+(a fix: chain50 356 -> 371 arcs, none lost), then those half-angle sines (identical families under it),
+then k = 2 fixed-period solves by the scalar equation (``solve_pairs``): interleaved, chain50 12.2 -> 9.9,
+demo8 3.08 -> 2.11, demo32 92 -> 50 (loaded machine).
+
+With ``--compare`` each case also reports the arcs of before inside no arc of after (and the reverse) and how
+many middle orbits of the arcs of before lie on no family of after (re-solved from every new family,
+``modes.on_curve``): the strict "nothing lost" test.
 """
 
 from __future__ import annotations
