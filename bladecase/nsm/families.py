@@ -22,9 +22,16 @@ import numpy as np
 
 from . import continuation
 from .arc_ends import _bisect_end, bisect_ends
-from .modal import ModalKernel, impact_kernels, solve_stack, solve_times, solve_times_stack
+from .modal import (
+    ModalKernel,
+    delay_terms,
+    half_period_terms,
+    impact_kernels,
+    solve_stack,
+    solve_times,
+    solve_times_stack,
+)
 from .orbits import PeriodicOrbit, make_orbit, make_orbits
-from .signals import sincos_half
 from .system import LinearSystem
 
 #: Relative precision in ``T`` of the refined ends of admissible arcs.
@@ -72,9 +79,9 @@ class KippCurves:
         T0 = self.T0[idx]
         T = Z[:, 1] * T0
         D = np.mod(Z[:, 0] * T0 - T, T)
-        sh, ch = sincos_half(np.multiply.outer(T / 4, self.omega))  # of ωT/2
-        sp, cp = sincos_half(np.multiply.outer((D - T / 2) / 2, self.omega))  # of ω(D - T/2)
-        return T0, T, D, self.b**2 / (2 * sh), sh, ch, cp, (sp if sines else None)
+        c, sh, ch = half_period_terms(self.omega, self.b, T)
+        sp, cp = delay_terms(self.omega, T, D)
+        return T0, T, D, c, sh, ch, cp, (sp if sines else None)
 
     def _evaluate2(self, Z, idx, jacobian: bool):
         """:meth:`evaluate` for k = 2 in closed form: ``n = Σ⁻¹1 ∝ (1, 1)``, so ``R = ∓s(D) (1, -1)/(√2 S)``."""

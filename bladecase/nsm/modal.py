@@ -262,6 +262,19 @@ def solve_times(kernel: ModalKernel, times0: np.ndarray, d: float) -> tuple[np.n
     return _levenberg_marquardt(kernel, times0, lam0, d)
 
 
+def half_period_terms(omega: np.ndarray, b: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(c, sin, cos)`` of ``ωT/2`` for periods ``T`` ``(B,)``, each ``(B, m)``, ``c = b²/(2 sin(ωT/2))``: the
+    period-dependent factors of the kernel sums ``g``, ``s`` (:class:`ModalKernel`), half-angle sines."""
+    sh, ch = sincos_half(np.multiply.outer(np.asarray(T, dtype=float) / 4, omega))
+    return b**2 / (2 * sh), sh, ch
+
+
+def delay_terms(omega: np.ndarray, T: np.ndarray, D: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(sin, cos)`` of ``ω(D - T/2)`` ``(B, m)`` at delays ``D`` ``(B,)``: ``s(D) = -Σ c sin``,
+    ``g(D) = Σ (c/ω) cos``, ``s'(D) = -Σ cω cos``."""
+    return sincos_half(np.multiply.outer((D - T / 2) / 2, omega))
+
+
 def solve_pairs(omega: np.ndarray, b: np.ndarray, T: np.ndarray, t1: np.ndarray, d: float,
                 maxiter: int = 12) -> tuple[np.ndarray, np.ndarray]:
     """2-ipp orbits at fixed periods, many at once: ``(times, Λ)``, each ``(B, 2)``, NaN rows where Newton fails.
@@ -282,7 +295,7 @@ def solve_pairs(omega: np.ndarray, b: np.ndarray, T: np.ndarray, t1: np.ndarray,
     """
     T = np.asarray(T, dtype=float)
     u = np.asarray(t1, dtype=float).reshape(-1).copy()
-    c = b**2 / (2 * np.sin(np.multiply.outer(T / 2, omega)))  # (B, m)
+    c, _, ch = half_period_terms(omega, b, T)  # (B, m)
     cw = c * omega
     prev = np.full(u.size, np.inf)
     live = np.ones(u.size, dtype=bool)
@@ -291,7 +304,7 @@ def solve_pairs(omega: np.ndarray, b: np.ndarray, T: np.ndarray, t1: np.ndarray,
         rows = np.flatnonzero(live)
         if rows.size == 0:
             break
-        sn, cs = sincos_half(np.multiply.outer((u[rows] - T[rows] / 2) / 2, omega))
+        sn, cs = delay_terms(omega, T[rows], u[rows])
         with np.errstate(divide="ignore", invalid="ignore"):
             step = -np.einsum("bm,bm->b", sn, c[rows]) / np.einsum("bm,bm->b", cs, cw[rows])  # -s/s'
         u[rows] += step
@@ -303,11 +316,11 @@ def solve_pairs(omega: np.ndarray, b: np.ndarray, T: np.ndarray, t1: np.ndarray,
     failed |= live  # not converged within maxiter
     with np.errstate(invalid="ignore"):
         failed |= ~((u > DISTINCT_RTOL * T) & (T - u > DISTINCT_RTOL * T))
-    sn, cs = sincos_half(np.multiply.outer((u - T / 2) / 2, omega))
+    sn, cs = delay_terms(omega, T, u)
     w = c / omega
     s_u = -np.einsum("bm,bm->b", sn, c)
     with np.errstate(divide="ignore", invalid="ignore"):
-        sigma = np.einsum("bm,bm->b", np.cos(np.multiply.outer(T / 2, omega)) + cs, w)  # g(0) + g(t₁)
+        sigma = np.einsum("bm,bm->b", ch + cs, w)  # g(0) + g(t₁)
         lam = -d / sigma
         scale = float(b @ b) / 2 * np.abs(lam)
         ok = (~failed & np.isfinite(lam) & (np.abs(s_u * lam) <= 1e-9 * np.maximum(scale, d))
