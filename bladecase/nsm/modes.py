@@ -30,7 +30,7 @@ from .coverage import (  # noqa: F401 (PASS_GATE, passes, phase_distance(s), sta
 )
 from .families import FamilyTracer, complete_families
 from .kipp import canonical_rotation, check_k, orbits_kipp
-from .modal import ModalKernel, solve_times
+from .modal import ModalKernel, solve_pairs, solve_times
 from .orbits import REPEAT_RTOL, PeriodicOrbit
 from .system import LinearSystem
 
@@ -330,19 +330,44 @@ def _near(curve: list[PeriodicOrbit], orbits: list[PeriodicOrbit], allowed: np.n
 
 def _matches(curve: list[PeriodicOrbit], orbits: list[PeriodicOrbit], allowed: np.ndarray | None = None
              ) -> np.ndarray:
-    """:func:`on_curve`, as the segment of ``curve`` each orbit lies on (``-1``: none)."""
+    """:func:`on_curve`, as the segment of ``curve`` each orbit lies on (``-1``: none).
+
+    Each orbit tries its candidate segments nearest first and stops at the first that gives it back; the
+    candidates of all orbits are solved round by round (the nearest of every orbit, then the next of those
+    not yet matched, ...), each round's fixed-period solves together (:func:`_solve_candidates`)."""
     hit = np.full(len(orbits), -1)
     if len(curve) < 2 or not orbits:
         return hit
     near, guess, dist, Q = _near(curve, orbits, allowed)
+    order = np.argsort(np.where(near, dist, np.inf), axis=1, kind="stable")  # each orbit's candidates, nearest first
+    tries = near.sum(axis=1)
     system = curve[0].system
-    for i in np.flatnonzero(near.any(axis=1)):
-        Ti = Q[i, 0]
-        md = ModalKernel.of(system, Ti)
-        for j in np.flatnonzero(near[i])[np.argsort(dist[i, near[i]])]:
-            sol = solve_times(md, np.append(guess[i, j], 1.0) * Ti, system.gap)
-            if sol is not None and np.abs(canonical_rotation(sol[0], sol[1], Ti)[0][:-1] / Ti - Q[i, 1:]).max() \
-                    <= SAME_RTOL:
-                hit[i] = j
-                break
+    for r in range(int(tries.max(initial=0))):
+        rows = np.flatnonzero((tries > r) & (hit < 0))
+        if rows.size == 0:
+            break
+        j = order[rows, r]
+        T = Q[rows, 0]
+        for i, jj, sol in zip(rows, j, _solve_candidates(system, T, guess[rows, j], system.gap)):
+            if sol is not None and np.abs(canonical_rotation(sol[0], sol[1], Q[i, 0])[0][:-1] / Q[i, 0]
+                                          - Q[i, 1:]).max() <= SAME_RTOL:
+                hit[i] = jj
     return hit
+
+
+def _solve_candidates(system: LinearSystem, T: np.ndarray, guess: np.ndarray, d: float) -> list:
+    """:func:`~bladecase.nsm.modal.solve_times` at periods ``T`` from canonical times ``guess`` (``(B, k-1)``, over
+    ``T``) for every row: for ``k = 2`` the scalar solves of all rows at once (:func:`solve_times` tries them
+    first), :func:`solve_times` itself where they fail."""
+    out: list = [None] * len(T)
+    rest = range(len(T))
+    if guess.shape[1] == 1:
+        omega, b, _ = system.spectrum.contact_modes
+        times, lam = solve_pairs(omega, b, T, guess[:, 0] * T, d)
+        good = np.isfinite(times[:, 0])
+        for i in np.flatnonzero(good):
+            out[i] = (times[i], lam[i])
+        rest = np.flatnonzero(~good)
+    for i in rest:
+        out[i] = solve_times(ModalKernel.of(system, T[i]), np.append(guess[i], 1.0) * T[i], d)
+    return out
