@@ -64,6 +64,28 @@ def test_lstsq_stack_is_numpy_lstsq():
     np.testing.assert_allclose(np.einsum("bij,bj->bi", P, b), ref, rtol=0, atol=1e-12 * np.abs(ref).max())
 
 
+def test_lstsq2_stack_is_lstsq_stack():
+    """The closed-form two-unknown least squares of the k = 2 corrector: LAPACK's solutions to round-off times the
+    condition number, the rank-deficient rows (handed to LAPACK) its minimum-norm ones exactly."""
+    rng = np.random.default_rng(1)
+    A = rng.standard_normal((200, 3, 2))
+    A[:, :2] *= 10.0 ** rng.uniform(-2, 6, (200, 1, 1))  # a corrector's [J; tangent]: |J| up to 1e6
+    A[::9, :, 1] = 2 * A[::9, :, 0]  # rank deficient
+    A[5, 0, 0] = np.nan  # not finite: NaN as lstsq_stack
+    b = rng.standard_normal((200, 3))
+    ref = continuation.lstsq_stack(A, b)
+    got = continuation.lstsq2_stack(A, b)
+    cond = np.linalg.cond(np.nan_to_num(A))
+    ok = np.isfinite(ref).all(axis=1)
+    assert np.isnan(got[5]).all() and not ok[5]
+    err = np.abs(got - ref).max(axis=1)[ok] / np.abs(ref).max(axis=1)[ok]
+    assert (err <= 1e-14 * cond[ok]).all(), err.max()
+    np.testing.assert_array_equal(got[::9][1:], ref[::9][1:])  # rank deficient: LAPACK's own answer
+    square = A[:, :2]  # M = N = 2 (rows 10-16 regular): the solution of the square system
+    np.testing.assert_allclose(continuation.lstsq2_stack(square[10:17], b[10:17, :2]),
+                               np.linalg.solve(square[10:17], b[10:17, :2, None])[..., 0], rtol=1e-9)
+
+
 @pytest.mark.parametrize("sysname,k", [("two_dof", 2), ("five_dof", 2), ("five_dof", 3), ("five_dof", 4)])
 def test_impact_kernels_are_the_modal_kernel(request, sysname, k):
     system = request.getfixturevalue(sysname)
