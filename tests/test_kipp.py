@@ -148,6 +148,21 @@ def five_dof():
 
 
 @pytest.fixture(scope="module")
+def kipp_at(two_dof):
+    """``orbits_kipp(two_dof, T, k)``, solved once per ``(T, k)`` for the module: several tests check different
+    properties of the same solutions (the multistart for k >= 3 is the slow part of this file)."""
+    solved = {}
+
+    def get(T: float, k: int) -> list:
+        key = (float(T), int(k))
+        if key not in solved:
+            solved[key] = bc.orbits_kipp(two_dof, T, k)
+        return solved[key]
+
+    return get
+
+
+@pytest.fixture(scope="module")
 def fam2(two_dof):
     """The paper's Fig. 2 families (k = 2)."""
     return bc.nonsmooth_mode(two_dof, 2, (3.0, 14.5), scan=24)
@@ -237,8 +252,8 @@ KIPP_CASES = [(2, T) for T in (3.3, 6.3, 9.1, 12.7, 14.2)] + [(3, T) for T in (4
 
 
 @pytest.mark.parametrize("k, T", KIPP_CASES)
-def test_orbits_kipp_solve_the_equations(two_dof, k, T):
-    orbits = bc.orbits_kipp(two_dof, T, k)
+def test_orbits_kipp_solve_the_equations(two_dof, kipp_at, k, T):
+    orbits = kipp_at(T, k)
     assert orbits, "at least the equally spaced (repeated) solution exists"
     for o in orbits:
         assert o.k == k and o.T == T and o.impact_times[-1] == T
@@ -288,8 +303,8 @@ K3_EQUAL_MISSED = (7.25, 10.85)  # regression: missed by the multistart before 3
 
 
 @pytest.mark.parametrize("T", [4.0, 6.05, 9.1, 12.7, 13.85, *K3_EQUAL_MISSED])
-def test_k3_equally_spaced_is_repeated_1ipp(two_dof, T):
-    orbits = bc.orbits_kipp(two_dof, T, 3)
+def test_k3_equally_spaced_is_repeated_1ipp(two_dof, kipp_at, T):
+    orbits = kipp_at(T, 3)
     eq = [o for o in orbits if np.abs(o.impact_times - T * np.array([1, 2, 3]) / 3).max() <= 1e-10 * T]
     assert len(eq) == 1
     assert eq[0].repeats == 3
@@ -306,8 +321,8 @@ def _find(orbits, times, impulses, T, rtol=1e-8):
 
 
 @pytest.mark.parametrize("T", [6.0, 6.5])
-def test_k4_repeated_orbits_are_found_and_flagged(two_dof, T):
-    orbits = bc.orbits_kipp(two_dof, T, 4)
+def test_k4_repeated_orbits_are_found_and_flagged(two_dof, kipp_at, T):
+    orbits = kipp_at(T, 4)
     for o in orbits:
         r_pi, r_sg = residuals(two_dof, o)
         assert r_pi <= 1e-10 and r_sg <= 1e-10
@@ -382,8 +397,8 @@ def test_multistart_finds_well_resolved_solutions(two_dof, k, T, times_over_T, a
 # Regression (fixed in 3fb26e6): canonical_rotation compared rotated time tuples exactly, so orbits with
 # an interval pattern (a, a, b) (t₁ tied up to round-off between two rotations) were returned twice.
 @pytest.mark.parametrize("k, T", [(3, 9.1), (3, 12.7), (4, 6.3)])
-def test_orbits_kipp_returns_each_orbit_once(two_dof, k, T):
-    orbits = bc.orbits_kipp(two_dof, T, k)
+def test_orbits_kipp_returns_each_orbit_once(kipp_at, k, T):
+    orbits = kipp_at(T, k)
     dups = [(a.impact_times, b.impact_times) for i, a in enumerate(orbits) for b in orbits[i + 1:]
             if same_orbit(a, b, 1e-7)]
     assert not dups
