@@ -487,7 +487,11 @@ def lowest_modes(
         if sparse and n > DENSE_LIMIT:
             raise ValueError(f"lowest_modes: {count} of the {n} modes of {name} need a dense eigen-solution, "
                              f"limited to DENSE_LIMIT = {DENSE_LIMIT} rows (the sparse solver gives at most {n - 1})")
-        lam, phi = sla.eigh(_dense(K), _dense(M), subset_by_index=[0, count - 1])
+        if count > n // 4:  # all pairs by divide and conquer: several times faster than the subset driver here
+            lam, phi = sla.eigh(_dense(K), _dense(M), driver="gvd")
+            lam, phi = lam[:count], phi[:, :count]
+        else:
+            lam, phi = sla.eigh(_dense(K), _dense(M), subset_by_index=[0, count - 1])
     else:
         if count >= n:
             raise ValueError(f"count = {count}: the sparse eigen-solver gives at most {n - 1} of the {n} modes of "
