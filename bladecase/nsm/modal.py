@@ -23,7 +23,7 @@ True
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cache, cached_property
 
 import numpy as np
 
@@ -358,6 +358,14 @@ def _levenberg_marquardt(kernel: ModalKernel, times0: np.ndarray, lam0: np.ndarr
 # -- many periods at once ----------------------------------------------------------------------------------
 
 
+@cache
+def _upper_pairs(k: int) -> tuple[np.ndarray, np.ndarray]:
+    """``np.triu_indices(k, 1)``, made once per ``k`` (read-only)."""
+    iu, ju = np.triu_indices(k, 1)
+    iu.flags.writeable = ju.flags.writeable = False
+    return iu, ju
+
+
 def impact_kernels(omega: np.ndarray, b: np.ndarray, times: np.ndarray, derivatives: bool = False,
                    T: np.ndarray | None = None):
     """The kernel sums at the delays ``D_ij = (t_i - t_j) mod T`` of many impact patterns at once.
@@ -382,7 +390,7 @@ def impact_kernels(omega: np.ndarray, b: np.ndarray, times: np.ndarray, derivati
     half = np.multiply.outer(T / 2, omega)
     sh, ch = np.sin(half), np.cos(half)
     c = b**2 / (2 * sh)  # (B, m)
-    iu, ju = np.triu_indices(k, 1)
+    iu, ju = _upper_pairs(k)
     D = np.mod(times[:, iu] - times[:, ju], T[:, None])  # (B, P): the delays above the diagonal
     ph = (D - (T / 2)[:, None])[:, :, None] * omega
     cp, sp = np.cos(ph), np.sin(ph)
