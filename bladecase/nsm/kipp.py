@@ -12,7 +12,8 @@ from itertools import combinations
 
 import numpy as np
 
-from .modal import ModalKernel, check_period, impulses_for, newton_times, solve_times
+from .continuation import lstsq_stack
+from .modal import ModalKernel, _newton_stack, check_period, impact_kernels, impulses_for, solve_times
 from .orbits import REPEAT_RTOL, PeriodicOrbit, make_orbit, orbit_1ipp
 from .signals import TrigSum, all_roots
 from .system import LinearSystem
@@ -207,10 +208,12 @@ def _multistart(md: ModalKernel, k: int, d: float, resolution: int | None) -> li
     # costlier) from the seeds and the promising cells.
     for times0 in seeds + candidates:
         keep(solve_times(md, np.asarray(times0, dtype=float), d))
-    for times0 in starts:
-        lam0 = impulses_for(md, times0, d)
-        if lam0 is not None:
-            keep(newton_times(md, times0, lam0, d))
+    # every cell's Newton at once (newton_times vectorised), kept in the order of the cells
+    lam0 = lstsq_stack(-impact_kernels(md.omega, md.b, starts)[0], np.full(starts.shape, d), rcond=1e-12)
+    rows = np.flatnonzero(np.all(np.isfinite(lam0), axis=1))
+    times, lam, ok = _newton_stack(md.omega, md.b, np.full(rows.size, T), starts[rows], lam0[rows], d)
+    for j in np.flatnonzero(ok):
+        keep((times[j], lam[j]))
     return found
 
 
