@@ -259,6 +259,18 @@ def test_make_orbits_is_make_orbit(five_dof, k):
     assert [o.repeats for o in alone] == [o.repeats for o in one]
     np.testing.assert_allclose([o.energy for o in alone], [o.energy for o in one], rtol=0, atol=0)
     assert make_orbits(five_dof, [], np.zeros((0, k)), np.zeros((0, k))) == []
+    # a suspected violation checked first (the probe of the arc-end bisection): the same verdicts as make_orbit's
+    # probe and as no probe at all, a refuted orbit's probed violation the same as make_orbit's
+    bad = [o for o in one if not o.admissible and o.max_violation > 0]
+    probe = np.array([np.nan if o.admissible else o.max_violation_time for o in one])
+    probe[1::2] = bad[0].max_violation_time  # elsewhere for half of them: misses as well as hits
+    probed = make_orbits(five_dof, T, times, lam, probe=probe)
+    alone = [make_orbit(five_dof, *args, polish=False, probe=None if np.isnan(p) else p)
+             for *args, p in zip(T, times, lam, probe)]
+    assert [o.admissible for o in probed] == [o.admissible for o in alone] == [o.admissible for o in one]
+    np.testing.assert_allclose([o.max_violation for o in probed], [o.max_violation for o in alone], rtol=1e-12,
+                               atol=1e-14)
+    assert sum(o.max_violation < w.max_violation for o, w in zip(probed, one)) >= 3  # some refuted by the probe
 
 
 def test_bisect_ends_is_bisect_end(five_dof):

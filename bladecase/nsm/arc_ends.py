@@ -50,6 +50,7 @@ def bisect_ends(ends: list[tuple], rtol: float) -> list[tuple[float, bool]]:
     Zin = np.array([e[1] for e in ends], dtype=float)
     Zout = np.array([e[2] for e in ends], dtype=float)
     live, done = np.ones(n, dtype=bool), np.zeros(n, dtype=bool)
+    phase = np.full(n, np.nan)  # where (over T) the bracket's last refuted midpoint violated: checked first
     for _ in range(MAX_STEPS + 1):
         T_in, T_out = Zin[:, -1] * T0, Zout[:, -1] * T0
         near = np.abs(T_out - T_in) <= rtol * np.abs(T_in)
@@ -63,7 +64,8 @@ def bisect_ends(ends: list[tuple], rtol: float) -> list[tuple[float, bool]]:
         rows, Zm = rows[ok], Zm[ok]
         if rows.size == 0:
             continue
-        inside = _admissible(system, d, Zm * T0[rows, None])
+        inside, seen = _admissible(system, d, Zm * T0[rows, None], phase[rows])
+        phase[rows] = np.where(np.isnan(seen), phase[rows], seen)
         Zin[rows[inside]] = Zm[inside]
         Zout[rows[~inside]] = Zm[~inside]
     return [(float(Zin[i, -1] * T0[i]), bool(done[i])) for i in range(n)]
@@ -104,14 +106,19 @@ def _regular(system, T: float) -> bool:
     return True
 
 
-def _admissible(system, d: float, times: np.ndarray) -> np.ndarray:
-    """Admissibility of the orbits at the impact times ``times`` (rows; impulses ``Λ = d Σ⁻¹1``), certified."""
+def _admissible(system, d: float, times: np.ndarray, phase: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Admissibility of the orbits at the impact times ``times`` (rows; impulses ``Λ = d Σ⁻¹1``), certified, a
+    violation first looked for at ``phase·T`` (NaN: nowhere; the probe of :func:`_bisect_end`); and where
+    (over ``T``) each refuted orbit was seen to violate the constraint (NaN: admissible, or not seen)."""
     omega, b, _ = system.spectrum.contact_modes
     lam = d * solve_stack(-impact_kernels(omega, b, times)[0], np.ones(times.shape))
-    out = np.zeros(len(times), dtype=bool)
+    out, seen = np.zeros(len(times), dtype=bool), np.full(len(times), np.nan)
     rows = np.flatnonzero(np.all(np.isfinite(lam), axis=1) & np.all(np.isfinite(times), axis=1))
-    out[rows] = [o.admissible for o in make_orbits(system, times[rows, -1], times[rows], lam[rows])]
-    return out
+    T = times[rows, -1]
+    for j, o in zip(rows, make_orbits(system, T, times[rows], lam[rows], probe=phase[rows] * T)):
+        out[j], where = o.admissible, None if o.admissible else _violation_phase(o)
+        seen[j] = np.nan if where is None else where
+    return out, seen
 
 
 def _bisect_end(problem, z_in, z_out, orbit_out: PeriodicOrbit | None = None, rtol: float = 1e-9

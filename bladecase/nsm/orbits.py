@@ -17,7 +17,7 @@ from functools import cached_property
 import numpy as np
 
 from .modal import RESONANCE_RTOL, ModalKernel, check_period, impact_matrices
-from .signals import TrigSum, certified_max, certified_max_stack, sincos
+from .signals import POINTS_PER_PERIOD, TrigSum, certified_max, certified_max_stack, sincos
 from .system import LinearSystem
 
 __all__ = [
@@ -312,10 +312,13 @@ def make_orbit(
     )
 
 
-def make_orbits(system: LinearSystem, T, impact_times, impulses, certify: bool = True) -> list[PeriodicOrbit]:
+def make_orbits(system: LinearSystem, T, impact_times, impulses, certify: bool = True, probe=None
+                ) -> list[PeriodicOrbit]:
     """:func:`make_orbit` with ``polish=False`` of many orbits with ``k`` impacts at once (periods ``T``
     ``(B,)``, impact times and impulses ``(B, k)``): the energies, the flights' trigonometric sums and their
     certification (:func:`~bladecase.nsm.signals.certified_max_stack`) computed for all orbits together.
+    ``probe`` ``(B,)``: as in :func:`make_orbit`, a time per orbit where a violation is suspected (NaN: none),
+    checked first so that an orbit violated there is rejected without its flights' proofs.
 
     The same records as one :func:`make_orbit` call each: admissibility proved on every flight exactly as
     there (flight by flight, stopping at the first flight not proved admissible; ``max_violation`` of a
@@ -346,6 +349,8 @@ def make_orbits(system: LinearSystem, T, impact_times, impulses, certify: bool =
     worst_t = np.zeros(T.size)
     certified = np.full(T.size, certify) & np.all(lam >= 0, axis=1)
     c = -b**2 / (2 * omega * sh)
+    if probe is not None:
+        _refute_at(np.asarray(probe, dtype=float), omega, c, d, T, times, lam, certified, worst, worst_t)
     for i in range(times.shape[1]):  # flight by flight, the orbits not yet refuted
         rows = np.flatnonzero(certified)
         if rows.size == 0:
@@ -364,6 +369,32 @@ def make_orbits(system: LinearSystem, T, impact_times, impulses, certify: bool =
     return [PeriodicOrbit(system=system, T=float(T[i]), impact_times=times[i].copy(), impulses=lam[i].copy(),
                           energy=float(energy[i]), admissible=bool(certified[i]), max_violation=float(worst[i]),
                           max_violation_time=float(worst_t[i]), repeats=int(repeats[i])) for i in range(T.size)]
+
+
+def _refute_at(probe: np.ndarray, omega, c, d: float, T, times, lam, certified, worst, worst_t) -> None:
+    """The probe of :func:`make_orbit` for the orbits of :func:`make_orbits` still ``certified`` with a finite
+    ``probe``: the contact distance at 9 points within two grid steps of the probe time, in its flight; an orbit
+    violated there (beyond its flight's tolerance) is marked refuted, its largest probed violation recorded."""
+    rows = np.flatnonzero(certified & np.isfinite(probe))
+    if rows.size == 0:
+        return
+    k = times.shape[1]
+    at = np.mod(probe[rows], T[rows])
+    i = np.minimum((times[rows] <= at[:, None]).sum(axis=1), k - 1)  # the flight (searchsorted, side="right")
+    r = np.arange(rows.size)
+    start = np.where(i == 0, 0.0, times[rows, np.maximum(i - 1, 0)])
+    cs, sn = _impulse_phases(omega, T[rows], start, times[rows])
+    alpha = c[rows] * np.einsum("bmk,bk->bm", cs, lam[rows])
+    beta = -c[rows] * np.einsum("bmk,bk->bm", sn, lam[rows])
+    tol = np.maximum(ADMISSIBILITY_RTOL * d, 1e4 * np.finfo(float).eps * np.hypot(alpha, beta).sum(axis=1))
+    step = 2 * np.pi / (POINTS_PER_PERIOD * float(omega.max()))  # TrigSum.step
+    tau = np.clip((at - start)[:, None] + step * np.linspace(-2, 2, 9), 0, (times[rows, i] - start)[:, None])
+    ph = tau[:, :, None] * omega
+    vals = np.einsum("bjm,bm->bj", np.cos(ph), alpha) + np.einsum("bjm,bm->bj", np.sin(ph), beta) - d
+    j = np.argmax(vals, axis=1)
+    bad = vals[r, j] > tol
+    worst[rows[bad]], worst_t[rows[bad]] = vals[r, j][bad], (start + tau[r, j])[bad]
+    certified[rows[bad]] = False
 
 
 def _impulse_phases(omega: np.ndarray, T: np.ndarray, start: np.ndarray, times: np.ndarray
