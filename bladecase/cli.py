@@ -218,7 +218,7 @@ def _cmd_run(args) -> int:
 
 def _cmd_demo(args) -> int:
     from .io import check_output_dir
-    from .study.schema import demo_study, demo_text
+    from .study.demo import demo_study, demo_text
 
     if args.print_study:
         print(demo_text(), end="")

@@ -1,6 +1,7 @@
 """Studies — a TOML file run through every stage, on top of the library.
 
 - :mod:`~bladecase.study.schema` — the typed sections of a study file, validated with clear errors;
+- :mod:`~bladecase.study.demo` — the embedded demo study (``bladecase demo``);
 - :mod:`~bladecase.study.stages` — one plain function per stage (mesh, model, contact, reduced model, search);
 - :mod:`~bladecase.study.choose` — which orbits to animate, and their frames;
 - :mod:`~bladecase.study.render` — each chosen orbit checked and handed to the output writers;
@@ -12,9 +13,10 @@
 The command line (:mod:`bladecase.cli`) is a thin layer over this package.
 """
 
+from .demo import demo_study
 from .executor import DaskExecutor, Executor, ProcessExecutor, SerialExecutor, keyword_task, make_executor
 from .run import RunResult, run
-from .schema import Study, StudyError, demo_study, load_study
+from .schema import Study, StudyError, load_study
 
 __all__ = ["DaskExecutor", "Executor", "ProcessExecutor", "RunResult", "SerialExecutor", "Study", "StudyError",
            "demo_study", "keyword_task", "load_study", "make_executor", "run"]
