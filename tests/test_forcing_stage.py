@@ -7,7 +7,7 @@ import csv
 
 import numpy as np
 import pytest
-from _studies import PLATE, absolute
+from _studies import PLATE, ROOT, absolute
 
 from bladecase.nsm import chain
 from bladecase.nsm.forced import Damping
@@ -179,8 +179,10 @@ def test_a_study_with_forcing_writes_the_forced_response_and_animates_a_steady_s
     from bladecase.study import run
     from bladecase.study.schema import loads
 
+    # [output] animate = 0: no nonsmooth mode animated (not asserted; tests/test_pipeline.py animates them); the
+    # forced state is still animated ([forcing] animate = 1 by default), in a small window: its GIF is only sized
     text = PLATE.replace("size = 10", "size = 4") + (
-        '\n[output]\nformats = ["png", "gif"]\nanimate = 1\nreference = false\nframes = 6\n'
+        '\n[output]\nformats = ["png", "gif"]\nanimate = 0\nwindow = [160, 120]\nreference = false\nframes = 6\n'
         '[forcing]\nratio = 0.03\namplitude = 900.0\nfrequencies = [0.9, 1.1]\npoints = 7\nperiods = 150\n'
         'direction = "up"\n')
     result = run(loads(text, base=ROOT), out=tmp_path / "out", progress=False)
@@ -197,19 +199,49 @@ def test_a_study_with_forcing_writes_the_forced_response_and_animates_a_steady_s
     assert "## Forced response" in (out / "report.md").read_text()
 
 
-def test_a_massless_study_with_forcing(tmp_path):
+#: The plate with the massless contact model, forced hard enough to touch the casing near resonance.
+MASSLESS_FORCED = PLATE.replace("size = 10", "size = 4").replace("[contact]\n", '[contact]\nmodel = "massless"\n'
+                                                                 ).replace('method = "modal"', 'method = "massless"'
+                                                                           ).replace("periods = [0.5, 0.9999]",
+                                                                                     "periods = [0.8, 1.001]") + (
+    '\n[output]\nformats = ["png", "gif"]\nanimate = 1\nwindow = [160, 120]\nreference = false\nframes = 6\n'
+    'manifold = false\n[forcing]\nratio = 0.03\namplitude = 900.0\nfrequencies = [0.9, 1.1]\npoints = 5\n'
+    'periods = 100\n')
+
+
+@pytest.fixture(scope="module")
+def massless_forced_run(tmp_path_factory):
+    """``(RunResult, forced steady states)`` of the massless forced plate study run once through
+    bladecase.study.run; the run drops the steady states (:class:`ForcedOrbit`) from its summary, so the
+    forcing stage's answer is kept on its way.  A massless mode is animated too (the render path of contact
+    phases), in a small window: the GIFs are only sized."""
+    import importlib
+
+    from bladecase.study import run
+
+    run_module = importlib.import_module("bladecase.study.run")  # (bladecase.study.run is the function)
+    kept = []
+    real = run_module.forced_response
+
+    def keep(*args, **kwargs):
+        section = real(*args, **kwargs)
+        kept.append(section["orbits"])
+        return section
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(run_module, "forced_response", keep)
+        result = run(loads(MASSLESS_FORCED, base=ROOT), out=tmp_path_factory.mktemp("massless") / "out",
+                     progress=False)
+    assert len(kept) == 1
+    return result, kept[0]
+
+
+def test_a_massless_study_with_forcing(massless_forced_run):
     """[forcing] with [contact] model = "massless" through bladecase.study.run: the steady states with contact
     phases are re-simulated back to themselves and one is animated; restitution is refused by the schema."""
-    from _studies import PLATE, ROOT
+    from bladecase.study import StudyError
 
-    from bladecase.study import StudyError, run
-    from bladecase.study.schema import loads
-
-    text = PLATE.replace("size = 10", "size = 4").replace("[contact]\n", '[contact]\nmodel = "massless"\n').replace(
-        'method = "modal"', 'method = "massless"').replace("periods = [0.5, 0.9999]", "periods = [0.8, 1.001]") + (
-        '\n[output]\nformats = ["png", "gif"]\nanimate = 1\nreference = false\nframes = 6\nmanifold = false\n'
-        '[forcing]\nratio = 0.03\namplitude = 900.0\nfrequencies = [0.9, 1.1]\npoints = 5\nperiods = 100\n')
-    result = run(loads(text, base=ROOT), out=tmp_path / "out", progress=False)
+    result, _ = massless_forced_run
     pts = result.summary["forcing"]["points"]
     touching = [i for i, lab in enumerate(pts["label"]) if "/" in lab and not lab.startswith("0/")]
     assert touching, pts["label"]
@@ -217,31 +249,26 @@ def test_a_massless_study_with_forcing(tmp_path):
     anim = result.summary["files"]["forced_animations"]
     assert len(anim) == 1 and (result.directory / anim[0]["gif"]).stat().st_size > 1000
     with pytest.raises(StudyError, match="restitution: Newton's contact model only"):
-        loads(text + "restitution = 0.9\n", base=ROOT)
+        loads(MASSLESS_FORCED + "restitution = 0.9\n", base=ROOT)
 
 
-def test_forced_massless_frames_hold_the_contact_at_the_casing():
+def test_forced_massless_frames_hold_the_contact_at_the_casing(massless_forced_run):
     """A load on the massless contact dofs moves them (F K_cc⁻¹f_c) and the multiplier: in every frame of the
     animated steady state the contact displacement wᵀx of the FE field stays at or below the gap, on it while
-    in contact (before the correction the frames were off by ~3 % of the gap)."""
-    from _studies import PLATE, ROOT
+    in contact (before the correction the frames were off by ~3 % of the gap).
 
-    from bladecase.fe import stiffness_factor
-    from bladecase.study.forcing import forced_response, forced_scene
-    from bladecase.study.schema import loads
-    from bladecase.study.stages import build_contact, build_mesh, build_model, build_reduced
-
-    text = PLATE.replace("size = 10", "size = 4").replace("[contact]\n", '[contact]\nmodel = "massless"\n').replace(
-        'method = "modal"', 'method = "massless"').replace("periods = [0.5, 0.9999]", "periods = [0.8, 1.001]") + (
-        '\n[output]\nformats = []\nanimate = 1\nreference = false\nframes = 24\n'
-        '[forcing]\nratio = 0.03\namplitude = 900.0\nfrequencies = [0.9, 1.1]\npoints = 5\nperiods = 100\n')
-    study = loads(text, base=ROOT)
-    model = build_model(study, build_mesh(study))
-    contact = build_contact(study, model)
-    reduced = build_reduced(study, model, contact, factor=stiffness_factor(model))
-    section = forced_response(reduced, [], study["forcing"])
-    orbits = section.pop("orbits")
-    pick = next(i for i, lab in enumerate(section["points"]["label"])
+    The steady states are the forcing stage's of the study run above (its reduced model: the FE model's
+    stiffness factor, as the stages build it); the frames are drawn here, 24 of them."""
+    result, orbits = massless_forced_run
+    study = loads(MASSLESS_FORCED.replace('formats = ["png", "gif"]', "formats = []").replace(
+        "frames = 6", "frames = 24"), base=ROOT)
+    assert study["output"]["frames"] == 24
+    reduced = next(iter(result.models.values())).reduced
+    model, contact = reduced.model, reduced.contact
+    assert reduced.method == "massless" and reduced.size == 4
+    labels = result.summary["forcing"]["points"]["label"]
+    assert len(orbits) == len(labels)
+    pick = next(i for i, lab in enumerate(labels)
                 if "/" in lab and not lab.startswith("0/") and orbits[i] is not None)
     scene = forced_scene(study, reduced, orbits[pick], "s")
     w = contact.w(model)

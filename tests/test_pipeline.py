@@ -16,8 +16,11 @@
 
 from __future__ import annotations
 
+import contextlib
 import copy
+import io
 import json
+import shutil
 from pathlib import Path
 
 import imageio.v3 as iio
@@ -243,10 +246,27 @@ def plate_study(tmp_path_factory):
     return f
 
 
-def test_user_mesh_study_cli(plate_study, tmp_path, capsys):
-    out = tmp_path / "run"
-    assert main(["run", str(plate_study), "--out", str(out), "--quiet", "--no-progress"]) == 0
-    assert capsys.readouterr().out.strip() == str(out / "report.md")
+@pytest.fixture(scope="module")
+def plate_cli_run(plate_study, tmp_path_factory):
+    """``(results folder, exit code, stdout)`` of ``bladecase run`` on the plate study, run once for the module:
+    the tests about what a later run does to existing results start from a copy of this folder."""
+    out = tmp_path_factory.mktemp("plate_cli") / "run"
+    with contextlib.redirect_stdout(io.StringIO()) as stdout:
+        code = main(["run", str(plate_study), "--out", str(out), "--quiet", "--no-progress"])
+    return out, code, stdout.getvalue()
+
+
+def _copy_of(results: Path, tmp_path: Path) -> Path:
+    """A copy of a published results folder (the previous results a new run finds)."""
+    out = tmp_path / "out"
+    shutil.copytree(results, out)
+    return out
+
+
+def test_user_mesh_study_cli(plate_study, plate_cli_run, tmp_path):
+    out, code, stdout = plate_cli_run
+    assert code == 0
+    assert stdout.strip() == str(out / "report.md")
     s = json.loads((out / "summary.json").read_text())
     assert s["model"]["dim"] == 2 and s["model"]["dofs"] == 1084
     assert s["model"]["mesh"]["source"].endswith("plate.vtu")
@@ -296,10 +316,12 @@ def test_stage_modes_from_user_matrices(plate_study, tmp_path):
     assert data["system_dofs"] == 3 and data["families"][0]["ipp"] == 1
 
 
-def test_failed_run_keeps_previous_results(plate_study, tmp_path, monkeypatch):
-    st = loads(plate_study.read_text(), base=plate_study.parent)
-    out = tmp_path / "out"
-    pipeline.run(st, out=out, progress=False)
+def test_failed_run_keeps_previous_results(plate_study, plate_cli_run, tmp_path, monkeypatch):
+    # the failing run: the plate study without its figures (png), which it would draw before it renders
+    text = plate_study.read_text()
+    assert 'formats = ["gif", "vtu", "png"]' in text
+    st = loads(text.replace('formats = ["gif", "vtu", "png"]', 'formats = ["gif", "vtu"]'), base=plate_study.parent)
+    out = _copy_of(plate_cli_run[0], tmp_path)  # the previous results: the plate study, run once for the module
     before = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
     from bladecase.post import animation as viz
 
@@ -336,13 +358,13 @@ def test_model_and_reduced_files_round_trip(tmp_path):
         load_model(tmp_path / "r.npz")
 
 
-def test_rerun_replaces_results_and_drops_stale_ones(plate_study, tmp_path):
+def test_rerun_replaces_results_and_drops_stale_ones(plate_study, plate_cli_run, tmp_path):
     st = loads(plate_study.read_text(), base=plate_study.parent)
-    out = tmp_path / "out"
-    pipeline.run(st, out=out, progress=False)
+    out = _copy_of(plate_cli_run[0], tmp_path)  # the first run's results (every format, the comparison figures)
     (out / "notes.txt").write_text("mine")  # a user's file: never touched
     raw = copy.deepcopy(st.config)
-    raw["output"]["formats"] = ["gif"]
+    # 2 frames of 64×64: the test is about which results the rerun leaves, not about the frames
+    raw["output"].update(formats=["gif"], frames=2, window=[64, 64])
     raw = as_raw(raw)
     raw["mesh"]["path"] = str(st.mesh_path())
     pipeline.run(validate(raw), out=out, progress=False)
@@ -417,7 +439,12 @@ def test_run_changes_no_global_state(plate_study, tmp_path):
     import subprocess
     import sys
 
-    proc = subprocess.run([sys.executable, "-c", NO_SIDE_EFFECTS, str(plate_study), str(tmp_path / "out")],
+    # the plate study with 2 frames of 64×64 (every stage and format runs; the frames are not what is checked)
+    study = tmp_path / "plate.toml"
+    study.write_text(plate_study.read_text().replace("frames = 10", "frames = 2").replace("window = [240, 180]",
+                                                                                           "window = [64, 64]"))
+    assert "frames = 2" in study.read_text() and "window = [64, 64]" in study.read_text()
+    proc = subprocess.run([sys.executable, "-c", NO_SIDE_EFFECTS, str(study), str(tmp_path / "out")],
                           capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
     handlers_kept, backend_kept, figures, infos = proc.stdout.split()
@@ -431,7 +458,10 @@ def test_library_code_never_uses_pyplot_or_switches_backend():
 
     offenders = []
     for path in sorted((Path(bc.__file__).parent).rglob("*.py")):
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        text = path.read_text(encoding="utf-8")
+        if "matplotlib" not in text:  # no pyplot import, no matplotlib.use without the word: nothing to parse
+            continue
+        for node in ast.walk(ast.parse(text)):
             names = ([a.name for a in node.names] if isinstance(node, ast.Import) else
                      [f"{node.module}.{a.name}" for a in node.names] if isinstance(node, ast.ImportFrom) else [])
             if any(n.startswith("matplotlib.pyplot") for n in names):
