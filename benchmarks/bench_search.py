@@ -41,7 +41,9 @@ the batched kernel sums (chain50 median 11.5 -> 9.8, demo32 84 -> 78) were not k
 demo32 one family fewer; docs/performance.md has the analysis.  Third pass: the corrector's round-off floor
 (a fix: chain50 356 -> 371 arcs, none lost), then those half-angle sines (identical families under it),
 then k = 2 fixed-period solves by the scalar equation (``solve_pairs``): interleaved, chain50 12.2 -> 9.9,
-demo8 3.08 -> 2.11, demo32 92 -> 50 (loaded machine).
+demo8 3.08 -> 2.11, demo32 92 -> 50 (loaded machine).  Fourth pass (families, spans and arcs identical):
+stacked matches in the de-duplication, the corrector's closed-form 3×2 least squares for big stacks, the arc-end
+probe; medians of 5 interleaved runs chain20 4.75 -> 3.99, chain50 9.60 -> 8.41, demo8 2.23 -> 1.98.
 
 With ``--compare`` each case also reports the arcs of before inside no arc of after (and the reverse) and how
 many middle orbits of the arcs of before lie on no family of after (re-solved from every new family,
