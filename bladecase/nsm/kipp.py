@@ -208,12 +208,15 @@ def _multistart(md: ModalKernel, k: int, d: float, resolution: int | None) -> li
     # costlier) from the seeds and the promising cells.
     for times0 in seeds + candidates:
         keep(solve_times(md, np.asarray(times0, dtype=float), d))
-    # every cell's Newton at once (newton_times vectorised), kept in the order of the cells
-    lam0 = lstsq_stack(-impact_kernels(md.omega, md.b, starts)[0], np.full(starts.shape, d), rcond=1e-12)
-    rows = np.flatnonzero(np.all(np.isfinite(lam0), axis=1))
-    times, lam, ok = _newton_stack(md.omega, md.b, np.full(rows.size, T), starts[rows], lam0[rows], d)
-    for j in np.flatnonzero(ok):
-        keep((times[j], lam[j]))
+    # every cell's Newton at once (newton_times vectorised), kept in the order of the cells; in chunks of about
+    # 2e6 kernel terms (k(k-1)/2 delays × modes per cell) to bound the memory
+    chunk = max(256, 2_000_000 // max(1, k * (k - 1) // 2 * md.omega.size))
+    for part in np.array_split(starts, -(-len(starts) // chunk)):
+        lam0 = lstsq_stack(-impact_kernels(md.omega, md.b, part)[0], np.full(part.shape, d), rcond=1e-12)
+        rows = np.flatnonzero(np.all(np.isfinite(lam0), axis=1))
+        times, lam, ok = _newton_stack(md.omega, md.b, np.full(rows.size, T), part[rows], lam0[rows], d)
+        for j in np.flatnonzero(ok):
+            keep((times[j], lam[j]))
     return found
 
 
