@@ -285,15 +285,18 @@ def lstsq_stack(A: np.ndarray, b: np.ndarray, rcond: float | None = None) -> np.
 LSTSQ2_MIN_ROWS = 48
 
 
-def lstsq2_stack(A: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """:func:`lstsq_stack` for two unknowns (``A`` ``(B, M, 2)``, ``M >= 2``) by two Householder reflections in
-    closed form, vectorised over the stack (backward stable, as LAPACK's QR); rows that are rank deficient to
-    within ``100 ε`` are left to :func:`lstsq_stack` (its rank cut-off); rows with non-finite entries come back NaN.
+def lstsq2_stack(A: np.ndarray, b: np.ndarray, min_rows: int = LSTSQ2_MIN_ROWS) -> np.ndarray:
+    """:func:`lstsq_stack` for two unknowns (``A`` ``(B, M, 2)``, ``M >= 2``): stacks of at least ``min_rows``
+    by two Householder reflections in closed form, vectorised (backward stable, as LAPACK's QR), smaller ones by
+    :func:`lstsq_stack` (faster there).  Rows rank deficient to within ``100 ε`` are left to :func:`lstsq_stack`
+    (its rank cut-off); rows with non-finite entries come back NaN.
 
     >>> A = np.array([[[1.0, 0.0], [0.0, 2.0], [0.0, 0.0]], [[1.0, 1.0], [1.0, 1.0], [0.0, 0.0]]])
-    >>> lstsq2_stack(A, np.array([[1.0, 2.0, 3.0], [2.0, 2.0, 0.0]])).round(12).tolist()
+    >>> lstsq2_stack(A, np.array([[1.0, 2.0, 3.0], [2.0, 2.0, 0.0]]), min_rows=0).round(12).tolist()
     [[1.0, 1.0], [1.0, 1.0]]
     """
+    if len(A) < min_rows:
+        return lstsq_stack(A, b)
     a1, a2, y = A[:, :, 0], A[:, :, 1].copy(), np.array(b, dtype=float)
     with np.errstate(all="ignore"):
         n1 = np.sqrt(np.einsum("bi,bi->b", a1, a1))
@@ -382,7 +385,7 @@ def correct_stack(curve: BatchCurve, ZP: np.ndarray, D: np.ndarray, idx: np.ndar
             dz = -(P @ r[:, :, None])[:, :, 0]
         else:
             A = np.concatenate([Jz, d[:, None, :]], axis=1)
-            dz = lstsq2_stack(A, -r) if A.shape[2] == 2 and len(A) >= LSTSQ2_MIN_ROWS else lstsq_stack(A, -r)
+            dz = lstsq2_stack(A, -r) if A.shape[2] == 2 else lstsq_stack(A, -r)
         Z = Z + dz
         checking = np.abs(dz).max(axis=1) < curve.step_tol
         checking[~np.isfinite(dz).all(axis=1)] = False  # a failed solve: maxiter iterations, no convergence

@@ -30,7 +30,7 @@ from .coverage import (  # noqa: F401 (PASS_GATE, passes, phase_distance(s), sta
 )
 from .families import FamilyTracer, complete_families
 from .kipp import canonical_rotation, check_k, orbits_kipp
-from .modal import ModalKernel, solve_pairs, solve_times
+from .modal import solve_times_stack
 from .orbits import REPEAT_RTOL, PeriodicOrbit
 from .system import LinearSystem
 
@@ -348,26 +348,9 @@ def _matches(curve: list[PeriodicOrbit], orbits: list[PeriodicOrbit], allowed: n
             break
         j = order[rows, r]
         T = Q[rows, 0]
-        for i, jj, sol in zip(rows, j, _solve_candidates(system, T, guess[rows, j], system.gap)):
+        times0 = np.column_stack([guess[rows, j] * T[:, None], T])
+        for i, jj, sol in zip(rows, j, solve_times_stack(system, T, times0, system.gap)):
             if sol is not None and np.abs(canonical_rotation(sol[0], sol[1], Q[i, 0])[0][:-1] / Q[i, 0]
                                           - Q[i, 1:]).max() <= SAME_RTOL:
                 hit[i] = jj
     return hit
-
-
-def _solve_candidates(system: LinearSystem, T: np.ndarray, guess: np.ndarray, d: float) -> list:
-    """:func:`~bladecase.nsm.modal.solve_times` at periods ``T`` from canonical times ``guess`` (``(B, k-1)``, over
-    ``T``) for every row: for ``k = 2`` the scalar solves of all rows at once (:func:`solve_times` tries them
-    first), :func:`solve_times` itself where they fail."""
-    out: list = [None] * len(T)
-    rest = range(len(T))
-    if guess.shape[1] == 1:
-        omega, b, _ = system.spectrum.contact_modes
-        times, lam = solve_pairs(omega, b, T, guess[:, 0] * T, d)
-        good = np.isfinite(times[:, 0])
-        for i in np.flatnonzero(good):
-            out[i] = (times[i], lam[i])
-        rest = np.flatnonzero(~good)
-    for i in rest:
-        out[i] = solve_times(ModalKernel.of(system, T[i]), np.append(guess[i], 1.0) * T[i], d)
-    return out

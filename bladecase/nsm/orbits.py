@@ -356,10 +356,7 @@ def make_orbits(system: LinearSystem, T, impact_times, impulses, certify: bool =
         if rows.size == 0:
             break
         start = np.zeros(rows.size) if i == 0 else times[rows, i - 1]
-        cs, sn = _impulse_phases(omega, T[rows], start, times[rows])
-        alpha = c[rows] * np.einsum("bmk,bk->bm", cs, lam[rows])
-        beta = -c[rows] * np.einsum("bmk,bk->bm", sn, lam[rows])
-        tol = np.maximum(ADMISSIBILITY_RTOL * d, 1e4 * np.finfo(float).eps * np.hypot(alpha, beta).sum(axis=1))
+        alpha, beta, tol = _flight_sums(omega, c[rows], d, T[rows], start, times[rows], lam[rows])
         value, where, _, ok = certified_max_stack(alpha, beta, omega, np.full(rows.size, -d),
                                                   times[rows, i] - start, tol, ends_at_zero=True)
         raise_ = value > worst[rows]
@@ -383,10 +380,7 @@ def _refute_at(probe: np.ndarray, omega, c, d: float, T, times, lam, certified, 
     i = np.minimum((times[rows] <= at[:, None]).sum(axis=1), k - 1)  # the flight (searchsorted, side="right")
     r = np.arange(rows.size)
     start = np.where(i == 0, 0.0, times[rows, np.maximum(i - 1, 0)])
-    cs, sn = _impulse_phases(omega, T[rows], start, times[rows])
-    alpha = c[rows] * np.einsum("bmk,bk->bm", cs, lam[rows])
-    beta = -c[rows] * np.einsum("bmk,bk->bm", sn, lam[rows])
-    tol = np.maximum(ADMISSIBILITY_RTOL * d, 1e4 * np.finfo(float).eps * np.hypot(alpha, beta).sum(axis=1))
+    alpha, beta, tol = _flight_sums(omega, c[rows], d, T[rows], start, times[rows], lam[rows])
     step = 2 * np.pi / (POINTS_PER_PERIOD * float(omega.max()))  # TrigSum.step
     tau = np.clip((at - start)[:, None] + step * np.linspace(-2, 2, 9), 0, (times[rows, i] - start)[:, None])
     ph = tau[:, :, None] * omega
@@ -395,6 +389,17 @@ def _refute_at(probe: np.ndarray, omega, c, d: float, T, times, lam, certified, 
     bad = vals[r, j] > tol
     worst[rows[bad]], worst_t[rows[bad]] = vals[r, j][bad], (start + tau[r, j])[bad]
     certified[rows[bad]] = False
+
+
+def _flight_sums(omega, c, d: float, T, start, times, lam) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The flights from ``start`` of many orbits: the contact distance ``-d + Σ α cos(ωτ) + β sin(ωτ)`` at
+    ``τ`` after ``start`` as ``(α, β)`` ``(B, m)``, and each flight's admissibility tolerance ``(B,)``
+    (``c = -b²/(2ω sin(ωT/2))`` per orbit)."""
+    cs, sn = _impulse_phases(omega, T, start, times)
+    alpha = c * np.einsum("bmk,bk->bm", cs, lam)
+    beta = -c * np.einsum("bmk,bk->bm", sn, lam)
+    tol = np.maximum(ADMISSIBILITY_RTOL * d, 1e4 * np.finfo(float).eps * np.hypot(alpha, beta).sum(axis=1))
+    return alpha, beta, tol
 
 
 def _impulse_phases(omega: np.ndarray, T: np.ndarray, start: np.ndarray, times: np.ndarray
