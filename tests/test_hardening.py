@@ -9,6 +9,7 @@ import json
 import math
 import os
 import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -265,15 +266,19 @@ def test_study_mesh_inside_a_result_folder_is_refused(tmp_path):
 
 def test_run_results_are_strict_json_and_leave_no_lock_or_staging(tmp_path, plate):
     out = tmp_path / "out"
-    (out / ".bladecase-run-killed").mkdir(parents=True)  # a staging folder of a killed run
-    (out / ".bladecase-run-killed" / "modes.json").write_text("half")
-    (out / ".vtk.old-abc").mkdir()  # a folder set aside by a killed publication
+    out.mkdir()
+    killed = pub.staging_dir(out)  # a staging folder of a killed run (signed token inside)
+    (killed / "modes.json").write_text("half")
+    pub.release(out)
+    (out / ".bladecase-run-mine").mkdir()  # the user's folders that only look like bladecase's
+    (out / ".vtk.old-2024").mkdir()
     bc.study.run(plate, out=out, progress=False)
     names = sorted(p.name for p in out.iterdir())
-    assert names == ["mesh.vtu", "modes.json", "report.md", "run.log", "summary.json"]
+    assert names == [".bladecase-manifest.json", ".bladecase-run-mine", ".vtk.old-2024", "mesh.vtu", "modes.json",
+                     "report.md", "run.log", "summary.json"]
     for name in ("modes.json", "summary.json"):
         _strict_load(out / name)
-    # a re-run into its own results is allowed (they are listed in summary.json)
+    # a re-run into its own results is allowed (the signed manifest lists them, unchanged)
     bc.study.run(plate, out=out, progress=False)
     assert sorted(p.name for p in out.iterdir()) == names
 
@@ -298,30 +303,43 @@ def test_second_run_into_a_locked_folder_is_refused_with_the_holders_pid(tmp_pat
         pub.staging_dir(out)
     (staging / "report.md").write_text("new")
     pub.publish(staging, out)
-    assert sorted(p.name for p in out.iterdir()) == ["report.md"]
+    assert sorted(p.name for p in out.iterdir()) == [pub.MANIFEST, "report.md"]
 
 
 def test_failed_run_frees_the_folder_for_the_next(tmp_path):
     out = tmp_path / "out"
     staging = pub.staging_dir(out)
-    staging.rmdir()  # the run failed and removed its staging (without release)
+    shutil.rmtree(staging)  # the run failed and removed its staging (without release)
     again = pub.staging_dir(out)
     pub.release(out)
-    again.rmdir()
+    shutil.rmtree(again)
     assert list(out.iterdir()) == []
 
 
-def test_publication_killed_half_way_is_finished_by_the_next_run(tmp_path, caplog):
+def test_publication_killed_half_way_is_finished_by_the_next_run(tmp_path, caplog, monkeypatch):
     out = tmp_path / "out"
-    out.mkdir()
-    (out / "modes.json").write_text("from the killed run")  # published, summary.json was not
-    (out / pub.MARKER).write_text(json.dumps(["modes.json", "summary.json"]))
+    staging = pub.staging_dir(out)
+    for name in ("modes.json", "summary.json"):
+        (staging / name).write_text(f"{name} of the killed run")
+    real = os.replace
+
+    def killed(src, dst):  # the process dies after its first move (SIGKILL: no clean-up runs)
+        real(src, dst)
+        raise SystemExit("killed")
+
+    monkeypatch.setattr(pub.os, "replace", killed)
+    with pytest.raises(SystemExit):
+        pub.publish(staging, out, pub.RUN_RESULTS)
+    monkeypatch.setattr(pub.os, "replace", real)
+    assert (out / pub.MARKER).exists() and staging.exists()
     with caplog.at_level("WARNING", logger="bladecase"):
-        staging = pub.staging_dir(out)
-    assert "interrupted while publishing" in caplog.text
-    (staging / "modes.json").write_text("new")
-    pub.publish(staging, out, pub.RUN_RESULTS)
-    assert sorted(p.name for p in out.iterdir()) == ["modes.json"] and (out / "modes.json").read_text() == "new"
+        again = pub.staging_dir(out)
+    assert "killed while publishing" in caplog.text
+    assert (out / "summary.json").read_text() == "summary.json of the killed run"  # finished, whole
+    (again / "modes.json").write_text("new")
+    pub.publish(again, out, pub.RUN_RESULTS)
+    assert sorted(p.name for p in out.iterdir()) == [pub.MANIFEST, "modes.json"]
+    assert (out / "modes.json").read_text() == "new"
 
 
 def test_ctrl_c_waits_until_every_entry_is_published(tmp_path, monkeypatch):
@@ -342,8 +360,9 @@ def test_ctrl_c_waits_until_every_entry_is_published(tmp_path, monkeypatch):
     monkeypatch.setattr(pub.os, "replace", replace)
     with pytest.raises(KeyboardInterrupt):
         pub.publish(staging, out, pub.RUN_RESULTS)
-    assert calls == ["modes.json", "report.md", "summary.json"]  # summary.json (the manifest) last
-    assert sorted(p.name for p in out.iterdir()) == ["modes.json", "report.md", "summary.json"]
+    assert calls[-2:] == ["summary.json", pub.MANIFEST]  # summary.json last, then the signed manifest
+    assert [c for c in calls if not c.startswith(".")] == ["modes.json", "report.md", "summary.json"]
+    assert sorted(p.name for p in out.iterdir()) == [pub.MANIFEST, "modes.json", "report.md", "summary.json"]
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
 
 

@@ -303,10 +303,13 @@ def test_backbone_refuses_work_out_of_proportion(capsys, args, words):
 # ----------------------------------------------------------------------------- interruptions
 
 def _fake_previous_results(out: Path) -> dict[str, bytes]:
-    out.mkdir()
-    (out / "summary.json").write_text(json.dumps({"bladecase_version": bc.__version__, "outputs": [
+    from bladecase.study import publish as pub
+
+    staging = pub.staging_dir(out)  # published by bladecase: listed in the signed manifest
+    (staging / "summary.json").write_text(json.dumps({"bladecase_version": bc.__version__, "outputs": [
         "summary.json", "report.md"]}))
-    (out / "report.md").write_text("# the previous report\n")
+    (staging / "report.md").write_text("# the previous report\n")
+    pub.publish(staging, out)
     (out / "notes.txt").write_text("mine")
     return {p.name: p.read_bytes() for p in out.iterdir()}
 

@@ -74,8 +74,8 @@ def test_demo_writes_every_file(demo_run):
         assert ("mp4" in a) == mp4_available()
         if "mp4" in a:
             assert (out / a["mp4"]).stat().st_size > 1000
-    # nothing hidden left behind (staging folders, temporary files)
-    assert not [p for p in out.rglob(".*")]
+    # nothing hidden left behind (staging folders, temporary files) but the signed manifest of the results
+    assert [p.name for p in out.rglob(".*")] == [".bladecase-manifest.json"]
     report = (out / "report.md").read_text()
     for a in anims:
         assert a["gif"] in report
@@ -370,8 +370,8 @@ def test_rerun_replaces_results_and_drops_stale_ones(plate_study, plate_cli_run,
     pipeline.run(validate(raw), out=out, progress=False)
     names = sorted(p.name for p in out.iterdir())
     # no png in formats: the comparison keeps its table only (comparison.csv), no figures
-    assert names == ["animations", "comparison.csv", "mesh.vtu", "modes.json", "notes.txt", "report.md", "run.log",
-                     "summary.json"]
+    assert names == [".bladecase-manifest.json", "animations", "comparison.csv", "mesh.vtu", "modes.json", "notes.txt",
+                     "report.md", "run.log", "summary.json"]
     assert (out / "notes.txt").read_text() == "mine"
 
 

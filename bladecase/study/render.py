@@ -19,7 +19,7 @@ from ..post.outputs import FORMATS, OrbitScene
 from ..progress import progress_bar
 from ..reduction import ReducedModel
 from .choose import Choice, choose_orbits, frame_times
-from .publish import publish, release, staging_dir
+from .publish import output_folder, publish, release, staging_dir
 from .reference import check_in_reference, log_check, reference_model
 from .schema import Study
 from .stages import period_unit
@@ -133,7 +133,7 @@ def animate_families(study: Study, reduced: ReducedModel, families: list[Branch]
     Returns one entry per animated orbit (period, energy, verification, file
     names relative to the output directory); files are published together.
     """
-    out = study.output_dir(out)
+    out = output_folder(study, out)
     staging = staging_dir(out, ("animations", "vtk"))
     try:
         reference = reference_model(reduced.model, reduced.contact, reduced) if study["output"]["reference"] else None

@@ -27,7 +27,7 @@ from .comparison import FE_MODES, compare_models
 from .documents import contact_summary, families_document, family_summary, model_summary, reduced_summary
 from .executor import Executor, make_executor
 from .forcing import forced_response, forced_scene
-from .publish import RUN_RESULTS, check_inputs, publish, release, staging_dir
+from .publish import RUN_RESULTS, check_inputs, output_folder, publish, release, staged_names, staging_dir
 from .reference import reference_model
 from .render import render_all
 from .schema import Study
@@ -123,10 +123,11 @@ def run(study: Study, out: str | os.PathLike | None = None, progress: bool = Tru
     >>> [(a["ipp"], a["frames"], a["verification"]["ok"]) for a in result.summary["files"]["animations"]]
     [(1, 4, True)]
     """
-    out = study.output_dir(out)
+    out = output_folder(study, out)
     t_start = time.perf_counter()
-    if not study.parametric:
-        check_inputs(out, [study.mesh_path()])
+    check_inputs(out, [study.mesh_path()] if not study.parametric else [])
+    if study.source and Path(study.source).is_file():
+        check_inputs(out, [study.source])
     staging = staging_dir(out)
     stages = _Stages(progress, total=7 if study["forcing"]["amplitude"] is not None else 6)
     x = study["execution"]
@@ -138,7 +139,7 @@ def run(study: Study, out: str | os.PathLike | None = None, progress: bool = Tru
             summary["timings_s"] = dict(stages.timings, total=round(time.perf_counter() - t_start, 3))
             log.info("results in %s (%.1f s)", out, summary["timings_s"]["total"])
         write_text(staging / "run.log", "\n".join(lines) + "\n")
-        summary["outputs"] = sorted({p.name for p in staging.iterdir()} | {"summary.json", "report.md"})
+        summary["outputs"] = sorted(set(staged_names(staging)) | {"summary.json", "report.md"})
         write_json(staging / "summary.json", summary)
         write_text(staging / "report.md", report(summary))
         publish(staging, out, RUN_RESULTS, whole=True)
