@@ -13,6 +13,29 @@ from .cli_input import check_outputs as _check_outputs
 from .cli_input import load_system as _load_system
 
 
+def _out_dir(text: str) -> Path:
+    """``--out DIR``: a folder name (an empty one would mean the working folder)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(f"expected a folder, got an empty name {text!r} (it would mean the working "
+                                         "folder; give e.g. results/NAME)")
+    return Path(text)
+
+
+def _not_onto_inputs(outputs: dict[str, Path | None], inputs: dict[str, Path | None]) -> None:
+    """Refuse (before any work) an output file that is one of the command's inputs, or two outputs in one file."""
+    seen: dict[str, str] = {}
+    for label, path in inputs.items():
+        if path is not None and os.path.lexists(path):
+            seen[os.path.realpath(path)] = f"its input {label} {str(path)!r}"
+    for label, path in outputs.items():
+        if path is None:
+            continue
+        real = os.path.realpath(path)
+        if real in seen:
+            raise ValueError(f"{label} {str(path)!r} is {seen[real]}: it would be overwritten; write to another file")
+        seen[real] = f"also given as {label}"
+
+
 class _Parser(argparse.ArgumentParser):
     """ArgumentParser whose errors are one line: ``bladecase …: error: reason``."""
 
@@ -108,7 +131,7 @@ def _study_commands(sub) -> None:
                     "report.md, modes.json, the frequency–energy plot, GIF/MP4 animations and VTK time series "
                     "into the output directory.  Results are staged and moved into place only on success.")
     run.add_argument("study", type=Path, metavar="STUDY.toml")
-    run.add_argument("--out", type=Path, metavar="DIR", help="output directory (overrides [output] directory)")
+    run.add_argument("--out", type=_out_dir, metavar="DIR", help="output directory (overrides [output] directory)")
     _progress_options(run)
     _execution_options(run)
     run.set_defaults(func=_cmd_run)
@@ -119,7 +142,7 @@ def _study_commands(sub) -> None:
                     "Ti-6Al-4V, lumped mass, its tip face 0.1 mm from a compliant casing (1e6 N/m), the massless "
                     "contact model; the nonsmooth mode grown from the first linear mode, checked in a richer "
                     "reference model and animated.  --print-study shows its TOML as a template.")
-    demo.add_argument("--out", type=Path, metavar="DIR", help="output directory (default results/demo)")
+    demo.add_argument("--out", type=_out_dir, metavar="DIR", help="output directory (default results/demo)")
     demo.add_argument("--print-study", action="store_true", help="print the demo study file and exit")
     _progress_options(demo)
     _execution_options(demo)
@@ -176,7 +199,7 @@ def _study_commands(sub) -> None:
     ani.add_argument("study", type=Path, metavar="STUDY.toml")
     ani.add_argument("--reduced", type=Path, required=True, metavar="REDUCED.npz")
     ani.add_argument("--modes", type=Path, required=True, metavar="MODES.json")
-    ani.add_argument("--out", type=Path, metavar="DIR", help="output directory (overrides [output] directory)")
+    ani.add_argument("--out", type=_out_dir, metavar="DIR", help="output directory (overrides [output] directory)")
     _progress_options(ani)
     ani.set_defaults(func=_cmd_animate)
 
@@ -238,6 +261,8 @@ def _cmd_mesh(args) -> int:
     _setup(args)
     _check_outputs(args.output)
     study = _study(args.study)
+    _not_onto_inputs({"-o": args.output}, {"STUDY": args.study,
+                                           "[mesh] path": None if study.parametric else study.mesh_path()})
     if study.parametric and args.output.suffix == ".msh":
         mesh = build_mesh(study, path=args.output)
     else:
@@ -256,6 +281,8 @@ def _cmd_assemble(args) -> int:
     _setup(args)
     _check_outputs(args.output)
     study = _study(args.study)
+    _not_onto_inputs({"-o": args.output}, {"STUDY": args.study, "--mesh": args.mesh,
+                                           "[mesh] path": None if study.parametric else study.mesh_path()})
     if args.mesh is not None:
         mesh = load_mesh(args.mesh, require=[study["fem"]["clamp"]])
     else:
@@ -275,6 +302,7 @@ def _cmd_reduce(args) -> int:
 
     _setup(args)
     _check_outputs(args.output)
+    _not_onto_inputs({"-o": args.output}, {"STUDY": args.study, "--model": args.model})
     study = _study(args.study)
     model = load_model(args.model)
     contact = build_contact(study, model)
@@ -293,6 +321,8 @@ def _cmd_modes(args) -> int:
 
     progress = _setup(args)
     _check_outputs(args.output, args.plot)
+    _not_onto_inputs({"-o": args.output, "--plot": args.plot},
+                     {"STUDY": args.study, "--reduced": args.reduced, "--matrices": args.matrices})
     study = _study(args.study, model=args.reduced is not None)  # with --matrices: [search] is enough
     if args.reduced is not None:
         from .reduction import load_reduced
@@ -316,10 +346,12 @@ def _cmd_animate(args) -> int:
     from .io import check_output_dir
     from .reduction import load_reduced
     from .study.documents import load_families
+    from .study.publish import check_inputs
     from .study.render import animate_families
 
     progress = _setup(args)
     study = _study(args.study)
+    check_inputs(study.output_dir(args.out), [args.study, args.reduced, args.modes], ("animations", "vtk"))
     check_output_dir(study.output_dir(args.out))
     reduced = load_reduced(args.reduced)
     families = load_families(args.modes, reduced.system)
@@ -337,6 +369,8 @@ def _cmd_backbone(args) -> int:
     from .nsm import backbone
 
     _check_outputs(args.table, args.json, args.plot)
+    _not_onto_inputs({"--table": args.table, "--json": args.json, "--plot": args.plot},
+                     {"--matrices": args.matrices})
     system = _load_system(args)
     progress = not args.no_progress and sys.stderr.isatty()
     if args.ipp == 1:
@@ -437,6 +471,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"{where}: error: out of memory (reduce the sizes asked for: [reduction] size, [search] scan, "
               "[output] frames, manifold_size)", file=sys.stderr)
         return 1
+    except RecursionError:  # (before RuntimeError, its base class)
+        print(f"{where}: error: an input is nested too deeply to be read (a study, mesh or JSON file)", file=sys.stderr)
+        return 2
     except RuntimeError as exc:  # e.g. no off-screen rendering
         print(f"{where}: error: {_one_line(exc)}", file=sys.stderr)
         return 1
@@ -444,6 +481,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         what = "terminated" if isinstance(exc, _Terminated) else "interrupted"
         print(f"{where}: {what}, previous results untouched", file=sys.stderr)
         return 143 if isinstance(exc, _Terminated) else 130
+    except Exception as exc:  # an input no check caught, or a bug: one line, never a traceback
+        if os.environ.get("BLADECASE_TRACEBACK"):
+            raise
+        print(f"{where}: error: unexpected {type(exc).__name__}: {_one_line(exc)} — an input bladecase failed to "
+              "check, or a bug in bladecase (BLADECASE_TRACEBACK=1 shows where; please report it)", file=sys.stderr)
+        return 2
     finally:
         if main_thread:
             signal.signal(signal.SIGTERM, previous if previous is not None else signal.SIG_DFL)
