@@ -40,3 +40,16 @@ def test_ruff_is_clean():
         pytest.skip("ruff is not installed in this environment (it is in the [test] extra)")
     res = subprocess.run([str(ruff), "check", "--quiet", str(ROOT)], capture_output=True, text=True, cwd=ROOT)
     assert res.returncode == 0, res.stdout + res.stderr
+
+
+def test_run_takes_the_path_of_a_study_file(tmp_path, monkeypatch):
+    (tmp_path / "plate.vtu").write_bytes((Path(__file__).resolve().parents[1] / "meshes" / "plate.vtu").read_bytes())
+    (tmp_path / "p.toml").write_text('[study]\nname = "p"\n[mesh]\npath = "plate.vtu"\n[fem]\norder = 1\n'
+                                     'thickness = 0.002\n[contact]\nclearance = 1e-4\n[reduction]\nmethod = "modal"\n'
+                                     'size = 4\n[search]\nipp = [1]\nscan = 3\n[output]\nformats = []\n'
+                                     'reference = false\nanimate = 0\n')
+    monkeypatch.chdir(tmp_path)
+    result = bladecase.run("p.toml", progress=False)
+    assert result.directory == Path("results/p") and (tmp_path / "results" / "p" / "summary.json").is_file()
+    with pytest.raises(ValueError, match="study must be a Study .* or the path of a study file, got int 3"):
+        bladecase.run(3)

@@ -63,36 +63,65 @@ _KEYS: dict[str, bytes] = {}
 def signing_key() -> bytes:
     """The user's secret key (32 random bytes, created on first use, readable by the user alone).
 
-    ``RuntimeError`` naming the path when it can neither be read nor created (results could then be
-    written but never proved to be bladecase's, so nothing is written)."""
+    Where the configuration folder cannot be written (a read-only home), a private folder of the user's in
+    the system's temporary folder holds it.  ``RuntimeError`` naming the path when neither works (results
+    could then be written but never proved to be bladecase's, so nothing is written)."""
     path = key_path()
     cached = _KEYS.get(str(path))
     if cached is not None:
         return cached
     try:
-        key = _read_key(path)
-        if key is None:
-            path.parent.mkdir(parents=True, exist_ok=True, mode=0o700)
-            fd, tmp = tempfile.mkstemp(prefix=".key-", dir=path.parent)
-            try:
-                os.write(fd, secrets.token_bytes(32))
-                os.fsync(fd)
-            finally:
-                os.close(fd)
-            try:
-                os.link(tmp, path)  # atomic, and never over a key another process created meanwhile
-            except FileExistsError:
-                pass
-            finally:
-                os.unlink(tmp)
-            key = _read_key(path)
+        key = _key_at(path)
     except OSError as exc:
-        raise RuntimeError(f"cannot read or create bladecase's signing key {str(path)!r} ({exc.strerror or exc}): "
-                           "set BLADECASE_KEY_FILE to a file in a folder you may write to") from None
+        fallback = _private_fallback()
+        if os.environ.get("BLADECASE_KEY_FILE") or fallback is None:
+            raise RuntimeError(f"cannot read or create bladecase's signing key {str(path)!r} ({exc.strerror or exc}): "
+                               "set BLADECASE_KEY_FILE to a file in a folder you may write to") from None
+        try:
+            key = _key_at(fallback)
+        except OSError:
+            raise RuntimeError(f"cannot read or create bladecase's signing key {str(path)!r} ({exc.strerror or exc}):"
+                               " set BLADECASE_KEY_FILE to a file in a folder you may write to") from None
     if key is None:
         raise RuntimeError(f"bladecase's signing key {str(path)!r} is not 32 bytes: delete it (a new one is made)")
     _KEYS[str(path)] = key
     return key
+
+
+def _key_at(path: Path) -> bytes | None:
+    """The key stored at ``path``, created there if missing."""
+    key = _read_key(path)
+    if key is None and not os.path.lexists(path):
+        path.parent.mkdir(parents=True, exist_ok=True, mode=0o700)
+        fd, tmp = tempfile.mkstemp(prefix=".key-", dir=path.parent)
+        try:
+            os.write(fd, secrets.token_bytes(32))
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+        try:
+            os.link(tmp, path)  # atomic, and never over a key another process created meanwhile
+        except FileExistsError:
+            pass
+        finally:
+            os.unlink(tmp)
+        key = _read_key(path)
+    return key
+
+
+def _private_fallback() -> Path | None:
+    """``<tmp>/bladecase-<uid>/signing.key`` in a folder of this user's that nobody else may enter."""
+    if not hasattr(os, "getuid"):
+        return None
+    folder = Path(tempfile.gettempdir()) / f"bladecase-{os.getuid()}"
+    try:
+        folder.mkdir(mode=0o700, exist_ok=True)
+        st = os.lstat(folder)
+    except OSError:
+        return None
+    if not stat.S_ISDIR(st.st_mode) or st.st_uid != os.getuid() or st.st_mode & 0o077:
+        return None  # planted by someone else: not a place for a secret
+    return folder / "signing.key"
 
 
 def _read_key(path: Path) -> bytes | None:

@@ -30,7 +30,7 @@ from .forcing import forced_response, forced_scene
 from .publish import RUN_RESULTS, check_inputs, output_folder, publish, release, staged_names, staging_dir
 from .reference import reference_model
 from .render import render_all
-from .schema import Study
+from .schema import Study, load_study
 from .stages import build_contact, build_mesh, build_model, build_reduced, period_unit, search
 
 
@@ -83,9 +83,10 @@ class _Stages:
             self.bar.update()
 
 
-def run(study: Study, out: str | os.PathLike | None = None, progress: bool = True,
+def run(study: Study | str | os.PathLike, out: str | os.PathLike | None = None, progress: bool = True,
         executor: Executor | None = None) -> RunResult:
-    """Run the whole study; write every result into the output directory.
+    """Run the whole study (a :class:`Study`, or the path of a study file); write every result into the output
+    directory.
 
     Files (in ``out``, default ``[output] directory``): ``summary.json``,
     ``report.md``, ``run.log``, ``modes.json`` (every family, every orbit),
@@ -123,6 +124,11 @@ def run(study: Study, out: str | os.PathLike | None = None, progress: bool = Tru
     >>> [(a["ipp"], a["frames"], a["verification"]["ok"]) for a in result.summary["files"]["animations"]]
     [(1, 4, True)]
     """
+    if isinstance(study, (str, os.PathLike)):
+        study = load_study(study)
+    elif not isinstance(study, Study):
+        raise ValueError(f"study must be a Study (bladecase.load_study) or the path of a study file, got "
+                         f"{type(study).__name__} {study!r:.60}")
     out = output_folder(study, out)
     t_start = time.perf_counter()
     check_inputs(out, [study.mesh_path()] if not study.parametric else [])
