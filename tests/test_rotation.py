@@ -135,3 +135,28 @@ def test_speed_units_and_bad_input(beam):
         RotationAxis((0, 0, 0), (0, 0, 0))
     with pytest.raises(ValueError, match="the blade is unstable"):  # an axis along the beam: spin softening only
         spin(beam, 2000.0, RotationAxis((0, 0, 0), (1, 0, 0)))
+
+
+def test_campbell_tracks_modes_through_a_crossing_by_shape():
+    """The flapwise mode (lowest at rest) stiffens past the chordwise one near λ = 5: followed by shape, each keeps
+    its identity (ranking by frequency would swap them); its frequencies are the flap/chord ones of the model."""
+    from bladecase.fe.campbell import campbell
+
+    model = _beam(nx=20)
+    scale = _scale(model)
+    speeds = np.linspace(0, 8, 9) / scale
+    c = campbell(model, speeds, Z_AXIS, count=2, engine_orders=[1, 2, 3])
+    flap, chord = c.frequencies[:, 0], c.frequencies[:, 1]
+    assert flap[0] < chord[0] and flap[-1] > chord[-1]  # they cross
+    top_flap, top_chord = _flap_chord(model, speeds[-1])
+    assert flap[-1] == pytest.approx(top_flap / (2 * np.pi), rel=1e-9)
+    assert chord[-1] == pytest.approx(top_chord / (2 * np.pi), rel=1e-9)
+    assert c.link_mac.min() > 0.99 and not c.uncertain_links
+    assert (c.rank[-1] == [1, 0]).all()
+    d = c.to_dict()
+    assert d["frequencies_hz"][-1] == sorted(d["frequencies_hz"][-1]) and d["tracked_mode"][-1] == [1, 0]
+    assert {(x["mode"], x["engine_order"]) for x in c.crossings} >= {(0, 2), (1, 2)}
+    # every crossing lies on its engine-order line and on the mode's piecewise-linear curve
+    for x in c.crossings:
+        assert x["frequency_hz"] == pytest.approx(x["engine_order"] * x["speed_rad_s"] / (2 * np.pi))
+        assert x["frequency_hz"] == pytest.approx(np.interp(x["speed_rad_s"], speeds, c.frequencies[:, x["mode"]]))
