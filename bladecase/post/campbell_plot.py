@@ -1,0 +1,61 @@
+"""The Campbell diagram as a figure: tracked natural frequencies against speed (rpm), engine-order lines, their
+crossings, and the nonsmooth-mode bands — from grazing to the end of each mode's admissible arc — where the
+blade touches its casing.
+
+>>> import numpy as np
+>>> from bladecase.fe.campbell import Campbell, crossings
+>>> speeds = np.linspace(0, 1000, 5)
+>>> f = np.c_[80 + 0.02 * speeds, 400 + 0.001 * speeds]
+>>> c = Campbell(speeds, f, np.tile([0, 1], (5, 1)), np.ones((5, 2)), [2, 4], crossings(speeds, f, [2, 4]))
+>>> fig = campbell_figure(c, bands={0: (speeds, f[:, 0], f[:, 0] * 1.02)})
+>>> [t.get_text() for t in fig.axes[0].texts]
+['EO 2', 'EO 4']
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from .plots import new_figure
+
+__all__ = ["campbell_figure"]
+
+
+def campbell_figure(campbell, bands: dict | None = None, title: str | None = None, ax=None) -> Figure:
+    """Frequencies (Hz) of the tracked modes against speed (rpm), engine orders (dashed, labelled ``EO n``),
+    their crossings (circles), and ``bands`` (mode → ``(speeds rad/s, low Hz, high Hz)``) shaded: the
+    frequencies a nonsmooth mode of that linear mode spans at each speed.  An engine order entering a band is
+    the contact-induced interaction risk."""
+    fig = ax.figure if ax is not None else new_figure(figsize=(7.0, 4.8), layout="constrained")
+    ax = ax if ax is not None else fig.add_subplot()
+    rpm = campbell.speeds * 60 / (2 * math.pi)
+    top = float(np.nanmax(campbell.frequencies)) * 1.08 if campbell.frequencies.size else 1.0
+    for j in range(campbell.frequencies.shape[1]):
+        color = f"C{j % 10}"
+        ax.plot(rpm, campbell.frequencies[:, j], "-", color=color, lw=1.6, label=f"mode {j + 1}")
+        if bands and j in bands:
+            w, lo, hi = (np.asarray(x, dtype=float) for x in bands[j])
+            ok = np.isfinite(lo) & np.isfinite(hi)
+            if ok.any():
+                ax.fill_between(w[ok] * 60 / (2 * math.pi), lo[ok], hi[ok], color=color, alpha=0.25, lw=0,
+                                label=f"mode {j + 1}: nonsmooth mode")
+                top = max(top, float(np.nanmax(hi[ok])) * 1.05)
+    x_end = float(rpm[-1]) if rpm.size else 1.0
+    for n in campbell.engine_orders:
+        y = n * campbell.speeds / (2 * math.pi)
+        ax.plot(rpm, y, "--", color="0.45", lw=0.9)
+        x_lab = min(x_end, 60.0 * top / n)  # where the line f = n · rpm / 60 leaves the plot (top or right edge)
+        ax.text(x_lab, n * x_lab / 60.0, f"EO {n}", fontsize=8, color="0.3", ha="right", va="bottom")
+    for x in campbell.crossings:
+        ax.plot(x["speed_rad_s"] * 60 / (2 * math.pi), x["frequency_hz"], "o", mfc="none", color="k", ms=6)
+    ax.set_xlim(float(rpm[0]) if rpm.size else 0.0, x_end if x_end > 0 else 1.0)
+    ax.set_ylim(0.0, top)
+    ax.set_xlabel("rotation speed (rpm)")
+    ax.set_ylabel("frequency (Hz)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, loc="upper left")
+    ax.set_title(title or "Campbell diagram")
+    return fig
