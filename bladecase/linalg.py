@@ -312,6 +312,15 @@ def _square(A, name: str) -> int:
     return A.shape[0]
 
 
+def _finite(A, name: str) -> None:
+    """Refuse inf/NaN entries (an overflowed model), which the factorisations report only as internals."""
+    values = A.data if is_sparse(A) else np.asarray(A, dtype=float)
+    bad = int(np.count_nonzero(~np.isfinite(values)))
+    if bad:
+        raise ValueError(f"{name} has {bad} non-finite entr{'y' if bad == 1 else 'ies'} (inf or NaN): the model "
+                         "overflowed (mesh coordinates, material constants or thickness out of range?)")
+
+
 def spd_factor(A, name: str = "A", *, hint: str = "") -> SPDFactor:
     """Factor a symmetric positive definite matrix (scipy sparse or dense); the symmetry is not checked.
 
@@ -342,6 +351,7 @@ def spd_factor(A, name: str = "A", *, hint: str = "") -> SPDFactor:
     ValueError: M is not positive definite: its LDLᵀ factorisation has a pivot -3 <= 0
     """
     n = _square(A, name)
+    _finite(A, name)
     if not is_sparse(A):
         a = np.asarray(A, dtype=float)
         try:
@@ -383,6 +393,7 @@ def symmetric_factor(A, name: str = "A", *, hint: str = "") -> Factor:
         ``A`` not square or singular (the message names ``A``, then ``hint``).
     """
     n = _square(A, name)
+    _finite(A, name)
     if not is_sparse(A):
         with warnings.catch_warnings():  # a singular matrix: the error below says it
             warnings.simplefilter("ignore", sla.LinAlgWarning)
@@ -421,9 +432,31 @@ def _sparse_modes(K, M, count: int, factor: Factor, method: str) -> tuple[np.nda
             return found
     # a fixed start vector: the same modes (signs, and the basis of repeated eigenvalues) on every run
     v0 = np.random.default_rng(0).standard_normal(K.shape[0])
-    lam, phi = spla.eigsh(K, k=count, M=M, sigma=0.0, which="LM", OPinv=factor.operator(), v0=v0)
+    try:
+        lam, phi = spla.eigsh(K, k=count, M=M, sigma=0.0, which="LM", OPinv=factor.operator(), v0=v0)
+    except (spla.ArpackError, spla.ArpackNoConvergence) as exc:  # ArpackNoConvergence is an ArpackError
+        raise ValueError(f"the eigen-solver (ARPACK's shift-invert Lanczos) failed on {factor.name} and M, "
+                         f"{K.shape[0]} dofs, {count} modes: {exc} (K and M must be symmetric, K positive definite "
+                         "and M positive semidefinite, both of a sensible scale)") from None
     order = np.argsort(lam)
     return lam[order], phi[:, order]
+
+
+def _check_pencil(K, M, name: str) -> None:
+    """Refuse what the eigen-solvers would only report as ARPACK/LAPACK internals: ``M`` of another shape,
+    non-finite entries, ``M = 0``, a negative diagonal entry of ``M``."""
+    n = K.shape[0]
+    if getattr(M, "ndim", None) != 2 or M.shape != (n, n):
+        raise ValueError(f"M must be a {n} × {n} matrix like {name}, got shape {getattr(M, 'shape', None)}")
+    _finite(K, name)
+    _finite(M, "M")
+    diag = np.asarray(M.diagonal(), dtype=float)
+    if not np.any(diag) and (M.count_nonzero() if is_sparse(M) else np.count_nonzero(M)) == 0:
+        raise ValueError("M is zero: the model has no mass (zero density, or a mesh whose cells have no volume)")
+    if np.any(diag < 0):
+        i = int(np.argmin(diag))
+        raise ValueError(f"M is not positive semidefinite: diagonal entry M[{i},{i}] = {diag[i]:.6g} < 0 (a negative "
+                         "density or thickness?)")
 
 
 def lowest_modes(
@@ -480,6 +513,7 @@ def lowest_modes(
     count = integer("count", count, 1, n, note=f" (the size of {name})")
     if method not in EIGEN_METHODS:
         raise ValueError(f"method must be one of {', '.join(map(repr, EIGEN_METHODS))}, got {method!r}")
+    _check_pencil(K, M, name)
     sparse = is_sparse(K)
     if dense is None:
         dense = not sparse or count >= n or (count > n // 2 and n <= DENSE_LIMIT)
@@ -501,7 +535,11 @@ def lowest_modes(
         elif not isinstance(factor, Factor) or factor.n != n:
             raise ValueError(f"factor must be a factorisation of {name} ({n} × {n}, from spd_factor), got {factor!r}")
         lam, phi = _sparse_modes(K, M, count, factor, method)
-        phi = phi / np.sqrt(np.einsum("ij,ij->j", phi, M @ phi))[None, :]
+        norms = np.einsum("ij,ij->j", phi, M @ phi)
+        if not np.all(norms > 0):
+            raise ValueError(f"M gives mode {int(np.argmin(norms > 0)) + 1} a modal mass {norms.min():.3g} <= 0: M is "
+                             "not positive semidefinite or has no mass on that mode's dofs")
+        phi = phi / np.sqrt(norms)[None, :]
     if not np.all(np.isfinite(lam)) or lam[0] <= 0:
         raise _fail(name, f"is not positive definite: eigenvalue {lam[0]:.3g} (a mechanism? degenerate cells?)", hint)
     return lam, sign_convention(phi)

@@ -52,7 +52,7 @@ from . import wedge_element
 from .cells import KINDS, SKFEM_MESHES, element_name
 from .eigen import natural_frequencies
 from .material import AL6061T6, ALUMINIUM, INCONEL718, PLANE_KINDS, PRESETS, STEEL, TI6AL4V, Material
-from .mesh import Mesh
+from .mesh import Mesh, check_extent
 from .model import DofMap, FEModel
 from .quality import corner_jacobians
 from .select import select_nodes
@@ -191,6 +191,7 @@ def assemble(
     points = np.asarray(mesh.points, dtype=float)
     if points.ndim != 2 or points.shape[1] != 3 or not np.all(np.isfinite(points)):
         raise ValueError(f"mesh.points must be a finite (n, 3) array, got shape {points.shape}")
+    check_extent(points, mesh.source or "(in memory)")  # 1e±150 m: K, M over/underflow; 0: a degenerate mesh
     clamped = _clamp_nodes(mesh, points, clamp)
 
     basis, fe_mesh, used = _basis(mesh, points, dim, order)

@@ -100,7 +100,12 @@ def read_cdb(path: str | os.PathLike):
     """
     import meshio
 
-    source = str(path)
+    from .mesh import check_input_file
+
+    try:
+        source = check_input_file(path, "ANSYS archive")  # a pipe or a device would never end
+    except ValueError as exc:
+        raise CdbError(str(exc)) from None
     try:
         with open(path, encoding="latin-1") as fh:
             lines = fh.read().splitlines()
@@ -110,15 +115,18 @@ def read_cdb(path: str | os.PathLike):
     ids = np.zeros(0, dtype=np.int64)
     xyz = np.zeros((0, 3))
     elements: list[tuple[int, int, list[int], int]] = []  # (type number, element number, nodes, line)
-    components: dict[str, tuple[str, list[int]]] = {}
+    components: dict[str, tuple[str, list[tuple[int, int]], int]] = {}  # name -> (kind, ranges, line)
     i = 0
     while i < len(lines):
         head = lines[i].split("!")[0].strip()
         word = head.split(",")[0].strip().upper()
         if word == "ET":
             _, itype, ename = (f.strip() for f in (head.split(",") + ["", ""])[:3])
-            types[_int(itype, source, i)] = _int(re.sub(r"^\D*", "", ename) or ename, source, i)
+            types[_int(itype, source, i, "the element type number of ET")] = _int(
+                re.sub(r"^\D*", "", ename) or ename, source, i, "the element name of ET (e.g. 186)")
         elif word == "NBLOCK":
+            if ids.size:
+                raise CdbError(f"ANSYS archive {source!r}, line {i + 1}: a second NBLOCK (one is read per archive)")
             ids, xyz, i = _nblock(lines, i, source)
             continue
         elif word == "EBLOCK":
@@ -126,28 +134,58 @@ def read_cdb(path: str | os.PathLike):
             elements += block
             continue
         elif word == "CMBLOCK":
-            name, kind, members, i = _cmblock(lines, i, source)
-            components[name] = (kind, members)
+            name, kind, ranges, start, i = _cmblock(lines, i, source)
+            components[name] = (kind, ranges, start)
             continue
         i += 1
     if ids.size == 0:
         raise CdbError(f"ANSYS archive {source!r} has no NBLOCK (node coordinates): not a mesh archive")
-    index = np.full(int(ids.max()) + 1, -1, dtype=np.int64)
-    index[ids] = np.arange(ids.size)
+    index = _NodeIndex(ids)
     cells, counts, by_number = _cells(elements, types, index, source)
     if not cells:
         found = ", ".join(f"{n} × {element_name(int(t))}" for t, n in counts.items()) or "none"
         raise CdbError(f"ANSYS archive {source!r} has no solid element bladecase reads (found: {found}; read: "
                        f"{', '.join(map(element_name, sorted(SOLIDS)))})")
+    numbers = np.array(sorted(by_number), dtype=np.int64)
     point_sets = {}
-    for name, (kind, members) in components.items():
+    for name, (kind, ranges, _) in components.items():
         if kind == "NODE":
-            nodes = [index[k] for k in members if k < index.size and index[k] >= 0]
+            nodes = [index.position[a:b] for a, b in (index.span(lo, hi) for lo, hi in ranges)]
         else:
-            nodes = [n for e in members for n in by_number.get(e, ())]
-        point_sets[name] = np.unique(np.asarray(nodes, dtype=np.int64))
+            chosen = [numbers[np.searchsorted(numbers, lo):np.searchsorted(numbers, hi, "right")] for lo, hi in ranges]
+            nodes = [np.asarray(by_number[int(e)], dtype=np.int64) for part in chosen for e in part]
+        point_sets[name] = np.unique(np.concatenate(nodes)) if nodes else np.zeros(0, dtype=np.int64)
     return meshio.Mesh(xyz, [(t, np.asarray(c, dtype=np.int64)) for t, c in cells.items()], point_sets=point_sets,
                        field_data={"ansys:types": counts})
+
+
+#: Largest node or element number read: ANSYS numbers them with 32-bit integers.
+MAX_NUMBER = 2**31 - 1
+
+#: Most fields a block's Fortran format may give (ANSYS writes at most 19 per line).
+MAX_FORMAT_FIELDS = 1000
+
+#: Most nodes an EBLOCK element record may list (the solids read have at most 20).
+MAX_ELEMENT_NODES = 64
+
+
+class _NodeIndex:
+    """ANSYS node numbers → 0-based positions in the NBLOCK, by binary search (memory: the node count, whatever
+    the largest number)."""
+
+    def __init__(self, ids: np.ndarray):
+        order = np.argsort(ids, kind="stable")
+        self.sorted, self.position = ids[order], order.astype(np.int64)
+
+    def find(self, numbers) -> np.ndarray:
+        """Positions of ``numbers`` (``-1`` for a number the NBLOCK does not define)."""
+        numbers = np.asarray(numbers, dtype=np.int64)
+        k = np.minimum(np.searchsorted(self.sorted, numbers), self.sorted.size - 1)
+        return np.where(self.sorted[k] == numbers, self.position[k], -1)
+
+    def span(self, lo: int, hi: int) -> tuple[int, int]:
+        """The slice of :attr:`position` of the node numbers in ``[lo, hi]``."""
+        return int(np.searchsorted(self.sorted, lo)), int(np.searchsorted(self.sorted, hi, "right"))
 
 
 def register() -> None:
@@ -159,11 +197,30 @@ def register() -> None:
         meshio.register_format("ansys-cdb", [".cdb"], read_cdb, {})
 
 
-def _int(text: str, source: str, line: int) -> int:
+def _int(text: str, source: str, line: int, what: str = "") -> int:
+    """``int(text)``, else a :class:`CdbError` naming the file, the line (0-based ``line``) and ``what``."""
     try:
         return int(str(text).strip())
     except ValueError:
-        raise CdbError(f"ANSYS archive {source!r}, line {line + 1}: expected an integer, got {text!r}") from None
+        what = f" {what}:" if what else ""
+        raise CdbError(f"ANSYS archive {source!r}, line {line + 1}:{what} expected an integer, got "
+                       f"{str(text).strip()!r}") from None
+
+
+def _number(value: int, source: str, line: int, what: str) -> int:
+    """``value`` if it is a node/element number ``1..MAX_NUMBER``, else a :class:`CdbError`."""
+    if not 1 <= value <= MAX_NUMBER:
+        raise CdbError(f"ANSYS archive {source!r}, line {line + 1}: {what} {value} is out of range (ANSYS numbers "
+                       f"are 1..{MAX_NUMBER})")
+    return value
+
+
+def _declared_count(header: str, source: str, line: int) -> int | None:
+    """The count an NBLOCK/EBLOCK header declares in its fifth field (``NBLOCK,6,SOLID,max,count``), if any."""
+    parts = [p.strip() for p in header.split("!")[0].split(",")]
+    if len(parts) < 5 or not parts[4]:
+        return None
+    return _int(parts[4], source, line, f"the count (fifth field) of {parts[0].upper()}")
 
 
 def _format(lines: list[str], i: int, source: str) -> list[tuple[str, int]]:
@@ -173,7 +230,11 @@ def _format(lines: list[str], i: int, source: str) -> list[tuple[str, int]]:
     if not (text.startswith("(") and items):
         raise CdbError(f"ANSYS archive {source!r}, line {i + 1}: expected a Fortran format such as "
                        f"(3i9,6e21.13e3), got {text!r}")
-    return [(kind.lower(), int(width)) for count, kind, width in items for _ in range(int(count or 1))]
+    counts = [int(count or 1) for count, _, _ in items]
+    if sum(counts) > MAX_FORMAT_FIELDS or any(int(width) < 1 for _, _, width in items):
+        raise CdbError(f"ANSYS archive {source!r}, line {i + 1}: the Fortran format {text!r} has "
+                       f"{sum(counts)} fields (at most {MAX_FORMAT_FIELDS}) or a zero width: a corrupt file?")
+    return [(kind.lower(), int(width)) for n, (_, kind, width) in zip(counts, items) for _ in range(n)]
 
 
 def _fields(line: str, widths: list[int]) -> list[str]:
@@ -192,27 +253,56 @@ def _nblock(lines: list[str], i: int, source: str) -> tuple[np.ndarray, np.ndarr
     fmt = _format(lines, i + 1, source)
     widths = [w for _, w in fmt]
     n_int = sum(1 for k, _ in fmt if k == "i")
-    ids, xyz = [], []
+    declared = _declared_count(lines[i], source, i)
+    names = ("x", "y", "z")
+    ids, xyz, first_line = [], [], {}
     j = i + 2
     while j < len(lines):
         line = lines[j]
         if line.strip().upper().startswith("N,") or line.strip() == "-1":
             break
         f = _fields(line, widths)
-        try:
-            ids.append(int(f[0]))
-            coords = [float(x.replace("D", "E").replace("d", "e")) for x in f[n_int:n_int + 3]]
-        except (ValueError, IndexError):
+        if not f:
             raise CdbError(f"ANSYS archive {source!r}, line {j + 1}: not a node record of the NBLOCK format "
-                           f"{lines[i + 1].strip()}: {line!r}") from None
+                           f"{lines[i + 1].strip()}: an empty line (expected the node number, then the coordinates)")
+        try:
+            node = int(f[0])
+        except ValueError:
+            raise CdbError(f"ANSYS archive {source!r}, line {j + 1}: not a node record of the NBLOCK format "
+                           f"{lines[i + 1].strip()}: field 1 (node number) is {f[0].strip()!r}, not an integer"
+                           ) from None
+        node = _number(node, source, j, "node number (field 1)")
+        coords = []
+        for k, x in enumerate(f[n_int:n_int + 3]):
+            try:
+                c = float(x.replace("D", "E").replace("d", "e"))
+            except ValueError:
+                raise CdbError(f"ANSYS archive {source!r}, line {j + 1}: not a node record of the NBLOCK format "
+                               f"{lines[i + 1].strip()}: the {names[k]} coordinate of node {node} (field "
+                               f"{n_int + k + 1}) is {x.strip()!r}, not a number") from None
+            if not np.isfinite(c):
+                raise CdbError(f"ANSYS archive {source!r}, line {j + 1}: the {names[k]} coordinate of node {node} "
+                               f"is {x.strip()!r}: coordinates must be finite numbers")
+            coords.append(c)
+        if node in first_line:
+            raise CdbError(f"ANSYS archive {source!r}, line {j + 1}: node {node} is defined twice (first on line "
+                           f"{first_line[node] + 1}); node numbers must be unique")
+        first_line[node] = j
+        ids.append(node)
         xyz.append(coords + [0.0] * (3 - len(coords)))
         j += 1
     else:
-        raise CdbError(f"ANSYS archive {source!r}: the NBLOCK of line {i + 1} has no end (-1 or N,R5.3,LOC,-1)")
-    ids = np.asarray(ids, dtype=np.int64)
-    if ids.size and (ids.min() < 1 or np.unique(ids).size != ids.size):
-        raise CdbError(f"ANSYS archive {source!r}: node numbers must be unique and >= 1 (NBLOCK of line {i + 1})")
-    return ids, np.asarray(xyz, dtype=float).reshape(-1, 3), j + 1
+        raise CdbError(f"ANSYS archive {source!r}: the NBLOCK of line {i + 1} has no end (-1 or N,R5.3,LOC,-1): "
+                       f"the file is truncated or not an ANSYS archive")
+    if declared is not None and declared != len(ids):
+        raise CdbError(f"ANSYS archive {source!r}: the NBLOCK of line {i + 1} declares {declared} nodes but lists "
+                       f"{len(ids)} (lines {i + 3}-{j}): the file is corrupt or truncated")
+    return np.asarray(ids, dtype=np.int64), np.asarray(xyz, dtype=float).reshape(-1, 3), j + 1
+
+
+#: The 11 header fields of a solid EBLOCK record.
+_EBLOCK_FIELDS = ("material", "element type", "real constant", "section", "coordinate system", "birth/death",
+                  "solid model reference", "shape", "node count", "exclude key", "element number")
 
 
 def _eblock(lines: list[str], i: int, source: str) -> tuple[list, int]:
@@ -220,52 +310,86 @@ def _eblock(lines: list[str], i: int, source: str) -> tuple[list, int]:
         raise CdbError(f"ANSYS archive {source!r}, line {i + 1}: only the solid EBLOCK format is read "
                        f"(EBLOCK,...,SOLID,...), got {lines[i].strip()!r}")
     widths = [w for _, w in _format(lines, i + 1, source)]
+    declared = _declared_count(lines[i], source, i)
     out = []
     j = i + 2
     while j < len(lines):
         f = _fields(lines[j], widths)
-        if not f or int(f[0]) == -1:
+        if not f or _int(f[0], source, j, "field 1 (material, or -1 ending the EBLOCK)") == -1:
+            if declared is not None and declared != len(out):
+                raise CdbError(f"ANSYS archive {source!r}: the EBLOCK of line {i + 1} declares {declared} elements "
+                               f"but lists {len(out)} (up to line {j + 1}): the file is corrupt or truncated")
             return out, j + 1
-        try:
-            v = [int(x) for x in f]
-            count, first = v[8], v[11:]
-            start = j
-            while len(first) < count:  # continuation lines
-                j += 1
-                first += [int(x) for x in _fields(lines[j], widths)]
-        except (ValueError, IndexError):
+        if len(f) < 11:
             raise CdbError(f"ANSYS archive {source!r}, line {j + 1}: not an element record of the solid EBLOCK "
-                           f"format (11 header fields, then the nodes): {lines[j]!r}") from None
-        out.append((v[1], v[10], first[:count], start))
+                           f"format: {len(f)} field(s), expected 11 header fields ({', '.join(_EBLOCK_FIELDS)}) "
+                           f"then the nodes: {lines[j]!r}")
+        v = [_int(x, source, j, f"field {k + 1} ({_EBLOCK_FIELDS[k] if k < 11 else f'node {k - 10}'})")
+             for k, x in enumerate(f)]
+        count, nodes, start = v[8], v[11:], j
+        if not 1 <= count <= MAX_ELEMENT_NODES:
+            raise CdbError(f"ANSYS archive {source!r}, line {j + 1}: field 9 (node count) is {count}, expected "
+                           f"1..{MAX_ELEMENT_NODES}")
+        number = _number(v[10], source, j, "element number (field 11)")
+        while len(nodes) < count:  # continuation lines
+            j += 1
+            if j >= len(lines):
+                raise CdbError(f"ANSYS archive {source!r}, line {start + 1}: element {number} lists {len(nodes)} "
+                               f"of its {count} nodes before the end of the file: the file is truncated")
+            more = _fields(lines[j], widths)
+            if not more:
+                raise CdbError(f"ANSYS archive {source!r}, line {j + 1}: element {number} (line {start + 1}) "
+                               f"lists {len(nodes)} of its {count} nodes, then an empty line")
+            nodes += [_int(x, source, j, f"node {len(nodes) + k + 1} of element {number}")
+                      for k, x in enumerate(more)]
+        out.append((v[1], number, nodes[:count], start))
         j += 1
-    raise CdbError(f"ANSYS archive {source!r}: the EBLOCK of line {i + 1} has no end (-1)")
+    raise CdbError(f"ANSYS archive {source!r}: the EBLOCK of line {i + 1} has no end (-1): the file is truncated")
 
 
-def _cmblock(lines: list[str], i: int, source: str) -> tuple[str, str, list[int], int]:
+def _cmblock(lines: list[str], i: int, source: str) -> tuple[str, str, list[tuple[int, int]], int, int]:
+    """``(name, kind, ranges, line, next line)``: the component's members as inclusive number ranges."""
     parts = [p.strip() for p in lines[i].split("!")[0].split(",")]
     if len(parts) < 4 or parts[2].upper() not in ("NODE", "ELEM"):
         raise CdbError(f"ANSYS archive {source!r}, line {i + 1}: expected CMBLOCK,name,NODE|ELEM,count, got "
                        f"{lines[i].strip()!r}")
-    name, kind, count = parts[1], parts[2].upper(), _int(parts[3], source, i)
+    name, kind = parts[1], parts[2].upper()
+    count = _int(parts[3], source, i, f"the entry count of component {name!r}")
+    if count < 0:
+        raise CdbError(f"ANSYS archive {source!r}, line {i + 1}: component {name!r} has {count} entries (>= 0)")
     widths = [w for _, w in _format(lines, i + 1, source)]
-    values: list[int] = []
+    values: list[tuple[int, int]] = []  # (value, line)
     j = i + 2
     while len(values) < count and j < len(lines):
-        values += [_int(x, source, j) for x in _fields(lines[j], widths)]
+        values += [(_int(x, source, j, f"an entry of component {name!r}"), j) for x in _fields(lines[j], widths)]
         j += 1
     if len(values) < count:
         raise CdbError(f"ANSYS archive {source!r}: component {name!r} (line {i + 1}) lists {len(values)} of its "
-                       f"{count} entries before the end of the file")
-    members: list[int] = []
-    for v in values[:count]:
-        if v < 0 and members:
-            members += range(members[-1] + 1, -v + 1)
+                       f"{count} entries before the end of the file: the file is truncated")
+    what = "node" if kind == "NODE" else "element"
+    ranges: list[tuple[int, int]] = []
+    for v, line in values[:count]:
+        if v < 0:
+            if not ranges or ranges[-1][0] != ranges[-1][1]:
+                raise CdbError(f"ANSYS archive {source!r}, line {line + 1}: component {name!r}: the entry {v} closes "
+                               "a range (a negative entry follows the range's first number), but no first number "
+                               "precedes it")
+            lo = ranges[-1][0]
+            hi = _number(-v, source, line, f"component {name!r}: {what} number")
+            if hi < lo:
+                raise CdbError(f"ANSYS archive {source!r}, line {line + 1}: component {name!r}: the range {lo}..{hi} "
+                               "runs backwards")
+            ranges[-1] = (lo, hi)
         elif v > 0:
-            members.append(v)
-    return name, kind, members, j
+            v = _number(v, source, line, f"component {name!r}: {what} number")
+            ranges.append((v, v))
+        else:
+            raise CdbError(f"ANSYS archive {source!r}, line {line + 1}: component {name!r}: entry 0 is not a "
+                           f"{what} number (1..{MAX_NUMBER}, or a negative number closing a range)")
+    return name, kind, ranges, i, j
 
 
-def _cells(elements, types: dict[int, int], index: np.ndarray, source: str):
+def _cells(elements, types: dict[int, int], index: _NodeIndex, source: str):
     """Cells by meshio type (node indices), element counts by ANSYS type, and each element's node indices."""
     cells: dict[str, list[list[int]]] = {}
     counts: dict[str, int] = {}
@@ -276,11 +400,15 @@ def _cells(elements, types: dict[int, int], index: np.ndarray, source: str):
         if ename is None:
             raise CdbError(f"ANSYS archive {source!r}, line {line + 1}: element {number} has type {itype}, which no "
                            "ET record defines")
-        bad = [k for k in nodes if k <= 0 or k >= index.size or index[k] < 0]
-        if bad:
-            raise CdbError(f"ANSYS archive {source!r}, line {line + 1}: element {number} uses node {bad[0]}, which "
+        found = index.find(nodes)
+        if (found < 0).any():
+            bad = nodes[int(np.flatnonzero(found < 0)[0])]
+            raise CdbError(f"ANSYS archive {source!r}, line {line + 1}: element {number} uses node {bad}, which "
                            "the NBLOCK does not define")
-        idx = [int(index[k]) for k in nodes]
+        idx = found.tolist()
+        if number in by_number:
+            raise CdbError(f"ANSYS archive {source!r}, line {line + 1}: element number {number} is used twice; "
+                           "element numbers must be unique")
         by_number[number] = sorted(set(idx))
         counts[str(ename)] = counts.get(str(ename), 0) + 1
         if ename not in SOLIDS:

@@ -34,12 +34,12 @@ import numpy as np
 from ..checks import finite, integer, point, positive
 from ..io import atomic_path
 from .cad import build_blade, build_plate, gmsh_model, tip_field
-from .mesh import Mesh, load_mesh
+from .mesh import EXTENT_RANGE, Mesh, load_mesh
 from .naca import SECTION_POINTS, naca_parameters, naca_section
 
 __all__ = [
-    "CONTACT_RTOL", "SECTION_POINTS", "TIP_ZONE", "BladeGeometry", "PlateGeometry", "blade_mesh", "cad_volume",
-    "naca_parameters", "naca_section",
+    "CONTACT_RTOL", "MAX_CELLS", "SECTION_POINTS", "TIP_ZONE", "BladeGeometry", "PlateGeometry", "blade_mesh",
+    "cad_volume", "estimate_cells", "naca_parameters", "naca_section",
 ]
 
 #: Tip refinement: the size grows from ``tip_size`` at the tip to ``size`` over
@@ -48,6 +48,56 @@ TIP_ZONE = 0.25
 
 #: Relative tolerance on the radial coordinate of a contact point (of ``span``).
 CONTACT_RTOL = 1e-9
+
+#: Default cap on the number of cells :func:`blade_mesh` may make (checked
+#: with :func:`estimate_cells` before gmsh runs): 2e6 tetrahedra of order 2
+#: are about 9e6 dofs, beyond what the dense-ish eigen/reduction steps handle
+#: in memory on a workstation.
+MAX_CELLS = 2_000_000
+
+
+#: Most lofted sections of a :class:`BladeGeometry` (OpenCASCADE lofts through
+#: hundreds of sections take minutes; a smooth blade needs a handful).
+MAX_SECTIONS = 200
+
+
+def _is_number(value) -> bool:
+    """A real number: Python or numpy int/float, not a boolean nor a string."""
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+
+
+def _check_types(obj, units: dict[str, str], optional: tuple[str, ...] = ()) -> None:
+    """Every field in ``units`` must be a number (``None`` allowed for ``optional``), else ``ValueError``."""
+    for name, unit in units.items():
+        value = getattr(obj, name)
+        if value is None and name in optional:
+            continue
+        if not _is_number(value):
+            hint = " or omitted" if name in optional else ""
+            raise ValueError(f"{name} must be a number ({unit}){hint}, got {value!r}")
+
+
+def _check_lengths(obj, names: tuple[str, ...], offsets: tuple[str, ...] = ()) -> None:
+    """Lengths (``names``, > 0) within :data:`~bladecase.fe.mesh.EXTENT_RANGE` and offsets (``offsets``) at most
+    its upper end: outside, a unit mistake, and gmsh and the FE matrices over- or underflow."""
+    lo, hi = EXTENT_RANGE
+    for name in names:
+        value = getattr(obj, name)
+        if value is not None and value > 0 and not lo <= value <= hi:
+            raise ValueError(f"{name} = {value!r} m is out of the range [{lo:g}, {hi:g}] m of a blade's lengths "
+                             "(a unit mistake?)")
+    for name in offsets:
+        value = getattr(obj, name)
+        if math.isfinite(value) and abs(value) > hi:
+            raise ValueError(f"{name} = {value!r} m is out of the range [-{hi:g}, {hi:g}] m (a unit mistake?)")
+
+
+def _check_point(name: str, value, sizes: tuple[int, ...]) -> None:
+    """``value`` must be a list/tuple/array of ``sizes`` numbers (then checked by :func:`~bladecase.checks.point`)."""
+    counts = " or ".join(map(str, sizes))
+    items = value.tolist() if isinstance(value, np.ndarray) and value.ndim == 1 else value
+    if not isinstance(items, (list, tuple)) or len(items) not in sizes or not all(map(_is_number, items)):
+        raise ValueError(f"{name} must be a list of {counts} numbers (metres), got {value!r}")
 
 
 @dataclass(frozen=True)
@@ -124,6 +174,16 @@ class BladeGeometry:
     contact_point: tuple[float, float, float] | None = None
 
     def __post_init__(self) -> None:
+        _check_types(self, {
+            "span": "metres", "root_chord": "metres", "tip_chord": "metres", "thickness": "metres",
+            "twist_deg": "degrees", "stagger_deg": "degrees", "sweep": "metres", "lean": "metres",
+            "trailing_edge_thickness": "a fraction of the chord",
+        }, optional=("tip_chord", "thickness"))
+        if self.naca is not None and not isinstance(self.naca, str):
+            raise ValueError(f"naca must be a 4-digit string such as '2412' or '0012', got {self.naca!r}")
+        integer("n_sections", self.n_sections, 2, MAX_SECTIONS)
+        if self.contact_point is not None:
+            _check_point("contact_point", self.contact_point, (3,))
         positive("span", self.span)
         positive("root_chord", self.root_chord)
         positive("tip_chord", self.tip_chord, allow_none=True)
@@ -135,7 +195,7 @@ class BladeGeometry:
             )
         for name in ("twist_deg", "stagger_deg", "sweep", "lean"):
             finite(name, getattr(self, name))
-        integer("n_sections", self.n_sections, 2)
+        _check_lengths(self, ("span", "root_chord", "tip_chord", "thickness"), ("sweep", "lean"))
         if self.naca is not None:
             t = naca_parameters(self.naca)[2]
             te = positive("trailing_edge_thickness", self.trailing_edge_thickness)
@@ -239,10 +299,19 @@ class PlateGeometry:
     contact_point: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
+        _check_types(self, {"span": "metres", "chord": "metres", "taper": "tip chord / root chord",
+                            "sweep": "metres"})
+        if self.contact_point is not None:
+            _check_point("contact_point", self.contact_point, (2, 3))
         positive("span", self.span)
         positive("chord", self.chord)
         positive("taper", self.taper)
         finite("sweep", self.sweep)
+        _check_lengths(self, ("span", "chord"), ("sweep",))
+        lo, hi = EXTENT_RANGE
+        if not lo <= self.taper * self.chord <= hi:
+            raise ValueError(f"taper = {self.taper!r} makes a tip chord of {self.taper * self.chord:g} m, out of the "
+                             f"range [{lo:g}, {hi:g}] m of a blade's lengths")
         if self.contact_point is not None:
             p = point("contact_point", self.contact_point, (2, 3))
             x, y = p[:2]
@@ -269,6 +338,151 @@ class PlateGeometry:
 
 # ----------------------------------------------------------------------------- meshing
 
+#: Cells per ``size**dim`` of area/volume made by gmsh's Delaunay/frontal
+#: meshers (an equilateral triangle of side h has area 0.433 h², gmsh's
+#: measured ~2.3 triangles per h²; about 6-7 tetrahedra per h³ measured on the
+#: blades), rounded up so that :func:`estimate_cells` over-estimates.
+_CELLS_PER_UNIT = {2: 2.6, 3: 8.0}
+#: Tetrahedra per surface triangle of a body thinner than the element size.
+_THIN_LAYER = 2.0
+#: Cells per simplex when ``cells = "hexahedron"`` (gmsh subdivision).
+_SUBDIVISION = {2: 3, 3: 4}
+
+
+def _measures(geometry) -> tuple[int, float, float]:
+    """``(dim, measure, boundary)``: area and perimeter (plate) or volume and surface area (blade)."""
+    if isinstance(geometry, PlateGeometry):
+        c0, c1 = geometry.chord, geometry.taper * geometry.chord
+        area = 0.5 * geometry.span * (c0 + c1)
+        lo, hi = geometry.tip_edge()
+        side = math.hypot(lo + 0.5 * c0, geometry.span) + math.hypot(hi - 0.5 * c0, geometry.span)
+        return 2, area, c0 + c1 + side
+    if isinstance(geometry, BladeGeometry):
+        c0 = geometry.root_chord
+        c1 = c0 if geometry.tip_chord is None else geometry.tip_chord
+        span = geometry.span
+        if geometry.naca is not None:  # unit-chord section: area and perimeter scale as c² and c
+            upper, lower, _ = naca_section(geometry.naca, 1.0, geometry.trailing_edge_thickness, 201)
+            ring = np.vstack([upper[::-1], lower])
+            x, y = ring[:, 0], ring[:, 1]
+            a1 = 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+            p1 = float(np.sum(np.hypot(*np.diff(np.vstack([ring, ring[:1]]), axis=0).T)))
+            section_area = (a1 * c0 * c0, a1 * c1 * c1)
+            volume = a1 * span * (c0 * c0 + c0 * c1 + c1 * c1) / 3
+            lateral = p1 * span * (c0 + c1) / 2
+        else:
+            t = float(geometry.thickness)
+            section_area = (c0 * t, c1 * t)
+            volume = span * t * (c0 + c1) / 2
+            lateral = span * (c0 + c1 + 2 * t)
+        # sweep and lean stretch the lateral surface
+        lateral *= math.hypot(1.0, math.hypot(geometry.sweep, geometry.lean) / span)
+        return 3, volume, lateral + sum(section_area)
+    raise ValueError(f"geometry must be a BladeGeometry or a PlateGeometry, got {type(geometry).__name__}")
+
+
+def estimate_cells(geometry, size: float | None = None, tip_size: float | None = None,
+                   cells: str = "simplex") -> int:
+    """An estimate (an over-estimate by up to ~3×) of the number of cells :func:`blade_mesh` would make.
+
+    From the analytic area (plate) or volume (blade) and the element size,
+    without running gmsh: about ``2.6 · A / size²`` triangles or
+    ``8 · V / size³`` tetrahedra, with a floor of a layer of cells over the
+    boundary when the body is thinner than ``size``; a ``tip_size`` refines
+    the ``TIP_ZONE · span`` next to the tip (size growing linearly to
+    ``size``); ``cells = "hexahedron"`` multiplies by 4 (3 in 2-D).
+
+    Parameters
+    ----------
+    geometry : BladeGeometry or PlateGeometry
+    size, tip_size : float or None
+        As in :func:`blade_mesh` (``None``: ``geometry.default_size()`` and a uniform size).
+    cells : {"simplex", "hexahedron"}
+
+    Examples
+    --------
+    >>> plate = PlateGeometry(span=0.1, chord=0.02)
+    >>> estimate_cells(plate, size=0.005) < 1000
+    True
+    >>> f"{estimate_cells(plate, size=1e-6):.1e}"  # far above MAX_CELLS: blade_mesh refuses it
+    '5.2e+09'
+    >>> estimate_cells(BladeGeometry(span=0.15, root_chord=0.05, naca="2412")) < MAX_CELLS
+    True
+    """
+    size = geometry.default_size() if size is None else positive("size", size)
+    tip_size = positive("tip_size", tip_size, allow_none=True)
+    if cells not in ("simplex", "hexahedron"):
+        raise ValueError(f"cells must be 'simplex' or 'hexahedron', got {cells!r}")
+    n = _estimate(_measures(geometry), float(geometry.span), size, tip_size, cells)
+    return int(math.ceil(min(n, 1e300)))
+
+
+def _estimate(measures: tuple[int, float, float], span: float, size: float, tip_size: float | None,
+              cells: str) -> float:
+    """:func:`estimate_cells` from :func:`_measures` (a float, ``inf`` when it overflows)."""
+    dim, measure, boundary = measures
+    reach = TIP_ZONE * span
+    refined = tip_size is not None and tip_size < size
+
+    def density(m: float, d: int) -> float:
+        """∫ dm / h^d over a measure ``m`` spread evenly along the span, h = size but over the tip zone."""
+        w = m / size**d
+        if refined:
+            slope = (size - tip_size) / reach  # h = tip_size + slope · (distance to the tip)
+            zone = (tip_size ** (1 - d) - size ** (1 - d)) / ((d - 1) * slope)  # ∫_0^reach ds / h^d
+            w += m / span * (zone - reach / size**d)
+        return w
+
+    try:
+        n = _CELLS_PER_UNIT[dim] * density(measure, dim)
+        if dim == 3:  # thin bodies: at least about a layer of tetrahedra under the surface triangles
+            n = max(n, _THIN_LAYER * _CELLS_PER_UNIT[2] * density(boundary, 2))
+    except (ZeroDivisionError, OverflowError):
+        return math.inf
+    return n * _SUBDIVISION[dim] if cells == "hexahedron" else n
+
+
+def _check_cells(geometry, size: float, tip_size: float | None, cells: str, max_cells: int) -> None:
+    """Refuse, before gmsh runs, sizes that would make more than ``max_cells`` cells."""
+    measures = _measures(geometry)
+    span = float(geometry.span)
+    n = _estimate(measures, span, size, tip_size, cells)
+    if n <= max_cells:
+        return
+
+    def least(count, x: float, top: float = math.inf) -> float:
+        """The least ``y`` in ``[x, top]`` with ``count(y) <= max_cells`` (``count`` decreasing; log bisection)."""
+        lo, hi = x, min(10 * x, top)
+        while count(hi) > max_cells and hi < min(top, 1e300):
+            lo, hi = hi, min(10 * hi, top)
+        for _ in range(80):
+            mid = lo * math.sqrt(hi / lo)
+            if count(mid) > max_cells:
+                lo = mid
+            else:
+                hi = mid
+        return hi
+
+    what = "cells" if cells == "simplex" else "hexahedra" if measures[0] == 3 else "quadrilaterals"
+
+    def up(x: float) -> str:  # 2 significant digits, rounded up
+        e = math.floor(math.log10(x)) - 1
+        return f"{math.ceil(x / 10**e) * 10**e:.2g}"
+
+    if tip_size is None or _estimate(measures, span, size, None, cells) > max_cells:
+        fix = f"size >= {up(least(lambda h: _estimate(measures, span, h, None, cells), size))} m"
+        if tip_size is not None:
+            fix += " without a finer tip_size"
+    else:
+        fix = f"tip_size >= {up(least(lambda t: _estimate(measures, span, size, t, cells), tip_size, size))} m"
+    given = f"size = {size:g} m" + ("" if tip_size is None else f", tip_size = {tip_size:g} m")
+    about = "more than 1e300" if math.isinf(n) else f"about {n:.1e}"
+    raise ValueError(
+        f"{given} would make {about} {what} (at most {max_cells:g}: raise [limits] cells "
+        f"(max_cells), or use {fix})"
+    )
+
+
 
 def _builder(geometry) -> tuple[int, object]:
     if isinstance(geometry, BladeGeometry):
@@ -285,6 +499,7 @@ def blade_mesh(
     order: int = 1,
     path: str | os.PathLike | None = None,
     cells: str = "simplex",
+    max_cells: int = MAX_CELLS,
 ) -> Mesh:
     """Mesh a blade with gmsh; write the ``.msh`` if ``path`` is given; return the mesh.
 
@@ -310,6 +525,9 @@ def blade_mesh(
         four times the cells; the hexahedra are checked like any mesh's, and
         at coarse sizes on thin curved blades a few come out folded, which is
         refused (try a smaller ``size``).
+    max_cells : int
+        Refuse, before running gmsh, a ``size``/``tip_size`` for which
+        :func:`estimate_cells` exceeds this (default :data:`MAX_CELLS`).
 
     Returns
     -------
@@ -368,6 +586,8 @@ def blade_mesh(
             f"blade_mesh writes gmsh .msh files, got path {str(path)!r}; "
             "use bladecase.save_mesh for .vtu, .vtk or .inp"
         )
+    max_cells = integer("max_cells", max_cells, 1)
+    _check_cells(geometry, size, tip_size, cells, max_cells)
 
     options = {
         "General.NumThreads": 1,  # reproducible meshes

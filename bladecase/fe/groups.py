@@ -11,9 +11,26 @@ from .cells import cell_dim as _cell_dim
 GROUP_PREFIX = "group:"
 
 
+def _check_data(m, blocks, n_points: int, source: str) -> None:
+    """Point data of one value per point and cell data of one value per cell of each block: a shorter array
+    is a truncated or corrupt file (its groups would silently lose nodes)."""
+    for key, values in (getattr(m, "point_data", None) or {}).items():
+        if len(np.asarray(values)) != n_points:
+            raise ValueError(f"mesh {source}: point data {key!r} has {len(np.asarray(values))} values for "
+                             f"{n_points} points (a truncated or corrupt file?)")
+    for key, per_block in (getattr(m, "cell_data", None) or {}).items():
+        per_block = list(per_block)
+        sizes = [len(np.asarray(v)) for v in per_block]
+        if len(per_block) != len(blocks) or any(k != len(d) for k, (_, d) in zip(sizes, blocks)):
+            expected = [len(d) for _, d in blocks]
+            raise ValueError(f"mesh {source}: cell data {key!r} has {sizes} values for cell blocks of {expected} "
+                             "cells (a truncated or corrupt file?)")
+
+
 def file_groups(m, blocks, n_points: int, source: str) -> dict[str, np.ndarray]:
     """Named node sets from every source meshio exposes (see :func:`bladecase.fe.mesh.from_meshio`)."""
     found: dict[str, list[np.ndarray]] = {}
+    _check_data(m, blocks, n_points, source)
 
     def add(name, nodes):
         found.setdefault(str(name), []).append(np.asarray(nodes, dtype=np.int64).ravel())
@@ -21,9 +38,13 @@ def file_groups(m, blocks, n_points: int, source: str) -> dict[str, np.ndarray]:
     cell_sets = {k: v for k, v in (getattr(m, "cell_sets", None) or {}).items() if not k.startswith("gmsh:")}
     for name, per_block in cell_sets.items():
         add(name, [])
-        for (_, data), idx in zip(blocks, per_block):
+        for (t, data), idx in zip(blocks, per_block):
             if idx is not None and len(idx):
-                add(name, data[np.asarray(idx, dtype=np.int64)])
+                idx = np.asarray(idx).ravel()
+                if idx.dtype.kind not in "iu" or idx.min() < 0 or idx.max() >= len(data):
+                    raise ValueError(f"mesh {source}: cell set {name!r} refers to {t} cells outside 0..{len(data) - 1}"
+                                     " (a truncated or corrupt file?)")
+                add(name, data[idx.astype(np.int64)])
     # gmsh MSH 2.2: physical names in field_data, tags in cell_data (no cell_sets).
     physical = (getattr(m, "cell_data", None) or {}).get("gmsh:physical")
     if physical is not None:

@@ -101,6 +101,18 @@ class FEModel:
             n = len(self.mesh.points)
             raise ValueError(f"the clamp fixes {self.clamped.size} of the mesh's {n} nodes: no degree of freedom "
                              "is left free; clamp a face (e.g. the root), not the whole body")
+        n = self.K.shape[0]
+        if self.K.shape != (n, n) or getattr(self.M, "shape", None) != (n, n):
+            raise ValueError(f"FE model of mesh {self.mesh.source or ''}: K ({self.K.shape}) and M "
+                             f"({getattr(self.M, 'shape', None)}) must be square matrices of the same size")
+        sizes = {name: len(getattr(self.dofs, name)) for name in ("node", "direction", "coords", "fe_index")}
+        if set(sizes.values()) != {n}:
+            raise ValueError(f"FE model of mesh {self.mesh.source or ''}: its dof map has "
+                             f"{', '.join(f'{v} {k}' for k, v in sizes.items())} entries for {n} dofs")
+        n_nodes = len(self.mesh.points)
+        clamped = np.asarray(self.clamped)
+        if clamped.size and (clamped.min() < 0 or clamped.max() >= n_nodes):
+            raise ValueError(f"FE model of mesh {self.mesh.source or ''}: clamped nodes outside 0..{n_nodes - 1}")
 
     @property
     def dim(self) -> int:
