@@ -74,11 +74,15 @@ def load_system(args):
     if (args.chain is None) == (args.matrices is None):
         raise ValueError("give exactly one of --chain N or --matrices FILE.npz")
     if args.chain is not None:
+        from .nsm.system import MAX_CHAIN, dense_cost
+
+        if args.chain > MAX_CHAIN:
+            raise ValueError(f"--chain N must be <= {MAX_CHAIN}, got {args.chain}: {dense_cost(args.chain, 'N')}")
         if args.gap is None:
             raise ValueError("--gap D is required with --chain")
         return chain(args.chain, k=args.k, m=args.m, gap=args.gap)
     source = str(args.matrices)
-    data = read_npz(args.matrices, "matrices file")
+    data = read_npz(args.matrices, "matrices file", names="M, K, w, gap")
     missing = [key for key in ("M", "K", "w") if key not in data]
     if missing:
         raise ValueError(f"{source} lacks array(s) {', '.join(missing)} (needs M, K, w and gap)")

@@ -242,11 +242,12 @@ def replace_dir(new: str | os.PathLike, target: str | os.PathLike) -> None:
 
 # ----------------------------------------------------------------------------- stage files (.npz)
 
-def read_npz(path: str | os.PathLike, what: str = "stage file") -> dict[str, np.ndarray]:
+def read_npz(path: str | os.PathLike, what: str = "stage file", names: str = "") -> dict[str, np.ndarray]:
     """Every array of the ``.npz`` file ``path``, read now (a corrupted member fails here, not later).
 
-    ``ValueError`` naming the file for a missing, unreadable, truncated or corrupted file, or one that
-    holds pickled objects (never loaded).
+    ``ValueError`` naming the file for a missing, unreadable, truncated or corrupted file, a single ``.npy``
+    array (``names``: the arrays the archive should hold, for that message, e.g. ``"M, K, w, gap"``), or one
+    that holds pickled objects (never loaded).
 
     >>> import tempfile
     >>> folder = tempfile.TemporaryDirectory()
@@ -264,9 +265,10 @@ def read_npz(path: str | os.PathLike, what: str = "stage file") -> dict[str, np.
         if head[:2] != b"PK" and head != b"\x93NUMPY":
             raise ValueError(f"cannot read {what} {source!r}: not a valid .npz file (truncated, corrupted or another "
                              f"format: it does not start as a zip archive{'; the file is empty' if not head else ''})")
+        if head == b"\x93NUMPY":  # np.load would return the array itself, not an archive
+            raise ValueError(f"cannot read {what} {source!r}: it is a single .npy array, not an .npz archive of "
+                             "named arrays" + (f" {names} (write one with numpy.savez)" if names else ""))
         with np.load(path, allow_pickle=False) as data:
-            if not isinstance(data, np.lib.npyio.NpzFile):
-                raise ValueError("a single .npy array, not an .npz archive of named arrays")
             return {key: data[key] for key in data.files}
     except FileNotFoundError:
         raise ValueError(f"cannot read {what} {source!r}: no such file") from None
@@ -310,9 +312,17 @@ def npz_scalar(data, key: str, source: str, kind: str = "real"):
     return {"real": float, "int": int, "str": str}[kind](a.item())
 
 
-def npz_array(data, key: str, source: str, ndim: int | None = None, kind: str = "real") -> np.ndarray:
+def npz_array(data, key: str, source: str, ndim: int | None = None, kind: str = "real", *,
+              finite: bool = False) -> np.ndarray:
     """The array ``data[key]`` of a stage file, checked: numbers (``kind="real"``) or integers (``"int"``),
-    of ``ndim`` dimensions if given; ``ValueError`` naming the file and the field otherwise."""
+    of ``ndim`` dimensions if given, every value finite if ``finite``; ``ValueError`` naming the file and the
+    field otherwise (booleans, text and objects are not numbers).
+
+    >>> npz_array({"points": np.array([[0.0, 1.0], [np.nan, 2.0]])}, "points", "m.npz", 2, finite=True)
+    Traceback (most recent call last):
+        ...
+    ValueError: m.npz: field 'points' must hold finite numbers, got 1 NaN or inf (the first: nan at [1, 0])
+    """
     a = _field(data, key, source)
     ok = {"real": "fiu", "int": "iu"}[kind]
     if kind == "int" and a.size == 0 and a.dtype.kind == "f":
@@ -322,4 +332,32 @@ def npz_array(data, key: str, source: str, ndim: int | None = None, kind: str = 
         raise ValueError(f"{source}: field {key!r} must hold {noun}, got dtype {a.dtype}")
     if ndim is not None and a.ndim != ndim:
         raise ValueError(f"{source}: field {key!r} must be a {ndim}-D array, got shape {a.shape}")
+    if finite and a.dtype.kind == "f":
+        bad = ~np.isfinite(a)
+        if bad.any():
+            at = np.unravel_index(int(np.flatnonzero(bad)[0]), a.shape)
+            raise ValueError(f"{source}: field {key!r} must hold finite numbers, got {int(bad.sum())} NaN or inf "
+                             f"(the first: {float(a[at])!r} at {list(map(int, at))})")
     return a
+
+
+def npz_index(data, key: str, source: str, size: int, *, ndim: int = 1, low: int = 0,
+              what: str = "an index") -> np.ndarray:
+    """The integer array ``data[key]`` of a stage file with every value in ``[low, size)`` (``what``: what the
+    values index, for the message); ``ValueError`` naming the file, the field and the first value out of range.
+
+    >>> npz_index({"cells": np.array([[0, 1, 2], [1, 2, 10**6]])}, "cells", "m.npz", 500, ndim=2,
+    ...           what="mesh nodes")
+    Traceback (most recent call last):
+        ...
+    ValueError: m.npz: field 'cells' must hold mesh nodes in 0..499, got 1000000 at [1, 2]
+    """
+    a = npz_array(data, key, source, ndim, "int")
+    if a.size:
+        bad = (a < low) | (a >= size)
+        if bad.any():
+            at = np.unravel_index(int(np.flatnonzero(bad)[0]), a.shape)
+            valid = f"in {low}..{size - 1}" if size > low else f"(there are none: the range {low}..{size - 1} is empty)"
+            raise ValueError(f"{source}: field {key!r} must hold {what} {valid}, got {int(a[at])} at "
+                             f"{list(map(int, at))}")
+    return a.astype(np.int64, copy=False)

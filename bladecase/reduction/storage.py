@@ -63,35 +63,86 @@ def load_reduced(path) -> ReducedModel:
 
 
 def _reduced_from_arrays(data: dict, source: str) -> ReducedModel:
+    """The reduced model of a file's arrays, every field checked against the others (``ValueError`` naming
+    ``source`` and the field): the FE model (:func:`bladecase.fe.model_from_arrays`), the contact on a free node
+    of it, ``method`` a registered one, ``size`` -1 (none) or >= 1, the reduced system (:class:`LinearSystem`'s
+    checks; for the massless contact model the same checks on ``Mr``, ``Sr``, ``w``, ``kc``), ``gap`` the
+    contact's, and ``basis`` (and ``closed_shape``, ``masses``) of one row per free dof of the model and one
+    column per reduced dof."""
+    from ..checks import numbers, positive_definite, symmetric
+    from .registry import METHODS
+
     def matrix(name):
-        return sparse_from_arrays(data, name, source) if f"{name}/data" in data else npz_array(data, name, source, 2)
+        if f"{name}/data" in data:
+            return sparse_from_arrays(data, name, source)
+        return npz_array(data, name, source, 2, finite=True)
 
     def scalar(name, kind="real"):
         return npz_scalar(data, name, source, kind)
 
+    def fail(name: str, text: str):
+        raise ValueError(f"{source}: field {name!r} {text}")
+
     model = model_from_arrays(data, prefix="model/", source=source)
-    normal = npz_array(data, "contact/normal", source, 1)
+    normal = npz_array(data, "contact/normal", source, 1, finite=True)
     nodes = tuple(int(k) for k in npz_array(data, "contact/nodes", source, 1, "int")) if "contact/nodes" in data else ()
     weights = tuple(float(x) for x in npz_array(data, "contact/weights", source, 1)) if "contact/weights" in data \
         else ()
     casing = scalar("contact/casing") if "contact/casing" in data else float("inf")
-    contact = Contact(scalar("contact/node", "int"), tuple(normal) if normal.size else None, scalar("contact/gap"),
-                      nodes, weights, casing)
-    size = scalar("size", "int")
-    w, gap, method = npz_array(data, "w", source, 1), scalar("gap"), scalar("method", "str")
     try:
-        if "contact_model" in data and scalar("contact_model", "str") == "massless":
+        contact = Contact(scalar("contact/node", "int"), tuple(normal) if normal.size else None,
+                          scalar("contact/gap"), nodes, weights, casing)
+        contact.dofs(model)
+        contact.normal_for(model)
+    except ValueError as exc:
+        raise ValueError(f"{source}: the contact (fields 'contact/...') does not fit the model: {exc}") from None
+    size = scalar("size", "int")
+    if size != -1 and size < 1:
+        fail("size", f"must be the size asked for (an integer >= 1) or -1 (none), got {size}")
+    w, gap, method = npz_array(data, "w", source, 1), scalar("gap"), scalar("method", "str")
+    if method not in METHODS:
+        fail("method", f"must be one of the reduction methods ({', '.join(map(repr, METHODS))}), got {method!r}")
+    if not gap == contact.gap:
+        fail("gap", f"must be the contact's clearance (field 'contact/gap' = {contact.gap!r}), got {gap!r}")
+    massless = "contact_model" in data and scalar("contact_model", "str") == "massless"
+    try:
+        if massless:
             from ..nsm import MasslessSystem
             from .massless import MasslessReducedModel
 
-            system = MasslessSystem(npz_array(data, "Mr", source, 2), npz_array(data, "Sr", source, 2), w,
-                                    scalar("kc"), gap, casing=casing)
-            return MasslessReducedModel(method=method, size=None if size < 0 else size, system=system,
-                                        basis=matrix("basis"), model=model, contact=contact,
-                                        closed_shape=npz_array(data, "closed_shape", source),
-                                        masses=npz_array(data, "masses", source))
-        system = LinearSystem(matrix("Mr"), matrix("Kr"), w, gap)
+            (Mr, Sr), r = (npz_array(data, name, source, 2, finite=True) for name in ("Mr", "Sr")), w.size
+            for name, A in (("Mr", Mr), ("Sr", Sr)):
+                if A.shape != (r, r):
+                    fail(name, f"must be {r} x {r} (one row and column per entry of 'w'), got shape {A.shape}")
+            numbers("w", w)
+            if not (np.all(np.isfinite(w)) and np.any(w)):
+                fail("w", f"must be a finite, non-zero vector, got {w!r}")
+            for name, A in (("Mr", Mr), ("Sr", Sr)):
+                symmetric(name, A)
+                positive_definite(name, A)
+            system = MasslessSystem(Mr, Sr, w, scalar("kc"), gap, casing=casing)
+            reduced = MasslessReducedModel(method=method, size=None if size < 0 else size, system=system,
+                                           basis=matrix("basis"), model=model, contact=contact,
+                                           closed_shape=npz_array(data, "closed_shape", source, 1, finite=True),
+                                           masses=npz_array(data, "masses", source, 1, finite=True))
+            for name in ("closed_shape", "masses"):
+                if getattr(reduced, name).shape != (model.n_dofs,):
+                    fail(name, f"must have one entry per free dof of the model ({model.n_dofs}), got shape "
+                               f"{getattr(reduced, name).shape}")
+            if np.any(reduced.masses < 0):
+                fail("masses", f"must be >= 0, got {float(reduced.masses.min())!r}")
+        else:
+            Mr, Kr = matrix("Mr"), matrix("Kr")
+            try:
+                system = LinearSystem(Mr, Kr, w, gap)
+            except ValueError as exc:  # M, K: the fields Mr, Kr
+                raise ValueError(f"{source}: the reduced system (fields 'Mr', 'Kr', 'w', 'gap'): {exc}") from None
+            reduced = ReducedModel(method=method, size=None if size < 0 else size, system=system,
+                                   basis=matrix("basis"), model=model, contact=contact)
     except ValueError as exc:
-        raise ValueError(f"{source}: {exc}") from None
-    return ReducedModel(method=method, size=None if size < 0 else size, system=system,
-                        basis=matrix("basis"), model=model, contact=contact)
+        raise ValueError(exc if str(exc).startswith(source) else f"{source}: {exc}") from None
+    want = (model.n_dofs, reduced.system.n)
+    if reduced.basis.shape != want:
+        fail("basis", f"must be {want[0]} x {want[1]} (a row per free dof of the model, a column per reduced dof), "
+                      f"got shape {reduced.basis.shape}")
+    return reduced
