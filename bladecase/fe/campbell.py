@@ -28,7 +28,7 @@ from ..linalg import lowest_modes
 from .model import FEModel
 from .rotation import RotationAxis, spin
 
-__all__ = ["Campbell", "campbell", "crossings", "mac", "track"]
+__all__ = ["Campbell", "campbell", "crossings", "from_modes", "mac", "track"]
 
 #: A link between two speeds whose MAC is below this is reported as uncertain (the speeds are too far apart).
 MAC_WARN = 0.8
@@ -169,7 +169,17 @@ def campbell(model: FEModel, speeds, axis: RotationAxis | None = None, count: in
         shapes.append(phi)
         values.append(np.sqrt(np.maximum(lam, 0.0)) / (2 * math.pi))
         displacements.append(state.displacement)
-    index, link = track(shapes, model.M, count)
-    freqs = np.array([values[s][index[s]] for s in range(len(speeds))])
+    out = from_modes(speeds, shapes, values, model.M, count, engine_orders)
+    out.running_displacement = displacements
+    return out
+
+
+def from_modes(speeds, shapes: list[np.ndarray], frequencies: list[np.ndarray], M, count: int,
+               engine_orders=()) -> Campbell:
+    """The Campbell diagram of modes computed elsewhere (e.g. by an executor, one speed per task):
+    ``shapes[s]`` (dofs × candidates) and ``frequencies[s]`` (Hz) at ``speeds[s]`` (rad/s, ascending)."""
+    speeds = np.asarray(speeds, dtype=float)
+    index, link = track(list(shapes), M, count)
+    freqs = np.array([np.asarray(frequencies[s])[index[s]] for s in range(len(speeds))])
     orders = [integer("engine order", e, 1) for e in engine_orders]
-    return Campbell(speeds, freqs, index, link, orders, crossings(speeds, freqs, orders), displacements)
+    return Campbell(speeds, freqs, index, link, orders, crossings(speeds, freqs, orders))
