@@ -1,0 +1,203 @@
+"""The rotating blade in a study (``[rotation]``): the operating speed every later stage works at, the running
+clearance, and the Campbell diagram with the nonsmooth-mode band at each speed.
+
+* **Operating speed** (``[rotation] speed``, default the highest of ``speeds``): the FE model is linearised about
+  its centrifugal state there (:func:`~bladecase.fe.rotation.spin`); the reduction, the nonsmooth modes and the
+  forced response all use ``K(Ω)``.
+* **Running clearance**: the centrifugal growth of the blade along the contact normal closes the clearance;
+  ``[contact] clearance`` is the cold one unless ``clearance_at = "speed"``.  A clearance that closes is a
+  clear error at the operating speed (with the speed at which the blade first touches), and an entry of the
+  Campbell table at the other speeds (no band there).
+* **Campbell diagram**: at every speed of ``speeds`` (one task per speed through the study's executor), the
+  lowest modes of ``K(Ω)``, followed across speeds by MAC (:mod:`~bladecase.fe.campbell`), the engine orders and
+  their crossings, and — unless ``bands = false`` — the reduced model and the nonsmooth-mode search of the study
+  at that speed: the band of frequencies the admissible orbits span, from grazing to the end of the arc.  The
+  report lists every speed range where an engine order lies inside a band (the contact-induced interaction
+  risk).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from .. import log
+from ..fe.campbell import Campbell, from_modes
+from ..fe.rotation import RotationAxis, SpinState, spin, to_rad_s
+from ..linalg import lowest_modes
+from .schema import Study, StudyError
+
+__all__ = ["band_risks", "campbell_stage", "operating_point", "rotation_axis", "running_clearance", "speeds"]
+
+#: Candidate modes computed beyond the ``modes`` tracked (modes entering from above are followed by shape).
+EXTRA_MODES = 4
+
+
+def _section(study: Study) -> dict | None:
+    r = study.config.get("rotation")
+    return r if r and (r.get("speeds") or r.get("speed") is not None) else None
+
+
+def rotation_axis(study: Study) -> RotationAxis:
+    """``[rotation] axis`` as a :class:`~bladecase.fe.rotation.RotationAxis`."""
+    axis = _section(study)["axis"]
+    try:
+        return RotationAxis(axis["origin"], axis["direction"])
+    except ValueError as exc:
+        raise StudyError(f"[rotation] axis: {exc}") from None
+
+
+def speeds(study: Study) -> np.ndarray:
+    """The Campbell speeds (rad/s, ascending, without repeats)."""
+    r = _section(study)
+    return np.unique([to_rad_s(v, r["speed_unit"]) for v in r["speeds"]])
+
+
+def operating_speed(study: Study) -> float | None:
+    """The speed (rad/s) of the study's analysis: ``[rotation] speed``, else the highest of ``speeds``; ``None``
+    for a study at rest."""
+    r = _section(study)
+    if r is None:
+        return None
+    return to_rad_s(r["speed"] if r.get("speed") is not None else max(r["speeds"]), r["speed_unit"])
+
+
+def running_clearance(study: Study, model, contact, state: SpinState) -> dict:
+    """The contact's centrifugal closure at ``state``'s speed and the running clearance it leaves."""
+    closure = float(contact.w(model) @ state.displacement)  # towards the casing: +
+    cold = study["contact"].get("clearance_at", "cold") == "cold"
+    given = float(contact.gap)
+    running = given - closure if cold else given
+    out = {"speed_rad_s": state.speed, "speed_rpm": state.speed * 60 / (2 * math.pi), "closure_m": closure,
+           "clearance_cold_m": given if cold else given + closure, "clearance_running_m": running}
+    if running <= 0 and closure > 0:  # the closure grows as Ω²: where the cold clearance is used up
+        out["touches_at_rpm"] = out["speed_rpm"] * math.sqrt(out["clearance_cold_m"] / closure)
+    return out
+
+
+def operating_point(study: Study, model, contact, factor=None):
+    """``(model, contact, factor, info)`` of the study's analysis: at rest unchanged (``info`` None); at speed the
+    model with ``K(Ω)``, the contact at its running clearance, ``K(Ω)``'s factorisation and a summary.
+
+    Raises
+    ------
+    StudyError
+        The running clearance is closed at the operating speed (the message gives the speed at which the blade
+        first touches its casing statically).
+    """
+    omega = operating_speed(study)
+    if omega is None:
+        return model, contact, factor, None
+    axis = rotation_axis(study)
+    try:
+        state = spin(model, omega, axis)
+    except ValueError as exc:
+        raise StudyError(f"[rotation] speed: {exc}") from None
+    info = running_clearance(study, model, contact, state)
+    if info["clearance_running_m"] <= 0:
+        raise StudyError(f"[rotation] speed: at {info['speed_rpm']:.6g} rpm the blade's centrifugal growth along the "
+                         f"contact normal ({info['closure_m'] * 1e3:.4g} mm) closes the clearance "
+                         f"({info['clearance_cold_m'] * 1e3:.4g} mm cold): it touches its casing statically from "
+                         f"about {info.get('touches_at_rpm', float('nan')):.6g} rpm; lower the speed or widen "
+                         "[contact] clearance")
+    log.info("rotation: %.6g rpm (%.6g rad/s) about %s through %s; running clearance %.4g mm (cold %.4g mm, "
+             "centrifugal closure %.4g mm)", info["speed_rpm"], omega, axis.direction.round(6).tolist(),
+             axis.origin.tolist(), info["clearance_running_m"] * 1e3, info["clearance_cold_m"] * 1e3,
+             info["closure_m"] * 1e3)
+    hot = dataclasses.replace(contact, gap=info["clearance_running_m"])
+    return state.model, hot, state.factor, info
+
+
+def _speed_point(omega: float, *, study: Study, model, contact, axis: RotationAxis, count: int,
+                 bands: bool) -> dict:
+    """One speed of the Campbell diagram (module level: an executor ships it to its workers)."""
+    from .stages import build_reduced, search
+
+    state = spin(model, float(omega), axis)
+    n = min(count + EXTRA_MODES, model.n_dofs - 1)
+    lam, phi = lowest_modes(state.model.K, state.model.M, n, factor=state.factor)
+    point = {"shapes": phi, "frequencies_hz": np.sqrt(np.maximum(lam, 0.0)) / (2 * math.pi),
+             "clearance": running_clearance(study, model, contact, state), "band_hz": None, "note": None}
+    d = point["clearance"]["clearance_running_m"]
+    if not bands:
+        return point
+    if d <= 0:
+        point["note"] = "clearance closed: the blade rests on its casing"
+        return point
+    hot = dataclasses.replace(contact, gap=d)
+    reduced = build_reduced(study, state.model, hot, factor=state.factor)
+    families = search(study, reduced.system)
+    arcs = [a for f in families for a in f.arcs]
+    if arcs:
+        point["band_hz"] = (min(1.0 / a.T_hi for a in arcs), max(1.0 / a.T_lo for a in arcs))
+    else:
+        point["note"] = "no admissible orbit in [search] periods"
+    return point
+
+
+def campbell_stage(study: Study, model, contact, executor, progress: bool = False) -> tuple[Campbell, dict]:
+    """The Campbell diagram of the study (see the module): ``(campbell, summary section)``; the bands as
+    ``summary["bands"]``, one entry per speed."""
+    r = _section(study)
+    w = speeds(study)
+    axis = rotation_axis(study)
+    count = min(int(r.get("modes", 6)), model.n_dofs - 1)
+    points = executor.map(_speed_point, list(w), shared={"study": study, "model": model, "contact": contact,
+                                                         "axis": axis, "count": count,
+                                                         "bands": bool(r.get("bands", True))},
+                          desc="speeds", progress=progress)
+    c = from_modes(w, [p["shapes"] for p in points], [p["frequencies_hz"] for p in points], model.M, count,
+                   r.get("engine_orders", []))
+    bands = [p["band_hz"] for p in points]
+    section = c.to_dict()
+    section["axis"] = {"origin": axis.origin.tolist(), "direction": axis.direction.tolist()}
+    section["running_clearance_m"] = [p["clearance"]["clearance_running_m"] for p in points]
+    section["closure_m"] = [p["clearance"]["closure_m"] for p in points]
+    section["bands"] = [None if b is None else {"mode": _rank0(c, s), "low_hz": b[0], "high_hz": b[1]}
+                        for s, b in enumerate(bands)]
+    section["band_notes"] = [p["note"] for p in points]
+    section["risks"] = band_risks(w, bands, section["engine_orders"])
+    if c.uncertain_links:
+        s, j = c.uncertain_links[0]
+        log.warning("Campbell: mode %d is followed from %.6g to %.6g rpm with a MAC of %.2f only: add speeds "
+                    "between them", j + 1, w[s - 1] * 60 / (2 * math.pi), w[s] * 60 / (2 * math.pi),
+                    c.link_mac[s, j])
+    for risk in section["risks"]:
+        log.warning("engine order %d lies inside the nonsmooth-mode band from %.6g to %.6g rpm: contact-induced "
+                    "interaction risk", risk["engine_order"], risk["from_rpm"], risk["to_rpm"])
+    return c, section
+
+
+def _rank0(c: Campbell, s: int) -> int:
+    """The tracked mode that is the lowest at speed ``s`` (the band's mode: [search] periods are in T1)."""
+    return int(np.flatnonzero(c.rank[s] == 0)[0]) if (c.rank[s] == 0).any() else 0
+
+
+def band_risks(speeds_rad_s: np.ndarray, bands: list, engine_orders, samples: int = 2001) -> list[dict]:
+    """Speed ranges (rpm) where an engine order's frequency ``N Ω / 2π`` lies inside the band (``(low, high)`` Hz
+    per speed, ``None`` where there is none), the band's edges interpolated linearly between speeds.
+
+    >>> band_risks(np.array([0.0, 100.0]), [(10.0, 11.0), (15.0, 17.0)], [1])
+    [{'engine_order': 1, 'from_rpm': 875.2, 'to_rpm': 954.9}]
+    """
+    w = np.asarray(speeds_rad_s, dtype=float)
+    have = np.array([b is not None for b in bands])
+    if w.size < 1 or not have.any():
+        return []
+    grid = np.linspace(w[0], w[-1], samples) if w.size > 1 else w
+    lo = np.array([b[0] if b is not None else np.nan for b in bands])
+    hi = np.array([b[1] if b is not None else np.nan for b in bands])
+    out = []
+    for n in engine_orders:
+        f = n * grid / (2 * math.pi)
+        low, high = np.interp(grid, w, lo), np.interp(grid, w, hi)
+        # no band between two speeds where one of them has none
+        gap = np.interp(grid, w, (~have).astype(float)) > 0
+        inside = (f >= low) & (f <= high) & ~gap & np.isfinite(low)
+        edges = np.flatnonzero(np.diff(np.r_[False, inside, False].astype(int)))
+        for a, b in zip(edges[::2], edges[1::2] - 1):
+            out.append({"engine_order": int(n), "from_rpm": round(float(grid[a]) * 60 / (2 * math.pi), 1),
+                        "to_rpm": round(float(grid[b]) * 60 / (2 * math.pi), 1)})
+    return out
