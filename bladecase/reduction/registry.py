@@ -8,6 +8,8 @@ A method is a name, a builder and a one-line summary.  The builder turns a model
 ``size`` has been checked to be an integer >= 1 (``sized=True``, the default) or is passed as given
 (``sized=False``, e.g. ``"full"``); ``factor`` is the caller's factorisation of ``model.K``
 (:func:`bladecase.fe.stiffness_factor`) or ``None`` — a builder that factorises ``K`` should reuse it.
+A method that keeps the whole model dense (``limited=True``, e.g. ``"full"``) also takes ``limit=``, the
+largest number of free dofs it may take (:func:`reduce`'s ``limit``).
 :data:`METHODS` is the registry of :func:`reduce`: it iterates over the names in registration order, so it
 is used as the tuple of names it was before (``", ".join(METHODS)``, ``method in METHODS``).
 
@@ -67,15 +69,17 @@ Builder = Callable[..., ReducedModel]
 
 @dataclass(frozen=True)
 class Entry:
-    """One registered method: its ``name``, ``builder``, one-line ``summary``, whether it takes a ``size``, and
+    """One registered method: its ``name``, ``builder``, one-line ``summary``, whether it takes a ``size``,
     whether it takes a compliant casing (``casing``: a contact law without impacts; the others model Newton's
-    impact law, which :func:`reduce` refuses against a compliant casing)."""
+    impact law, which :func:`reduce` refuses against a compliant casing), and whether its cost is that of the
+    whole model kept dense (``limited``: the builder takes ``limit=``, the most free dofs it may keep)."""
 
     name: str
     builder: Builder
     summary: str
     sized: bool = True
     casing: bool = False
+    limited: bool = False
 
 
 class Registry(BaseRegistry[Entry]):
@@ -88,24 +92,26 @@ class Registry(BaseRegistry[Entry]):
     """
 
     def register(self, name: str, builder: Builder, summary: str, *, sized: bool = True,
-                 casing: bool = False) -> Entry:
+                 casing: bool = False, limited: bool = False) -> Entry:
         """Add an entry; ``ValueError`` for an empty or taken name or a builder that is not callable."""
         if not callable(builder):
             raise ValueError(f"the builder of {self.kind} {name!r} must be callable, got {builder!r}")
-        return self.add(Entry(name, builder, str(summary), bool(sized), bool(casing)))
+        return self.add(Entry(name, builder, str(summary), bool(sized), bool(casing), bool(limited)))
 
 
 #: The reduction methods of :func:`reduce`, by name (filled by :mod:`bladecase.reduction.methods`).
 METHODS = Registry("reduction method")
 
 
-def register(name: str, builder: Builder, summary: str, *, sized: bool = True, casing: bool = False) -> Entry:
+def register(name: str, builder: Builder, summary: str, *, sized: bool = True, casing: bool = False,
+             limited: bool = False) -> Entry:
     """Register a reduction method in :data:`METHODS` (see the module docstring)."""
-    return METHODS.register(name, builder, summary, sized=sized, casing=casing)
+    return METHODS.register(name, builder, summary, sized=sized, casing=casing, limited=limited)
 
 
 def reduce(
-    model: FEModel, contact: Contact, method: str, size: int | None = None, *, factor: SPDFactor | None = None
+    model: FEModel, contact: Contact, method: str, size: int | None = None, *, factor: SPDFactor | None = None,
+    limit: int | None = None,
 ) -> ReducedModel:
     """Reduce a finite-element model with one contact to the system the solver consumes.
 
@@ -132,6 +138,10 @@ def reduce(
     factor : SPDFactor or None
         ``bladecase.fe.stiffness_factor(model)`` to reuse a factorisation of
         ``K`` (``"modal"`` and ``"lanczos-si"`` use it); computed when needed if ``None``.
+    limit : int or None
+        The most free dofs a method that keeps the whole model dense (``"full"``) may take; ``None``:
+        :data:`~bladecase.reduction.FULL_LIMIT`.  Refused before any matrix is made dense; the other methods
+        ignore it.
 
     Returns
     -------
@@ -182,4 +192,6 @@ def reduce(
         if size is None:
             raise ValueError(f"method {method!r} needs a size (an integer >= 1), got None")
         size = integer("size", size, 1, note=" (modes or Lanczos steps)")
+    if entry.limited:
+        return entry.builder(model, contact, size, factor=factor, limit=limit)
     return entry.builder(model, contact, size, factor=factor)

@@ -38,9 +38,11 @@ from ..nsm.sweep import ENERGY_SAMPLES, SweepPoint, forced_sweep, rate_max
 from ..post.forced_plots import forced_response_plot
 from ..reduction import ReducedModel
 from ..reduction.loads import engine_order_load, nodal_load, pressure_load, project_load
+from .sections import SWEEP_CEILING, longer_periods_weigh, sweep_work_words
+from .values import LIMITS, _amplitude, sweep_periods
 
-__all__ = ["COLUMNS", "DEFAULTS", "ForcedOrbit", "build_load", "contact_load", "forced_response", "forced_scene",
-           "forcing_frequencies", "steady_orbit"]
+__all__ = ["COLUMNS", "DEFAULTS", "ForcedOrbit", "build_load", "check_sweep_work", "contact_load", "contact_reach",
+           "forced_response", "forced_scene", "forcing_frequencies", "steady_orbit"]
 
 #: What ``[forcing]`` may hold, with the defaults of the keys that have one (``amplitude`` and one of
 #: ``rayleigh`` / ``ratio`` must be given).
@@ -67,6 +69,9 @@ def _settings(forcing: dict) -> dict:
     if s["amplitude"] is None or not math.isfinite(s["amplitude"]):
         raise ValueError(f"[forcing] amplitude: required, a finite number (N for a nodal load, Pa for a pressure), "
                          f"got {s['amplitude']!r}")
+    reason = _amplitude(s["amplitude"])
+    if reason:
+        raise ValueError(f"[forcing] amplitude: {reason}, got {s['amplitude']!r}")
     for key, valid in (("load", ("nodal", "pressure")), ("direction", ("up", "down", "both")),
                        ("frequency_unit", ("Hz", "f1", "rpm"))):
         if s[key] not in valid:
@@ -136,6 +141,51 @@ def contact_load(reduced: ReducedModel, f_free) -> float:
     if shape is None or not isinstance(reduced.system, MasslessSystem):
         return 0.0
     return -float(np.asarray(shape, dtype=float) @ np.asarray(f_free, dtype=float).reshape(-1))
+
+
+def contact_reach(reduced: ReducedModel, f_r, g: float = 0.0) -> float:
+    """An upper bound of the static contact displacement per unit amplitude of the reduced load ``f_r``:
+    ``Σ_j |b_j φ_jᵀf_r| / ω_j²`` over the (open-phase) modes, plus ``|g|`` (:func:`contact_load`) — no
+    cancellation between modes, so a load across the casing normal is bounded by what its modes carry."""
+    sp_ = reduced.system.spectrum
+    omega, phi, b = (np.asarray(a, dtype=float) for a in (sp_.omega, sp_.phi, sp_.b))
+    return float(np.sum(np.abs(b * (phi.T @ np.asarray(f_r, dtype=float))) / omega**2) + abs(g))
+
+
+def check_sweep_work(reduced: ReducedModel, forcing: dict, f_r, g: float = 0.0,
+                     max_periods: int | None = None) -> None:
+    """Refuse, before the sweep, a forced response out of proportion (``ValueError`` naming the key):
+
+    * an amplitude that pushes the contact statically (:func:`contact_reach`) more than
+      ``LIMITS["forcing_reach"]`` clearances: the linear model means nothing there, and the sweep chatters for
+      hours (cost per period measured growing like the square root of that ratio);
+    * a sweep of more than ``max_periods`` (``[limits] sweep_periods``; ``None``: the largest value that key
+      takes, 1e9) forcing periods, each counted in periods ``T1`` of the first linear mode when longer
+      (:func:`~bladecase.study.values.sweep_periods`).
+
+    A study runs this check when its reduced model is built (:func:`bladecase.study.stages.build_reduced`),
+    before the search, with its own ``[limits] sweep_periods``.
+    """
+    s = _settings(forcing)
+    gap = float(reduced.system.gap)
+    reach = abs(float(s["amplitude"])) * contact_reach(reduced, f_r, g)
+    top = LIMITS["forcing_reach"]
+    if reach > top * gap:
+        unit = "Pa" if s["load"] == "pressure" else "N"
+        most = top * gap / contact_reach(reduced, f_r, g)
+        raise ValueError(f"[forcing] amplitude: {s['amplitude']:g} {unit} moves the contact up to {reach:.3g} m "
+                         f"statically, {reach / gap:.3g} × the clearance {gap:g} m (at most {top} ×: beyond, the "
+                         f"linear model means nothing and the sweep chatters for hours); valid: |amplitude| <= "
+                         f"{most:.3g} {unit}")
+    cap = SWEEP_CEILING if max_periods is None else int(max_periods)
+    f1 = float(reduced.system.spectrum.contact_modes[0][0] / (2 * np.pi))
+    sweeps = 2 if s["direction"] == "both" else 1
+    work = sweep_periods(forcing_frequencies(reduced, s) / f1, int(s["periods"]), sweeps)
+    if work > cap:
+        f = {"points": int(s["points"]), "periods": int(s["periods"]), "direction": s["direction"]}
+        longer = f", a higher lower frequency (f1 = {f1:.5g} Hz)" if longer_periods_weigh(f, work) else ""
+        raise ValueError(f"[forcing] points × periods: {sweep_work_words(f, work)}, more than [limits] sweep_periods "
+                         f"= {cap}: fewer points or periods{longer}, or raise [limits] sweep_periods")
 
 
 def forcing_frequencies(reduced: ReducedModel, forcing: dict) -> np.ndarray:
@@ -267,7 +317,7 @@ def _sweep(direction: str, system, periods, run: dict) -> tuple[str, list[SweepP
 
 
 def forced_response(reduced: ReducedModel, families: list, forcing: dict, *, folder=None, figures: bool = False,
-                    title: str = "", executor=None, progress: bool = False) -> dict:
+                    title: str = "", executor=None, progress: bool = False, max_periods: int | None = None) -> dict:
     """The forced response of ``reduced`` under ``[forcing]``, over the nonsmooth modes ``families``.
 
     Returns the ``summary.json`` section: the settings, ``points`` (columns :data:`COLUMNS`, one entry per
@@ -278,7 +328,8 @@ def forced_response(reduced: ReducedModel, families: list, forcing: dict, *, fol
     (:class:`ForcedOrbit`) is kept under the key ``"orbits"`` (not for JSON: the caller pops it).
 
     Either contact model (the massless one: ``k`` counts contact phases, ``restitution`` must be 1).  Raises
-    ``ValueError`` for bad ``[forcing]`` values.
+    ``ValueError`` for bad ``[forcing]`` values, and before the sweep for work out of proportion
+    (:func:`check_sweep_work`; ``max_periods``: ``[limits] sweep_periods``, ``None``: at most 1e9 periods ``T1``).
 
     Examples
     --------
@@ -310,6 +361,7 @@ def forced_response(reduced: ReducedModel, families: list, forcing: dict, *, fol
     if not np.any(f_r) and g == 0.0:
         raise ValueError(f"[forcing] load: its projection on the {reduced.method} reduced model is zero (no reduced "
                          "mode feels it): load another place, or reduce with another method or size")
+    check_sweep_work(reduced, s, f_r, g, max_periods)
     eo = engine_order_load(f_free, s["engine_order"]) if s["engine_order"] is not None else None
     freqs = forcing_frequencies(reduced, s)
     damping = _damping(s)

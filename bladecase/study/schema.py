@@ -18,23 +18,28 @@ import dataclasses
 import math
 import os
 import re
+import stat
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..fe import BladeGeometry, PlateGeometry
+from ..fe import BladeGeometry, Material, PlateGeometry
+from ..fe.geometry import estimate_cells
 from ..post.outputs import FORMATS as OUTPUT_FORMATS
 from ..reduction import METHODS
 from .demo import NEWTON_DEMO, demo_study, demo_text  # noqa: F401 (re-exported: they lived here)
 from .keys import _BOOL, _INT, _LIST, _NUM, _STR, REQUIRED, Key, StudyError  # noqa: F401
-from .sections import EXECUTION_KEYS, FORCING_KEYS, execution_checks, forcing_checks
+from .sections import EXECUTION_KEYS, FORCING_KEYS, LIMIT_KEYS, execution_checks, forcing_checks
 from .values import (  # noqa: F401  (RANGES, LIMITS: part of the schema's documented surface)
     LIMITS,
+    MIN_FPS,
     RANGES,
     _clamp_spec,
     _compare_periods,
     _direction,
+    _file,
+    _folder,
     _formats,
     _in_range,
     _int_at_least,
@@ -42,19 +47,24 @@ from .values import (  # noqa: F401  (RANGES, LIMITS: part of the schema's docum
     _ipp,
     _manifold_size,
     _method_names,
+    _name,
     _nonzero,
     _num,
     _one_of,
     _orbit_list,
     _period_unit,
+    _period_unit_index,
     _periods,
+    _point,
     _positive,
     _rayleigh,
     _reduction_list,
     _scale,
     _size_list,
+    _study_name,
     _vector,
     _window,
+    show,
 )
 
 #: The registry of output formats (:mod:`bladecase.post.outputs`): GIF/MP4 animations, VTK time series
@@ -67,9 +77,7 @@ FORMATS = OUTPUT_FORMATS
 #: or :class:`~bladecase.PlateGeometry` (``kind = "plate"``), see :data:`GEOMETRY_FIELDS`.
 SCHEMA: dict[str, dict[str, Key]] = {
     "study": {
-        "name": Key(_STR, "study", "Name used in titles and file names.",
-                    lambda v: None if re.fullmatch(r"[A-Za-z0-9_.-]{1,64}", v) else
-                    "must be 1-64 characters among letters, digits, '_', '.', '-'"),
+        "name": Key(_STR, "study", "Name used in titles and file names (a plain folder name).", _study_name),
     },
     "geometry": {
         "kind": Key(_STR, "blade", "'blade' (3-D lofted solid, tetrahedra) or 'plate' (2-D plane stress).",
@@ -81,7 +89,8 @@ SCHEMA: dict[str, dict[str, Key]] = {
                      "hexahedra / quadrilaterals; mesh_order 1).", _one_of("simplex", "hexahedron")),
     },
     "mesh": {
-        "path": Key(_STR, REQUIRED, "Mesh file (any meshio format with named groups), relative to the study file."),
+        "path": Key(_STR, REQUIRED, "Mesh file (any meshio format with named groups), relative to the study file.",
+                    _file),
     },
     "material": {
         "preset": Key(_STR, "Ti-6Al-4V", "Material preset (Ti-6Al-4V, steel, Inconel 718, Al 6061-T6); "
@@ -96,7 +105,8 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "clamp": Key((str, dict), "root", "Clamped nodes: a mesh group, or by coordinates (meshes without groups): "
                      "{plane = [x0, y0, z0, nx, ny, nz]}, {box = [[xmin, ymin, zmin], [xmax, ymax, zmax]]} or "
                      "{sphere = [x, y, z, r]}, with an optional tol (m).", _clamp_spec),
-        "thickness": Key(_NUM, None, "Out-of-plane thickness of a 2-D model (m); required in 2-D.", _positive),
+        "thickness": Key(_NUM, None, "Out-of-plane thickness of a 2-D model (m); required in 2-D.",
+                         lambda v: "must be > 0 (metres)" if not v > 0 else _in_range("thickness")(v)),
         "plane": Key(_STR, "stress", "'stress' or 'strain' (2-D models).", _one_of("stress", "strain")),
         "frequencies": Key(_INT, 6, "Linear frequencies of the full FE model to compute and report.",
                            _int_between(1, LIMITS["frequencies"])),
@@ -106,11 +116,11 @@ SCHEMA: dict[str, dict[str, Key]] = {
                          lambda v: "must be > 0 (metres)" if not v > 0 else _in_range("clearance")(v)),
         "group": Key(_STR, None, "Mesh group of the contact node: alone, a one-node group (default "
                      "'contact'); with 'farthest', the group searched (default 'tip'); with 'nearest', the group "
-                     "searched (default: every free node)."),
-        "node": Key(_INT, None, "Mesh node index of the contact (overrides group).", _int_at_least(0)),
+                     "searched (default: every free node).", _name),
+        "node": Key(_INT, None, "Mesh node index of the contact (overrides group).", _int_between(0, LIMITS["node"])),
         "farthest": Key(_LIST, None, "Pick the free node of 'group' (default 'tip') farthest along this "
                         "direction, e.g. [-1, 0, 0].", _direction),
-        "nearest": Key(_LIST, None, "Pick the free node nearest this point (within 'group' if given).", _vector),
+        "nearest": Key(_LIST, None, "Pick the free node nearest this point (within 'group' if given).", _point),
         "face": Key((str, dict), None, "Contact on a whole face instead of one node: the mean normal displacement "
                     "of the free nodes of this mesh group (e.g. 'tip'), one constraint all the same; or the face's "
                     "nodes by coordinates: {plane = [x0, y0, z0, nx, ny, nz]}, {box = [[..], [..]]} or "
@@ -133,7 +143,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
     "reduction": {
         "method": Key(_STR, "lanczos-si", f"Reduced model: {', '.join(METHODS)}.", _one_of(*METHODS)),
         "size": Key(_INT, 20, "Modes / Lanczos steps / fixed-interface modes kept (ignored by 'full').",
-                    _int_at_least(1)),
+                    _int_between(1, LIMITS["size"])),
         "compare": Key(_LIST, [], "Other reduced models run through the same search for comparison: "
                        "[{method = 'modal', size = 20}, …].", _reduction_list),
         "methods": Key(_LIST, [], "A comparison grid: these methods × 'sizes' (default: [method]), each run "
@@ -148,7 +158,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "ipp": Key(_LIST, [1, 2], "Impacts per period of the families to look for.", _ipp),
         "periods": Key(_LIST, [0.9, 0.9999], "Period range [lower, upper] in 'period_unit'.", _periods),
         "period_unit": Key(_STR, "T1", "'s', or 'T<j>': the period 2π/ω_j of the j-th linear mode of the "
-                           "reduced model that sees the contact.", _period_unit),
+                           "reduced model that sees the contact.", _period_unit_index),
         "scan": Key(_INT, 24, "Starting periods scanned for k >= 2 (1 ipp scans max(scan, 200)).",
                     _int_between(2, LIMITS["scan"])),
         "resolution": Key(_INT, None, "Grid points per impact time of the k >= 3 start search at each scanned "
@@ -162,9 +172,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
     "forcing": FORCING_KEYS,
     "output": {
         "directory": Key(_STR, None, "Output directory, relative to the current directory; default "
-                         "'results/<name>'; the command line's --out overrides it."),
+                         "'results/<name>'; the command line's --out overrides it.", _folder),
         "animate": Key(_INT, 2, "How many orbits to animate when 'orbits' is empty: the middles of the "
-                       "widest admissible arcs, one per family.", _int_at_least(0)),
+                       "widest admissible arcs, one per family.", _int_between(0, LIMITS["animate"])),
         "orbits": Key(_LIST, [], "Orbits to animate: [{ipp = 1, T = 0.95}, …], T in search.period_unit "
                       "(the nearest admissible orbit of a family of that ipp).", _orbit_list),
         "reference": Key(_BOOL, True, "Check each chosen orbit in a reference model (another reduction method, "
@@ -182,9 +192,11 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "manifold_size": Key(_LIST, [40, 100], "[orbits, phases] sampled on the manifold.", _manifold_size),
         "window": Key(_LIST, [800, 600], "Animation size [width, height] in pixels.", _window),
         "fps": Key(_NUM, 20, "Frames per second of the animations.",
-                   lambda v: None if 0 < v <= LIMITS["fps"] else f"must be a number in (0, {LIMITS['fps']}]"),
+                   lambda v: f"must be a number in (0, {LIMITS['fps']}]" if not 0 < v <= LIMITS["fps"] else
+                   None if v >= MIN_FPS else f"must be at least {MIN_FPS:g} frames per second"),
     },
     "execution": EXECUTION_KEYS,
+    "limits": LIMIT_KEYS,
 }
 
 #: ``[geometry]`` keys taken from the geometry dataclasses (the parametric shape).
@@ -254,7 +266,11 @@ class Study:
         if override is not None:
             return Path(override)
         d = self.config["output"]["directory"]
-        return Path(d) if d is not None else Path("results") / self.name
+        if d is not None:
+            return Path(d)
+        if not isinstance(self.name, str) or _study_name(self.name):  # a Study made without validate()
+            raise StudyError(f"[study] name: {_study_name('')}, got {show(self.name)}")
+        return Path("results") / self.name
 
 
 def _type_name(types: tuple) -> str:
@@ -265,18 +281,61 @@ def _type_name(types: tuple) -> str:
     return " or ".join(names[t] for t in types)
 
 
+def _quoted(value) -> str:
+    """``repr(value)``, cut for a message (a huge list or string is not copied into it)."""
+    text = show(value)
+    return text.removeprefix("the string ").removeprefix("a list ").removeprefix("a table ").removeprefix(
+        "the boolean ")
+
+
 def _check_value(section: str, key: str, spec: Key, value) -> Any:
     where = f"[{section}] {key}"
     ok = any(isinstance(value, t) and not (t in (int, float) and isinstance(value, bool)) for t in spec.types)
     if not ok:
-        raise StudyError(f"{where}: expected {_type_name(spec.types)}, got {type(value).__name__} {value!r}")
+        raise StudyError(f"{where}: expected {_type_name(spec.types)}, got {show(value)}")
     if isinstance(value, float) and not math.isfinite(value):
         raise StudyError(f"{where}: must be finite, got {value!r}")
     if spec.check is not None:
-        message = spec.check(value)
-        if message:
-            raise StudyError(f"{where}: {message}, got {value!r}")
+        try:
+            message = spec.check(value)
+        except (TypeError, ValueError, OverflowError, RecursionError):  # an odd item inside a list or table
+            message = "has an item of the wrong type or size"
+        if message:  # a message that names the offending item already says what it got
+            raise StudyError(f"{where}: {message}" + ("" if "got " in message else f", got {_quoted(value)}"))
     return value
+
+
+def _field_kind(cls, name: str) -> str | None:
+    """What a geometry dataclass field takes, from its annotation: ``"number"``, ``"integer"``, ``"string"`` or
+    ``"numbers"`` (a point); ``None``: left to the dataclass."""
+    annotation = str(next(f.type for f in dataclasses.fields(cls) if f.name == name))
+    base = annotation.replace(" ", "").split("|")
+    if any(b.startswith(("tuple", "list", "Sequence")) for b in base):
+        return "numbers"
+    for kind, word in (("integer", "int"), ("number", "float"), ("string", "str")):
+        if word in base:
+            return kind
+    return None
+
+
+def _check_field(kind: str, cls, key: str, value) -> None:
+    """The type of a ``[geometry]`` field of the dataclass ``cls``, before the dataclass sees it (it would turn
+    the string ``"0.1"`` into a number)."""
+    where = f"[geometry] {key}"
+    want = _field_kind(cls, key)
+    number = isinstance(value, (int, float)) and not isinstance(value, bool)
+    if want == "integer" and not (number and isinstance(value, int)):
+        raise StudyError(f"{where}: expected an integer, got {show(value)}")
+    if want == "number" and not number:
+        raise StudyError(f"{where}: expected a number, got {show(value)}")
+    if want == "string" and not isinstance(value, str):
+        raise StudyError(f"{where}: expected a string, got {show(value)}")
+    if want == "numbers" and not (isinstance(value, list) and all(
+            isinstance(x, (int, float)) and not isinstance(x, bool) for x in value)):
+        raise StudyError(f"{where}: expected a list of numbers, got {show(value)}")
+    items = value if isinstance(value, list) else [value]
+    if any(isinstance(x, float) and not math.isfinite(x) for x in items):
+        raise StudyError(f"{where}: must be finite, got {_quoted(value)}")
 
 
 def _geometry_section(raw: dict) -> dict:
@@ -293,6 +352,7 @@ def _geometry_section(raw: dict) -> dict:
         else:
             if isinstance(value, dict):
                 raise StudyError(f"[geometry] {key}: expected a number, string or list, got a table")
+            _check_field(kind, BladeGeometry if kind == "blade" else PlateGeometry, key, value)
             out[key] = value
     for key, spec in SCHEMA["geometry"].items():
         out.setdefault(key, spec.default)
@@ -302,8 +362,55 @@ def _geometry_section(raw: dict) -> dict:
         missing = re.findall(r"'(\w+)'", str(exc))
         raise StudyError(f"[geometry] {', '.join(missing) or '?'}: required for kind = {kind!r} ({exc})") from None
     except ValueError as exc:
-        raise StudyError(f"[geometry] {exc}") from None
+        text = _one_line(exc)
+        name = re.match(r"(\w+)\b", text)
+        if name and name.group(1) in allowed and not text.startswith(f"{name.group(1)}:"):
+            text = f"{name.group(1)}:{text[name.end():]}"  # "[geometry] span: must be ..."
+        raise StudyError(f"[geometry] {text}") from None
+    g = out
+    if g["tip_size"] is not None and g["size"] is not None and g["tip_size"] > g["size"]:
+        raise StudyError(f"[geometry] tip_size: must not exceed size = {g['size']!r} (it refines the tip), got "
+                         f"{g['tip_size']!r}")
+    if g["cells"] == "hexahedron" and g["mesh_order"] != 1:
+        raise StudyError(f"[geometry] mesh_order: cells = 'hexahedron' makes order-1 cells: mesh_order = 1, got "
+                         f"{g['mesh_order']!r} ([fem] order chooses the element order)")
     return out
+
+
+def _one_line(exc: BaseException) -> str:
+    return "; ".join(line.strip() for line in str(exc).splitlines() if line.strip())
+
+
+def _cell_checks(c: dict) -> None:
+    """The mesh gmsh would make from ``[geometry]`` within ``[limits] cells`` (estimated before meshing)."""
+    if "geometry" not in c:
+        return
+    g, cap = c["geometry"], c["limits"]["cells"]
+    geometry = Study({"geometry": g}).geometry()
+    try:
+        n = estimate_cells(geometry, size=g["size"], tip_size=g["tip_size"], cells=g["cells"])
+    except ValueError as exc:
+        raise StudyError(f"[geometry] {_one_line(exc)}") from None
+    if n <= cap:
+        return
+    size = g["size"] if g["size"] is not None else geometry.default_size()
+    uniform = estimate_cells(geometry, size=size, cells=g["cells"])
+    dim = 2 if isinstance(geometry, PlateGeometry) else 3
+    if g["tip_size"] is not None and uniform <= cap:
+        key, value, fix = "tip_size", g["tip_size"], "a larger tip_size"
+    else:
+        key, value = "size", size
+        least = size * (uniform / cap) ** (1 / dim)  # cells ~ size^-dim
+        for _ in range(60):
+            if estimate_cells(geometry, size=least, cells=g["cells"]) <= cap:
+                break
+            least *= 1.05
+        e = math.floor(math.log10(least)) - 1
+        fix = f"size >= {math.ceil(least / 10**e) * 10**e:.2g} m"  # 2 digits, rounded up
+        fix += " (without a finer tip_size)" if g["tip_size"] is not None else ""
+    shown = f"{value:g} m" + ("" if g["size"] is not None or key != "size" else " (the geometry's default)")
+    raise StudyError(f"[geometry] {key}: {key} = {shown} makes about {n:.2g} mesh cells (estimated before meshing), "
+                     f"more than [limits] cells = {cap}: {fix}, or raise [limits] cells")
 
 
 def validate(raw: dict, source: str = "<string>", base: str | os.PathLike | None = None,
@@ -376,12 +483,18 @@ def _cross_checks(c: dict) -> None:
     if ct["weights"] is not None and ct["face"] is None:
         raise StudyError(f"[contact] weights: only with [contact] face (the weights of its nodes), got "
                          f"{ct['weights']!r} without a face")
+    if not given:
+        try:
+            Material.preset(m["preset"])
+        except ValueError as exc:
+            raise StudyError(f"[material] preset: {exc}") from None
     r = c["reduction"]
     if r["method"] == "full":
         r["size"] = None
     _expand_grid(r)
     _contact_model_checks(c)
     _work_checks(c["search"])
+    _cell_checks(c)
     forcing_checks(c)
     execution_checks(c)
     o, s = c["output"], c["search"]
@@ -397,6 +510,10 @@ def _work_checks(s: dict) -> None:
     if s["period_unit"] != "s" and s["periods"][1] > top:
         raise StudyError(f"[search] periods: the upper period must be <= {top} × {s['period_unit']} (the work grows "
                          f"with the number of linear periods per orbit), got {s['periods']}")
+    low = LIMITS["period_fraction"]
+    if s["period_unit"] != "s" and s["periods"][0] < low:
+        raise StudyError(f"[search] periods: the lower period must be >= {low:g} × {s['period_unit']} (shorter orbits "
+                         f"belong to modes far above it: use their T<j>), got {s['periods']}")
     k = max(s["ipp"])
     if s["resolution"] is not None and k >= 3:
         cells = math.comb(s["resolution"] - 1, k - 1)
@@ -455,13 +572,33 @@ def _contact_model_checks(c: dict) -> None:
                          "[contact] model = 'massless'")
 
 
+#: Largest study file read (bytes): a study is a few kilobytes; a bigger file is not a study (a mesh, a log).
+MAX_STUDY_BYTES = 1_000_000
+
+
 def loads(text: str, source: str = "<string>", base: str | os.PathLike | None = None, model: bool = True) -> Study:
-    """Parse and validate a study from TOML text (``model``: see :func:`validate`)."""
+    """Parse and validate a study from TOML text (``model``: see :func:`validate`).
+
+    >>> loads("x = " + "[" * 10000 + "]" * 10000)
+    Traceback (most recent call last):
+        ...
+    bladecase.study.schema.StudyError: <string>: not valid TOML: nested too deeply (arrays or tables inside each other)
+    """
+    if not isinstance(text, str):
+        raise StudyError(f"{source}: a study is TOML text, got {type(text).__name__}")
+    if len(text) > MAX_STUDY_BYTES:
+        raise StudyError(f"{source}: {len(text)} characters, more than a study's {MAX_STUDY_BYTES} (is it a study "
+                         "file?)")
     try:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise StudyError(f"{source}: not valid TOML: {exc}") from None
-    return validate(raw, source=source, base=base, model=model)
+        raise StudyError(f"{source}: not valid TOML: {_one_line(exc)}") from None
+    except RecursionError:
+        raise StudyError(f"{source}: not valid TOML: nested too deeply (arrays or tables inside each other)") from None
+    try:
+        return validate(raw, source=source, base=base, model=model)
+    except RecursionError:
+        raise StudyError(f"{source}: nested too deeply (arrays or tables inside each other)") from None
 
 
 def load_study(path: str | os.PathLike, model: bool = True) -> Study:
@@ -497,8 +634,40 @@ def load_study(path: str | os.PathLike, model: bool = True) -> Study:
     >>> folder.cleanup()
     """
     path = Path(path)
+    data = _read_study_bytes(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise StudyError(f"cannot read study file {str(path)!r}: {exc}") from None
-    return loads(text, source=str(path), base=path.resolve().parent, model=model)
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data[:exc.start].count(b"\n") + 1
+        raise StudyError(f"cannot read study file {str(path)!r}: not UTF-8 text (byte {exc.start}, line {line}); "
+                         "save it as UTF-8") from None
+    return loads(text.removeprefix("\ufeff"), source=str(path), base=path.resolve().parent, model=model)
+
+
+def _read_study_bytes(path: Path) -> bytes:
+    """The bytes of a regular file of at most :data:`MAX_STUDY_BYTES`; a pipe, a device or a folder is refused
+    before it is read (reading a FIFO would wait for a writer forever)."""
+    where = f"cannot read study file {str(path)!r}"
+    try:
+        info = path.stat()
+    except (OSError, ValueError) as exc:
+        raise StudyError(f"{where}: {getattr(exc, 'strerror', None) or exc}") from None
+    if not stat.S_ISREG(info.st_mode):
+        kind = ("a folder" if stat.S_ISDIR(info.st_mode) else "a named pipe (FIFO)" if stat.S_ISFIFO(info.st_mode)
+                else "a device" if stat.S_ISCHR(info.st_mode) or stat.S_ISBLK(info.st_mode)
+                else "a socket" if stat.S_ISSOCK(info.st_mode) else "a special file")
+        raise StudyError(f"{where}: it is {kind}, not a regular file")
+    if info.st_size > MAX_STUDY_BYTES:
+        raise StudyError(f"{where}: {info.st_size} bytes, more than a study's {MAX_STUDY_BYTES} (is it a study "
+                         "file?)")
+    try:  # O_NONBLOCK: should the path have become a FIFO since the stat, opening it does not wait
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    except OSError as exc:
+        raise StudyError(f"{where}: {exc.strerror or exc}") from None
+    with os.fdopen(fd, "rb") as f:
+        if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
+            raise StudyError(f"{where}: not a regular file")
+        data = f.read(MAX_STUDY_BYTES + 1)
+    if len(data) > MAX_STUDY_BYTES:
+        raise StudyError(f"{where}: more than a study's {MAX_STUDY_BYTES} bytes (is it a study file?)")
+    return data

@@ -1,13 +1,30 @@
 """The sections of a study beyond the pipeline's own: ``[forcing]`` (the forced–damped response of the blade:
-damping, load, forcing frequencies, the sweep; run by :func:`bladecase.study.forcing.forced_response`) and
-``[execution]`` (where independent tasks run: :func:`bladecase.study.executor.make_executor`), with their
-cross-checks."""
+damping, load, forcing frequencies, the sweep; run by :func:`bladecase.study.forcing.forced_response`),
+``[execution]`` (where independent tasks run: :func:`bladecase.study.executor.make_executor`) and ``[limits]``
+(the caps on the work a study may ask for, which a big machine may raise), with their cross-checks."""
 
 from __future__ import annotations
 
+import os
+
+import numpy as np
+
+from ..fe.geometry import MAX_CELLS
+from ..nsm.system import DENSE_LIMIT
 from .executor import make_executor
 from .keys import _INT, _LIST, _NUM, _STR, Key, StudyError
-from .values import LIMITS, _direction, _int_at_least, _int_between, _nonzero, _one_of, _periods, _rayleigh
+from .values import (
+    LIMITS,
+    _amplitude,
+    _direction,
+    _int_at_least,
+    _int_between,
+    _name,
+    _one_of,
+    _periods,
+    _rayleigh,
+    sweep_periods,
+)
 
 #: ``[forcing]``: key → :class:`~bladecase.study.keys.Key` (the section runs when ``amplitude`` is given).
 FORCING_KEYS: dict[str, Key] = {
@@ -18,14 +35,14 @@ FORCING_KEYS: dict[str, Key] = {
     "load": Key(_STR, "nodal", "'nodal' (a force shared by nodes) or 'pressure' (a uniform pressure on the "
                 "face 'group').", _one_of("nodal", "pressure")),
     "node": Key(_INT, None, "Nodal load: the mesh node loaded; default (no node, no group): the contact "
-                "node(s).", _int_at_least(0)),
+                "node(s).", _int_between(0, LIMITS["node"])),
     "group": Key(_STR, None, "Nodal load: the mesh group whose nodes share the force; pressure load: the face "
-                 "group (required)."),
+                 "group (required).", _name),
     "load_direction": Key(_LIST, None, "Nodal load: the force's direction; default: the casing normal.",
                           _direction),
     "amplitude": Key(_NUM, None, "Load amplitude F0: the total force (N) of a nodal load, the pressure (Pa) "
                      "of a pressure load (> 0 pushes into the body); the load is F0 f cos(2π f t).  The forced "
-                     "response runs when it is given.", _nonzero),
+                     "response runs when it is given.", _amplitude),
     "engine_order": Key(_INT, None, "Engine order EO of a travelling excitation: the blade is forced at "
                         "EO × rotation speed (its phase on a single blade only shifts time).",
                         _int_between(1, LIMITS["engine_order"])),
@@ -43,7 +60,7 @@ FORCING_KEYS: dict[str, Key] = {
                        lambda v: None if 0 < v <= 1 else "must be in (0, 1]"),
     "max_p": Key(_INT, 4, "Longest steady-state period looked for, in forcing periods.", _int_between(1, 16)),
     "animate": Key(_INT, 1, "Periodic steady states with impacts to animate (the highest-energy ones).",
-                   _int_at_least(0)),
+                   _int_between(0, LIMITS["animate"])),
 }
 
 
@@ -72,6 +89,44 @@ def forcing_checks(c: dict) -> None:
     if c["contact"]["model"] == "massless" and f["restitution"] != 1.0:
         raise StudyError(f"[forcing] restitution: Newton's contact model only (the massless contact model has no "
                          f"impact law), got {f['restitution']!r}")
+    unit, hi = f["frequency_unit"], f["frequencies"][1]
+    top = LIMITS["forcing_frequency"][unit]
+    if hi > top:
+        raise StudyError(f"[forcing] frequencies: the upper frequency must be <= {top:g} {unit}, got "
+                         f"{f['frequencies']}")
+    _sweep_work(c)
+
+
+def _sweep_work(c: dict) -> None:
+    """The forced sweep's work (:func:`~bladecase.study.values.sweep_periods`) within ``[limits] sweep_periods``;
+    with ``frequency_unit = 'f1'`` the forcing periods longer than ``T1`` count in ``T1`` (other units: at the
+    forcing stage, which knows ``f1``)."""
+    f, cap = c["forcing"], c["limits"]["sweep_periods"]
+    sweeps = 2 if f["direction"] == "both" else 1
+    lo, hi = f["frequencies"]
+    ratios = np.linspace(lo, hi, f["points"]) if f["frequency_unit"] == "f1" else np.ones(f["points"])
+    work = sweep_periods(ratios, f["periods"], sweeps)
+    if work > cap:
+        longer = ", a higher lower frequency" if longer_periods_weigh(f, work) else ""
+        raise StudyError(f"[forcing] points × periods: {sweep_work_words(f, work)}, more than [limits] sweep_periods "
+                         f"= {cap}: fewer points or periods{longer}, or raise [limits] sweep_periods")
+
+
+def sweep_work_words(f: dict, work: float) -> str:
+    """``41 points × 300 periods × 2 sweeps = 24600 forcing periods``, with the count in periods ``T1`` when the
+    forcing periods longer than ``T1`` weigh (more than 10 %)."""
+    sweeps = 2 if f["direction"] == "both" else 1
+    plain = f["points"] * f["periods"] * sweeps
+    text = (f"{f['points']} points × {f['periods']} periods{f' × {sweeps} sweeps' if sweeps > 1 else ''} = {plain} "
+            "forcing periods")
+    if work > 1.1 * plain:
+        text += f" ({work:.3g} periods T1: a forcing period longer than T1 counts in periods T1)"
+    return text
+
+
+def longer_periods_weigh(f: dict, work: float) -> bool:
+    """True when the forcing periods longer than ``T1`` make most of the sweep's work."""
+    return work > 2 * f["points"] * f["periods"] * (2 if f["direction"] == "both" else 1)
 
 
 #: ``[execution]``: key → :class:`~bladecase.study.keys.Key`.
@@ -89,9 +144,54 @@ EXECUTION_KEYS: dict[str, Key] = {
 
 
 def execution_checks(c: dict) -> None:
-    """``[execution]``: the executor's own checks (nothing is started here)."""
+    """``[execution]``: at most ``[limits] workers`` local processes, and the executor's own checks (nothing is
+    started here)."""
     x = c["execution"]
+    cap = worker_limit(c["limits"])
+    if x["workers"] is not None and x["workers"] > cap and x["scheduler"] is None:
+        cores = os.cpu_count() or 1
+        why = (f"{WORKERS_PER_CORE} per core of this machine's {cores}" if c["limits"]["workers"] is None
+               else "[limits] workers")
+        raise StudyError(f"[execution] workers: {x['workers']} local worker processes, at most {cap} ({why}): fewer "
+                         "workers, or raise [limits] workers")
     try:
         make_executor(x["executor"], x["workers"], x["scheduler"])
     except ValueError as exc:
         raise StudyError(f"[execution] {exc}") from None
+
+
+#: Local worker processes per core allowed when ``[limits] workers`` is not set.
+WORKERS_PER_CORE = 8
+
+
+def worker_limit(limits: dict) -> int:
+    """Most local worker processes: ``[limits] workers``, else :data:`WORKERS_PER_CORE` per core."""
+    return limits["workers"] if limits["workers"] is not None else WORKERS_PER_CORE * (os.cpu_count() or 1)
+
+
+#: Default of ``[limits] dofs_full``: measured on a 2-D plate of 2940 free dofs, ``method = "full"`` builds
+#: its dense model in 5 s and a 1-ipp search takes 40 s; the dense eigen-solution grows as ``n³``.
+DOFS_FULL = 3000
+
+#: Default of ``[limits] sweep_periods``: 8 × the default sweep (41 points × 300 periods); measured on the plate
+#: (modal 10): about 1 ms per forcing period without contact, 0.1 s with impacts.
+SWEEP_PERIODS = 100_000
+
+#: Most forcing periods ``[limits] sweep_periods`` may allow, and the cap of a forced response run without a
+#: study (:func:`bladecase.study.forcing.forced_response` without ``max_periods``).
+SWEEP_CEILING = 10**9
+
+#: ``[limits]``: key → :class:`~bladecase.study.keys.Key`.  Each caps work that would otherwise run for hours or
+#: not fit in memory; the study is refused before any work, with the estimate and the key that raises the cap.
+LIMIT_KEYS: dict[str, Key] = {
+    "cells": Key(_INT, MAX_CELLS, "Most mesh cells gmsh may make from [geometry] (estimated from the size "
+                 "before meshing).", _int_between(1, 10**9)),
+    "dofs_full": Key(_INT, DOFS_FULL, "Most free dofs of a model kept whole by [reduction] method = 'full' "
+                     "(dense matrices, a dense search).", _int_between(1, DENSE_LIMIT)),
+    "sweep_periods": Key(_INT, SWEEP_PERIODS, "Most forcing periods the forced sweep integrates (points × "
+                         "periods × sweeps; a forcing period longer than T1 counts in periods T1).",
+                         _int_between(1, SWEEP_CEILING)),
+    "workers": Key(_INT, None, f"Most local worker processes of [execution] workers; default: {WORKERS_PER_CORE} "
+                   "per core of the machine.", _int_between(1, LIMITS["workers"])),
+}
+

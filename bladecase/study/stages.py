@@ -17,6 +17,7 @@ from .. import log
 from ..fe import FEModel, Material, Mesh, assemble, blade_mesh, load_mesh
 from ..linalg import DENSE_LIMIT, SPDFactor
 from ..nsm import Branch, LinearSystem, nonsmooth_mode
+from ..nsm.system import DENSE_LIMIT as NSM_DENSE_LIMIT
 from ..reduction import Contact, ReducedModel, reduce
 from .schema import Study, StudyError
 
@@ -35,7 +36,7 @@ def build_mesh(study: Study, path: str | os.PathLike | None = None) -> Mesh:
         g = study["geometry"]
         try:
             mesh = blade_mesh(study.geometry(), size=g["size"], tip_size=g["tip_size"], order=g["mesh_order"],
-                              path=path, cells=g["cells"])
+                              path=path, cells=g["cells"], max_cells=_limits(study)["cells"])
         except ValueError as exc:
             raise StudyError(f"[geometry] {exc}") from None
     else:
@@ -160,14 +161,54 @@ def build_reduced(study: Study, model: FEModel, contact: Contact, method: str | 
     between the models of a study.
     """
     r = study["reduction"]
+    main = method is None
+    key = "method" if method is None or method == r["method"] else "compare"
     method = method or r["method"]
     size = (r["size"] if size is None else size) if method != "full" else None
     if method in EIGEN_METHODS and size is not None:
         _check_eigen_work(method, size, model.n_dofs)
+    limit = _limits(study)["dofs_full"]
+    if method == "full" and model.n_dofs > limit:
+        raise StudyError(f"[reduction] {key}: method 'full' keeps all {model.n_dofs} free dofs of this model in dense "
+                         f"matrices, more than [limits] dofs_full = {limit}: use a reduced method, e.g. method = "
+                         f"'lanczos-si' with size = 20, or raise [limits] dofs_full (at most {DENSE_LIMIT_FULL})")
     try:
-        return reduce(model, contact, method, size, factor=factor)
+        reduced = reduce(model, contact, method, size, factor=factor, limit=limit)
     except ValueError as exc:
         raise StudyError(f"[reduction] {exc}") from None
+    if main and (study.config.get("forcing") or {}).get("amplitude") is not None:
+        check_forcing(study, reduced)
+    return reduced
+
+
+def check_forcing(study: Study, reduced: ReducedModel) -> None:
+    """The forced response's work on ``reduced``, checked as soon as the reduced model is known (before the
+    search): the amplitude against the clearance, the sweep within ``[limits] sweep_periods`` counted in periods
+    ``T1`` (:func:`bladecase.study.forcing.check_sweep_work`); and the load itself (its group, its node)."""
+    from ..reduction.loads import project_load
+    from .forcing import build_load, check_sweep_work, contact_load
+
+    forcing = study["forcing"]
+    try:
+        f_free, _ = build_load(reduced, forcing)
+        check_sweep_work(reduced, forcing, project_load(reduced, f_free), contact_load(reduced, f_free),
+                         max_periods=_limits(study)["sweep_periods"])
+    except StudyError:
+        raise
+    except ValueError as exc:
+        raise StudyError(str(exc) if str(exc).startswith("[forcing]") else f"[forcing] {exc}") from None
+
+
+def _limits(study: Study) -> dict:
+    """``[limits]`` with its defaults (a :class:`Study` made without :func:`validate` may lack the section)."""
+    from .sections import LIMIT_KEYS
+
+    given = study.config.get("limits") or {}
+    return {k: spec.default if given.get(k) is None else given[k] for k, spec in LIMIT_KEYS.items()}
+
+
+#: Most free dofs ``[limits] dofs_full`` may allow: the dense spectrum's bound of the search.
+DENSE_LIMIT_FULL = NSM_DENSE_LIMIT
 
 
 #: Reduction methods whose cost is an eigen-solution for ``size`` modes of the FE model (ARPACK shift-invert).

@@ -6,6 +6,10 @@ ranges and caps they enforce (:data:`RANGES`, :data:`LIMITS`).
 'must be in [1e-09, 10] (m)'
 >>> _manifold_size([1000, 1000])
 'must sample at most 100000 points (orbits × phases), asks for 1000000'
+>>> _study_name("..")
+"must be a plain folder name: 1-64 characters among letters, digits, '_', '.', '-', not starting with '.'"
+>>> show("0.1"), show(True), show([1.0] * 100)[-11:]
+("the string '0.1'", 'the boolean true', '(100 items)')
 """
 
 from __future__ import annotations
@@ -21,6 +25,75 @@ def _num(x) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, bool)
 
 
+def _finite_num(x) -> bool:
+    """A finite number (not a boolean, not a string), as TOML gives them (``nan``, ``inf`` are refused)."""
+    return _num(x) and math.isfinite(x)
+
+
+def _count(x, lo: int, hi: int) -> bool:
+    """An integer (not a boolean) in ``[lo, hi]``."""
+    return isinstance(x, int) and not isinstance(x, bool) and lo <= x <= hi
+
+
+#: Longest repr of a value quoted in a message (a 10 000-item list is cut, with its length).
+SHOW_CHARS = 80
+
+
+def show(value) -> str:
+    """A value for a message, with what it is when that is not plain from its TOML spelling: ``the string '0.1'``,
+    ``the boolean true``, ``a list [...]``, ``a table {...}``; long reprs are cut (with the item count)."""
+    import datetime
+
+    if isinstance(value, bool):
+        return f"the boolean {str(value).lower()}"
+    if isinstance(value, str):
+        text = repr(value)
+        return "the string " + (text if len(text) <= SHOW_CHARS else f"{text[:SHOW_CHARS]}…' ({len(value)} characters)")
+    if isinstance(value, (datetime.date, datetime.time)):
+        return f"the date/time {value.isoformat()}"
+    text = repr(value)
+    if isinstance(value, (list, tuple, dict)):
+        what = "a table" if isinstance(value, dict) else "a list"
+        if len(text) > SHOW_CHARS:
+            text = f"{text[:SHOW_CHARS]}… ({len(value)} items)"
+        return f"{what} {text}"
+    if isinstance(value, int) and len(text) > 24:
+        return f"{value:.3g}"
+    return text if len(text) <= SHOW_CHARS else f"{text[:SHOW_CHARS]}…"
+
+
+#: A study name is a plain folder name (results go to ``results/<name>``): no ``..``, no hidden folder.
+NAME_PATTERN = r"[A-Za-z0-9_-][A-Za-z0-9_.-]{0,63}"
+
+
+def _study_name(v) -> str | None:
+    return None if re.fullmatch(NAME_PATTERN, v) else (
+        "must be a plain folder name: 1-64 characters among letters, digits, '_', '.', '-', not starting with '.'")
+
+
+def _folder(v) -> str | None:
+    """A folder path: not empty, no control characters (a NUL byte cannot be in a path)."""
+    if not v.strip():
+        return 'must name a folder (give a folder, e.g. "results/plate")'
+    if any(ord(c) < 32 or ord(c) == 127 for c in v):
+        return "must be a folder path without control characters"
+    return None
+
+
+def _file(v) -> str | None:
+    """A file path: not empty, no control characters."""
+    if not v.strip():
+        return 'must name a file (e.g. "meshes/plate.vtu")'
+    if any(ord(c) < 32 or ord(c) == 127 for c in v):
+        return "must be a file path without control characters"
+    return None
+
+
+def _name(v) -> str | None:
+    """A mesh group name: not empty."""
+    return None if v.strip() else "must be a mesh group name such as 'tip', not empty"
+
+
 def _positive(v) -> str | None:
     return None if math.isfinite(v) and v > 0 else "must be a finite number > 0"
 
@@ -33,13 +106,21 @@ def _int_at_least(n):
 #: precision no longer delivers the stated tolerances (energies ``~ K d²`` overflow, eigen-solutions and
 #: impact times lose their digits): ``[contact] clearance``, ``[material] E`` and ``rho``.
 RANGES = {"clearance": (1e-9, 10.0, "m"), "E": (1e3, 1e13, "Pa"), "rho": (1e-2, 1e5, "kg/m³"),
-          "casing_stiffness": (1e-3, 1e15, "N/m")}
+          "casing_stiffness": (1e-3, 1e15, "N/m"), "thickness": (1e-9, 100.0, "m"),
+          "amplitude": (1e-9, 1e9, "N or Pa"), "alpha": (0.0, 1.0, "s"), "beta": (0.0, 1e6, "1/s"),
+          "scale": (1e-12, 1e15, ""), "coordinate": (0.0, 1e6, "m"), "tol": (0.0, 1e6, "m")}
 
 #: Caps on the work a study may ask for (each is far above any useful value; beyond, a run would not end
 #: or not fit in memory).
 LIMITS = {"frames": 1000, "scan": 2000, "resolution": 1000, "max_points": 100_000, "fps": 1000, "frequencies": 100,
           "manifold_axis": 1000, "manifold_samples": 100_000, "period_multiple": 100, "grid_cells": 1_000_000,
-          "models": 32, "forcing_points": 2000, "forcing_periods": 100_000, "engine_order": 1000}
+          "models": 32, "forcing_points": 2000, "forcing_periods": 100_000, "engine_order": 1000,
+          "size": 6000, "animate": 1000, "mode_index": 1000, "node": 2**31 - 1, "forcing_reach": 1000,
+          "workers": 100_000, "period_fraction": 1e-6,
+          "forcing_frequency": {"f1": 1000.0, "Hz": 1e9, "rpm": 1e10}}
+
+#: Slowest frame rate of the animations (frames per second): a GIF frame lasts at most 100 s.
+MIN_FPS = 0.01
 
 
 def _in_range(name: str):
@@ -47,8 +128,23 @@ def _in_range(name: str):
     return lambda v: None if math.isfinite(v) and lo <= v <= hi else f"must be in [{lo:g}, {hi:g}] ({unit})"
 
 
+def _amplitude(v) -> str | None:
+    """A load amplitude: ``|v|`` within :data:`RANGES` ``["amplitude"]`` (N for a force, Pa for a pressure)."""
+    lo, hi, _ = RANGES["amplitude"]
+    if math.isfinite(v) and lo <= abs(v) <= hi:
+        return None
+    return (f"must be a force (N) or a pressure (Pa) with {lo:g} <= |amplitude| <= {hi:g} (beyond: a unit mistake, "
+            "and the response overflows)")
+
+
 def _int_between(lo: int, hi: int, why: str = ""):
     return lambda v: None if lo <= v <= hi else f"must be an integer with {lo} <= value <= {hi}{why}"
+
+
+def _positive_at_most(hi: float, unit: str = ""):
+    """A finite number in ``(0, hi]``."""
+    unit = f" ({unit})" if unit else ""
+    return lambda v: None if math.isfinite(v) and 0 < v <= hi else f"must be a number in (0, {hi:g}]{unit}"
 
 
 def _one_of(*choices):
@@ -56,9 +152,18 @@ def _one_of(*choices):
 
 
 def _vector(v) -> str | None:
-    if len(v) not in (2, 3) or not all(_num(x) and math.isfinite(x) for x in v):
+    if len(v) not in (2, 3) or not all(_finite_num(x) for x in v):
         return "must be a list of 2 or 3 finite numbers"
     return None
+
+
+def _point(v) -> str | None:
+    """A point (m): 2 or 3 finite coordinates within :data:`RANGES` ``["coordinate"]`` (distances then stay finite)."""
+    top = RANGES["coordinate"][1]
+    message = _vector(v)
+    if message is None and any(abs(x) > top for x in v):
+        return f"must be a list of 2 or 3 numbers of magnitude at most {top:g} (m; a unit mistake?)"
+    return message
 
 
 def _direction(v) -> str | None:
@@ -80,9 +185,19 @@ def _period_unit(v) -> str | None:
 
 
 def _periods(v) -> str | None:
-    if len(v) != 2 or not all(_num(x) and math.isfinite(x) for x in v) or not 0 < v[0] < v[1]:
+    if len(v) != 2 or not all(_finite_num(x) for x in v) or not 0 < v[0] < v[1]:
         return "must be [lower, upper] with 0 < lower < upper"
+    if v[0] < 1e-12 * v[1]:
+        return "must be [lower, upper] with 0 < lower < upper and lower >= 1e-12 × upper"
     return None
+
+
+def _period_unit_index(v) -> str | None:
+    """``period_unit``: ``'s'`` or ``'T<j>'`` with ``j`` at most :data:`LIMITS` ``["mode_index"]``."""
+    message = _period_unit(v)
+    if message is None and v != "s" and int(v[1:]) > LIMITS["mode_index"]:
+        return f"must be 's' or 'T<j>' with j <= {LIMITS['mode_index']}"
+    return message
 
 
 def _ipp(v) -> str | None:
@@ -94,6 +209,8 @@ def _ipp(v) -> str | None:
 
 
 def _formats(v) -> str | None:
+    if not all(isinstance(f, str) for f in v):
+        return f"must be a list of format names among {', '.join(OUTPUT_FORMATS)}"
     bad = [f for f in v if f not in OUTPUT_FORMATS]
     return f"unknown format(s) {bad} (valid: {', '.join(OUTPUT_FORMATS)})" if bad else None
 
@@ -107,9 +224,10 @@ def _window(v) -> str | None:
 def _scale(v) -> str | None:
     if v == "auto":
         return None
-    if _num(v):
-        return _positive(v)
-    return "must be 'auto' or a number > 0"
+    lo, hi, _ = RANGES["scale"]
+    if _num(v) and math.isfinite(v) and lo <= v <= hi:
+        return None
+    return f"must be 'auto' or a number in [{lo:g}, {hi:g}]"
 
 
 def _reduction_list(v) -> str | None:
@@ -119,15 +237,19 @@ def _reduction_list(v) -> str | None:
         extra = set(item) - {"method", "size"}
         if extra:
             return f"item {i}: unknown key(s) {sorted(extra)} (valid: method, size)"
-        if item.get("method") not in METHODS:
-            return f"item {i}: method must be one of {', '.join(METHODS)}, got {item.get('method')!r}"
-        size = item.get("size")
-        if item["method"] != "full" and (not isinstance(size, int) or isinstance(size, bool) or size < 1):
-            return f"item {i}: size must be an integer >= 1, got {size!r}"
+        if not isinstance(item.get("method"), str) or item.get("method") not in METHODS:
+            return f"item {i}: method must be one of {', '.join(METHODS)}, got {show(item.get('method'))}"
+        size, top = item.get("size"), LIMITS["size"]
+        if item["method"] != "full" and not _count(size, 1, top):
+            return f"item {i}: size must be an integer with 1 <= size <= {top}, got {show(size)}"
+        if item["method"] == "full" and size is not None:
+            return f"item {i}: method 'full' keeps every dof: no size, got {size!r}"
     return None
 
 
 def _method_names(v) -> str | None:
+    if not all(isinstance(m, str) for m in v):
+        return f"must be a list of method names among {', '.join(METHODS)}"
     bad = [m for m in v if m not in METHODS]
     if bad:
         return f"unknown method {bad[0]!r} (valid: {', '.join(METHODS)})"
@@ -135,9 +257,10 @@ def _method_names(v) -> str | None:
 
 
 def _size_list(v) -> str | None:
-    bad = [x for x in v if not isinstance(x, int) or isinstance(x, bool) or x < 1]
+    top = LIMITS["size"]
+    bad = [x for x in v if not _count(x, 1, top)]
     if bad:
-        return f"sizes must be integers >= 1, got {bad[0]!r}"
+        return f"sizes must be integers with 1 <= size <= {top}, got {show(bad[0])}"
     return None if len(set(v)) == len(v) else f"sizes repeat: {v}"
 
 
@@ -145,16 +268,20 @@ def _orbit_list(v) -> str | None:
     for i, item in enumerate(v):
         if not isinstance(item, dict) or set(item) - {"ipp", "T"} or not {"ipp", "T"} <= set(item):
             return f"item {i} must be a table {{ipp = K, T = period}} (T in search.period_unit)"
-        if not isinstance(item["ipp"], int) or isinstance(item["ipp"], bool) or item["ipp"] < 1:
-            return f"item {i}: ipp must be an integer >= 1, got {item['ipp']!r}"
-        if not _num(item["T"]) or not math.isfinite(item["T"]) or item["T"] <= 0:
-            return f"item {i}: T must be a number > 0, got {item['T']!r}"
+        if not _count(item["ipp"], 1, 8):
+            return f"item {i}: ipp must be an integer between 1 and 8, got {show(item['ipp'])}"
+        if not _finite_num(item["T"]) or item["T"] <= 0:
+            return f"item {i}: T must be a finite number > 0, got {show(item['T'])}"
     return None
 
 
 def _rayleigh(v) -> str | None:
-    if len(v) != 2 or not all(_num(x) and math.isfinite(x) and x >= 0 for x in v) or not any(v):
+    a, b = RANGES["alpha"][1], RANGES["beta"][1]
+    if len(v) != 2 or not all(_finite_num(x) and x >= 0 for x in v) or not any(v):
         return "must be [alpha, beta], two finite numbers >= 0, not both 0 (C = alpha K + beta M)"
+    if v[0] > a or v[1] > b:
+        return (f"must be [alpha, beta] with alpha <= {a:g} s and beta <= {b:g} 1/s (C = alpha K + beta M; beyond, "
+                "every mode is overdamped: a unit mistake?)")
     return None
 
 
@@ -169,19 +296,42 @@ CLAMP_RULES = ("plane", "box", "sphere")
 def _clamp_spec(v) -> str | None:
     """A group name, or a table with exactly one coordinate rule (its values are checked by ``select_nodes``)."""
     if isinstance(v, str):
-        return None if v else "must be a mesh group name or a table such as {plane = [0, 0, 0, 0, 0, 1]}"
+        return None if v.strip() else "must be a mesh group name or a table such as {plane = [0, 0, 0, 0, 0, 1]}"
     rules = [k for k in v if k in CLAMP_RULES]
     unknown = sorted(set(v) - set(CLAMP_RULES) - {"tol"})
     if unknown or len(rules) != 1:
         return (f"must hold exactly one of {', '.join(CLAMP_RULES)} (and optionally tol)"
                 + (f"; unknown keys {unknown}" if unknown else ""))
+    rule, value = rules[0], v[rules[0]]
+    top = RANGES["coordinate"][1]
+    numbers = value if rule != "box" else (
+        [x for corner in value for x in corner] if isinstance(value, list) and len(value) == 2
+        and all(isinstance(c, list) and len(c) in (2, 3) for c in value) else None)
+    if not isinstance(numbers, list) or not all(_finite_num(x) and abs(x) <= top for x in numbers):
+        shape = {"plane": "[x0, y0, z0, nx, ny, nz] (or [x0, y0, nx, ny] in 2-D)",
+                 "box": "[[xmin, ymin, zmin], [xmax, ymax, zmax]] (or 2-D corners)", "sphere": "[x, y, z, r]"}[rule]
+        return f"{rule} must be {shape}, finite numbers of magnitude at most {top:g}"
+    if "tol" in v and not (_finite_num(v["tol"]) and 0 <= v["tol"] <= RANGES["tol"][1]):
+        return f"tol must be a number in [0, {RANGES['tol'][1]:g}] (m)"
     return None
 
 
 def _compare_periods(v) -> str | None:
     """1 to 8 distinct finite periods in (0, 100] (× the FE first period)."""
-    if not 1 <= len(v) <= 8 or not all(_num(x) and math.isfinite(x) and 0 < x <= 100 for x in v):
+    if not 1 <= len(v) <= 8 or not all(_finite_num(x) and 0 < x <= 100 for x in v):
         return "must be a list of 1 to 8 numbers in (0, 100] (× the FE model's first period)"
     if len(set(v)) != len(v):
         return "periods repeat"
     return None
+
+
+def sweep_periods(ratios, periods: int, sweeps: int) -> float:
+    """The work of a forced sweep: forcing periods integrated (``periods`` per point, ``sweeps`` sweeps), each
+    counted in periods ``T1`` of the first linear mode when it is longer (at ``0.1 f1`` a forcing period counts 10:
+    the integration follows every mode's oscillations).  ``ratios``: the forcing frequencies over ``f1``.
+
+    >>> sweep_periods([0.5, 1.0, 2.0], 100, 2)
+    800.0
+    """
+    return float(sweeps * periods * sum(max(1.0, 1.0 / r) for r in ratios))
+

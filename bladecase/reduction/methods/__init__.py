@@ -1,7 +1,8 @@
 """The reduction methods, one module each, registered in :data:`bladecase.reduction.METHODS` here (theory §2).
 
 ``"full"`` (:mod:`.full`)
-    No reduction (``V = I``): dense ``M``, ``K``; refused above :data:`FULL_LIMIT` dofs.
+    No reduction (``V = I``): dense ``M``, ``K``; refused above :data:`FULL_LIMIT` dofs (or the caller's
+    ``limit``, at most :data:`bladecase.nsm.system.DENSE_LIMIT`).
 ``"modal"`` (:mod:`.modal`)
     The ``size`` lowest M-normalised modes ``Φ`` (sparse shift-invert about
     0): ``M_r = I``, ``K_r = diag(ω²)``, ``w_r = Φᵀw``.  Keeps the lowest
@@ -51,7 +52,7 @@ __all__ = [
 ]
 
 # The registration order is the order of METHODS (messages, the study schema's documentation).
-register("full", full.build, "no reduction: the dense M, K of all free dofs", sized=False)
+register("full", full.build, "no reduction: the dense M, K of all free dofs", sized=False, limited=True)
 register("modal", modal.build, "the size lowest modes (sparse shift-invert about 0)")
 register("lanczos", lanczos.build_plain, "size Lanczos steps from the contact: a chain of unit masses")
 register("lanczos-si", lanczos.build_shift_invert, "size shift-invert Lanczos steps about 0: the lowest modes "
