@@ -115,6 +115,14 @@ def _run_study(study, args, progress: bool):
     from .study.executor import make_executor
 
     x = study["execution"]
+    if args.workers is not None and not args.scheduler:
+        from .study.sections import worker_limit
+
+        cap = worker_limit(study["limits"])
+        if args.workers > cap:
+            raise StudyError(f"--workers: {args.workers} local worker processes, at most {cap} ([limits] workers, "
+                             f"or 8 per core of this machine's {os.cpu_count() or 1}): fewer workers, or raise "
+                             "[limits] workers")
     kind = args.executor or (None if args.scheduler or args.workers else x["executor"])
     try:
         executor = make_executor(kind, args.workers or x["workers"], args.scheduler or x["scheduler"])

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .rotation_report import rotation_report
+
 #: Admissible arcs narrower than this (relative, in frequency) are called narrow in words.
 NARROW_RTOL = 1e-3
 
@@ -28,6 +30,7 @@ def report(summary: dict) -> str:
              + f" at ({', '.join(f'{x:.5g}' for x in c['position'])}) m, casing normal "
              f"({', '.join(f'{x:.4g}' for x in c['normal'])}), clearance {c['clearance_m'] * 1e3:.4g} mm.",
              _casing_words(c.get("casing_stiffness_n_per_m")),
+             *rotation_report(summary.get("rotation"), summary.get("campbell")),
              "", "## Reduced model", "",
              f"- {r['method']} (size {r['size']}): {r['reduced_dofs']} reduced dofs.", "",
              "| mode | reduced f (Hz) | contact weight b² | FE counterpart (by mode shape) | rel. error |",

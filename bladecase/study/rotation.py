@@ -128,7 +128,7 @@ def _speed_point(omega: float, *, study: Study, model, contact, axis: RotationAx
         return point
     hot = dataclasses.replace(contact, gap=d)
     reduced = build_reduced(study, state.model, hot, factor=state.factor)
-    families = search(study, reduced.system)
+    families = search(study, reduced.system, label=f"{omega * 60 / (2 * math.pi):.6g} rpm")
     arcs = [a for f in families for a in f.arcs]
     if arcs:
         point["band_hz"] = (min(1.0 / a.T_hi for a in arcs), max(1.0 / a.T_lo for a in arcs))

@@ -30,6 +30,7 @@ from .forcing import forced_response, forced_scene
 from .publish import RUN_RESULTS, check_inputs, output_folder, publish, release, staged_names, staging_dir
 from .reference import reference_model
 from .render import render_all
+from .rotation import campbell_stage, operating_point
 from .schema import Study, load_study
 from .stages import build_contact, build_mesh, build_model, build_reduced, period_unit, search
 
@@ -135,7 +136,8 @@ def run(study: Study | str | os.PathLike, out: str | os.PathLike | None = None, 
     if study.source and Path(study.source).is_file():
         check_inputs(out, [study.source])
     staging = staging_dir(out)
-    stages = _Stages(progress, total=7 if study["forcing"]["amplitude"] is not None else 6)
+    stages = _Stages(progress, total=6 + (study["forcing"]["amplitude"] is not None)
+                     + bool(study.config.get("rotation") and study["rotation"]["speeds"]))
     x = study["execution"]
     own = None if executor is not None else make_executor(x["executor"], x["workers"], x["scheduler"])
     try:
@@ -175,6 +177,10 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         model = build_model(study, mesh)
         factor = stiffness_factor(model)
         contact = build_contact(study, model)
+        rest_model, cold_contact = model, contact
+        model, contact, factor, rotation = operating_point(study, model, contact, factor)
+        if rotation is not None:
+            rotation["axis"] = study["rotation"]["axis"]
         count = min(study["fem"]["frequencies"], model.n_dofs - 1)
         fe = fe_reference(model, contact, min(max(count, FE_MODES), model.n_dofs - 1), factor=factor)
         f_fe = fe.frequencies[:count]
@@ -230,6 +236,10 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
                                         fractions=study["reduction"]["compare_periods"])
             files["comparison"] = comparison["csv"]
             files["comparison_figures"] = comparison["figures"]
+    campbell = None
+    if study.config.get("rotation") and study["rotation"]["speeds"]:
+        with stage("campbell"):
+            campbell = _campbell(study, rest_model, cold_contact, executor, progress, staging, files)
     with stage("render"):
         files["animations"] = render_all(study, reduced, families, staging, progress, reference)
     forcing = None
@@ -249,6 +259,8 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         "model": model_summary(mesh, model, f_fe, "gmsh (parametric [geometry])" if study.parametric
                                else str(study.mesh_path())),
         "contact": contact_summary(contact, model),
+        "rotation": rotation,
+        "campbell": campbell,
         "reduction": reduced_summary(reduced, f_fe, fe),
         "reference": None if reference is None else reduced_summary(reference, f_fe),
         "compare": [dict(reduced_summary(r, f_fe), families=[family_summary(f) for f in fams])
@@ -260,6 +272,25 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         "files": files,
     }
     return summary, families, {m.name: m for m in models}
+
+
+def _campbell(study: Study, model, contact, executor: Executor, progress: bool, staging: Path, files: dict) -> dict:
+    """The Campbell stage: the diagram's summary section, and ``campbell.png`` when pictures are asked for."""
+    diagram, section = campbell_stage(study, model, contact, executor, progress)
+    if "png" in study["output"]["formats"]:
+        from ..io import save_figure
+        from ..post.campbell_plot import campbell_figure
+
+        w = diagram.speeds
+        bands: dict[int, tuple] = {}
+        for s, band in enumerate(section["bands"]):
+            if band is not None:
+                lo, hi = bands.setdefault(band["mode"], (w, np.full(w.size, np.nan), np.full(w.size, np.nan)))[1:]
+                lo[s], hi[s] = band["low_hz"], band["high_hz"]
+        save_figure(campbell_figure(diagram, bands, title=f"{study.name}: Campbell diagram"), staging / "campbell.png",
+                    dpi=150)
+        files["campbell"] = "campbell.png"
+    return section
 
 
 def _animate_forced(study: Study, reduced, section: dict, orbits: list, folder: Path) -> list[dict]:

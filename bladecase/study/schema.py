@@ -30,7 +30,15 @@ from ..post.outputs import FORMATS as OUTPUT_FORMATS
 from ..reduction import METHODS
 from .demo import NEWTON_DEMO, demo_study, demo_text  # noqa: F401 (re-exported: they lived here)
 from .keys import _BOOL, _INT, _LIST, _NUM, _STR, REQUIRED, Key, StudyError  # noqa: F401
-from .sections import EXECUTION_KEYS, FORCING_KEYS, LIMIT_KEYS, execution_checks, forcing_checks
+from .sections import (
+    EXECUTION_KEYS,
+    FORCING_KEYS,
+    LIMIT_KEYS,
+    ROTATION_KEYS,
+    execution_checks,
+    forcing_checks,
+    rotation_checks,
+)
 from .values import (  # noqa: F401  (RANGES, LIMITS: part of the schema's documented surface)
     LIMITS,
     MIN_FPS,
@@ -139,6 +147,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
                                 "(its local flexibility and coating); default: a rigid casing. Massless model only; "
                                 "well below the contact's own stiffness, the modes converge (docs/massless.md).",
                                 lambda v: "must be > 0 (N/m)" if not v > 0 else _in_range("casing_stiffness")(v)),
+        "clearance_at": Key(_STR, "cold", "A rotating blade's 'clearance' is the cold one ('cold': the "
+                            "centrifugal growth of the blade along the normal closes it at speed) or the running "
+                            "one at [rotation] speed ('speed').", _one_of("cold", "speed")),
     },
     "reduction": {
         "method": Key(_STR, "lanczos-si", f"Reduced model: {', '.join(METHODS)}.", _one_of(*METHODS)),
@@ -195,6 +206,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
                    lambda v: f"must be a number in (0, {LIMITS['fps']}]" if not 0 < v <= LIMITS["fps"] else
                    None if v >= MIN_FPS else f"must be at least {MIN_FPS:g} frames per second"),
     },
+    "rotation": ROTATION_KEYS,
     "execution": EXECUTION_KEYS,
     "limits": LIMIT_KEYS,
 }
@@ -497,6 +509,7 @@ def _cross_checks(c: dict) -> None:
     _cell_checks(c)
     forcing_checks(c)
     execution_checks(c)
+    rotation_checks(c)
     o, s = c["output"], c["search"]
     for i, item in enumerate(o["orbits"]):
         if item["ipp"] not in s["ipp"]:

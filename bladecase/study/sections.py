@@ -1,7 +1,9 @@
 """The sections of a study beyond the pipeline's own: ``[forcing]`` (the forced–damped response of the blade:
 damping, load, forcing frequencies, the sweep; run by :func:`bladecase.study.forcing.forced_response`),
 ``[execution]`` (where independent tasks run: :func:`bladecase.study.executor.make_executor`) and ``[limits]``
-(the caps on the work a study may ask for, which a big machine may raise), with their cross-checks."""
+(the caps on the work a study may ask for, which a big machine may raise), ``[rotation]`` (the blade's rotation:
+the speed every stage works at and the Campbell diagram, :mod:`bladecase.study.rotation`), with their
+cross-checks."""
 
 from __future__ import annotations
 
@@ -12,7 +14,7 @@ import numpy as np
 from ..fe.geometry import MAX_CELLS
 from ..nsm.system import DENSE_LIMIT
 from .executor import make_executor
-from .keys import _INT, _LIST, _NUM, _STR, Key, StudyError
+from .keys import _BOOL, _INT, _LIST, _NUM, _STR, Key, StudyError
 from .values import (
     LIMITS,
     _amplitude,
@@ -195,3 +197,74 @@ LIMIT_KEYS: dict[str, Key] = {
                    "per core of the machine.", _int_between(1, LIMITS["workers"])),
 }
 
+
+
+#: Most speeds of a Campbell diagram (each is an eigen-solution, and with bands a reduction and a search).
+MAX_SPEEDS = 200
+
+
+def _speeds(v) -> str | None:
+    if not v:
+        return None
+    if len(v) > MAX_SPEEDS:
+        return f"must list at most {MAX_SPEEDS} speeds, got {len(v)}"
+    if not all(isinstance(x, (int, float)) and not isinstance(x, bool) and np.isfinite(x) and x >= 0 for x in v):
+        return "must be a list of finite numbers >= 0"
+    return None
+
+
+def _axis(v) -> str | None:
+    from .values import _direction, _point
+
+    keys = set(v)
+    if keys - {"origin", "direction"} or "direction" not in keys:
+        return "must be {origin = [x, y, z], direction = [dx, dy, dz]} (origin optional, default [0, 0, 0])"
+    if not isinstance(v["direction"], list) or _direction(v["direction"]):
+        return "direction must be a list of 2 or 3 finite numbers, not all zero"
+    if "origin" in v and (not isinstance(v["origin"], list) or _point(v["origin"])):
+        return "origin must be a list of 2 or 3 finite numbers (m)"
+    return None
+
+
+def _orders(v) -> str | None:
+    top = LIMITS["engine_order"]
+    if not all(isinstance(x, int) and not isinstance(x, bool) and 1 <= x <= top for x in v):
+        return f"must be a list of integers between 1 and {top}"
+    return None
+
+
+#: ``[rotation]``: key → :class:`~bladecase.study.keys.Key` (a study rotates when ``speeds`` or ``speed`` is given).
+ROTATION_KEYS: dict[str, Key] = {
+    "speeds": Key(_LIST, [], "Rotation speeds of the Campbell diagram (in 'speed_unit'), e.g. [0, 5000, 10000, "
+                  "17189]: at each, the lowest modes about the centrifugal state, and the nonsmooth-mode band.",
+                  _speeds),
+    "speed": Key(_NUM, None, "The speed every stage works at (reduction, nonsmooth modes, forcing), in "
+                 "'speed_unit'; default: the highest of 'speeds'.",
+                 lambda v: None if np.isfinite(v) and v >= 0 else "must be a finite number >= 0"),
+    "speed_unit": Key(_STR, "rpm", "'rpm', 'rad/s' or 'Hz' (revolutions per second).",
+                      _one_of("rpm", "rad/s", "Hz")),
+    "axis": Key((dict,), None, "The rotation axis: {origin = [x, y, z], direction = [dx, dy, dz]} (m; the engine "
+                "axis, e.g. through the hub centre); required with 'speeds' or 'speed'.", _axis),
+    "engine_orders": Key(_LIST, [], "Engine orders drawn on the Campbell diagram, e.g. [1, 2, 36]; their "
+                         "crossings with the modes and with the nonsmooth-mode bands are reported.", _orders),
+    "modes": Key(_INT, 6, "Modes followed (by shape) on the Campbell diagram.", _int_between(1, 50)),
+    "bands": Key(_BOOL, True, "At each speed of 'speeds', also reduce and search the nonsmooth modes: the band "
+                 "of frequencies of the admissible orbits (costs a reduction and a search per speed)."),
+}
+
+
+def rotation_checks(c: dict) -> None:
+    """``[rotation]``: an axis whenever the blade rotates; the unit's name normalised."""
+    r = c.get("rotation")
+    if not r:
+        return
+    rotates = bool(r["speeds"]) or r["speed"] is not None
+    if rotates and r["axis"] is None:
+        raise StudyError("[rotation] axis: required with speeds or speed (the engine axis: {origin = [x, y, z], "
+                         "direction = [dx, dy, dz]})")
+    if r["axis"] is not None:
+        axis = r["axis"]
+        r["axis"] = {"origin": list(axis.get("origin", [0.0, 0.0, 0.0])), "direction": list(axis["direction"])}
+    if r["engine_orders"] and not r["speeds"]:
+        raise StudyError(f"[rotation] engine_orders: drawn on the Campbell diagram, which needs speeds; got "
+                         f"{r['engine_orders']} without speeds")
