@@ -8,21 +8,26 @@ matrices of linear elasticity with the clamped degrees of freedom removed
 eigenfrequencies).
 
 The discretisation is scikit-fem's: the mesh's vertices make a
-``skfem.MeshTet``/``MeshTri``/``MeshHex``/``MeshWedge1``/``MeshQuad`` (straight-sided,
-trilinear or prismatic cells; the extra nodes of second-order cells are not used),
+``skfem.MeshTet``/``MeshTri``/``MeshHex``/``MeshWedge1``/``MeshQuad`` (the cells' topology),
 the scalar element of :data:`~bladecase.fe.cells.SKFEM_ELEMENTS` (``ElementTetP1/P2``,
 ``ElementTriP1/P2``, ``ElementHex1``, ``ElementHexS2`` — ``ElementHex2`` on 27-node
 meshes —, ``ElementWedge1``, ``ElementWedgeS2`` — ``ElementWedge2`` on 18-node meshes —,
 ``ElementQuad1``, ``ElementQuadS2`` — ``ElementQuad2`` on 9-node meshes) gives the basis
 functions (the second-order wedges are :mod:`~bladecase.fe.wedge_element`'s: scikit-fem has
-none), ``skfem.models.elasticity.lame_parameters`` the Lamé constants.  Every scalar dof sits
-at a vertex, an edge midpoint or a face (cell) centre of the straight cell
-(``DofMap.coords``); :func:`~bladecase.fe.node_operator` finds there the extra nodes of
-quadratic mesh cells.  Simplices use scikit-fem's default quadrature; hexahedra and
+none), ``skfem.models.elasticity.lame_parameters`` the Lamé constants.  The geometry: at order
+2 on a second-order mesh, each cell is mapped through all its nodes by its own quadratic
+element (isoparametric, curved cells: :mod:`~bladecase.fe.isoparametric`), and every scalar dof
+sits at a mesh node — a vertex, or the midside, face-centre or centre node of its edge, face or
+cell (``DofMap.coords``, where :func:`~bladecase.fe.node_operator` finds it); otherwise (a
+first-order mesh, or order 1) the cells are straight-sided, trilinear or prismatic through
+their corners and the dofs sit at the vertices, edge midpoints and face (cell) centres of the
+straight cells.  Straight-sided second-order cells give the same matrices either way, to
+round-off.  Simplices use scikit-fem's default quadrature; hexahedra and
 quadrilaterals the ``(p+1)``-point Gauss rule per direction (exact mass and stiffness
 on parallelepipeds), wedges a triangle × line product rule of degree ``2p+1`` in each
 built here (exact on right prisms; scikit-fem 12.0's wedge rule does not integrate the
-reference prism: weights summing to 1/4, not 1/2).
+reference prism: weights summing to 1/4, not 1/2); curved cells keep the same rules (their
+integrands are no longer polynomials: the quadrature error is of the discretisation's order).
 The weak forms are those of ``skfem.models.elasticity.linear_elasticity``
 (``σ(u):ε(v)``) and of the mass ``ρ u·v`` on
 ``ElementVector(ElementTetP1/P2)``; they are integrated here by one batched
@@ -48,7 +53,7 @@ from skfem import CellBasis, ElementTetP1, ElementTetP2, ElementTriP1, ElementTr
 from skfem.quadrature import get_quadrature_line, get_quadrature_tri
 
 from ..checks import positive
-from . import wedge_element
+from . import isoparametric, wedge_element
 from .cells import KINDS, SKFEM_MESHES, element_name
 from .eigen import natural_frequencies
 from .material import AL6061T6, ALUMINIUM, INCONEL718, PLANE_KINDS, PRESETS, STEEL, TI6AL4V, Material
@@ -109,9 +114,10 @@ def assemble(
     ----------
     mesh : Mesh
         Tetrahedra, hexahedra or wedges (``dim == 3``), triangles or
-        quadrilaterals in the xy-plane (``dim == 2``); second-order cells
-        (``tetra10``, ``hexahedron20``, …) contribute their vertices only
-        (straight-sided cells).
+        quadrilaterals in the xy-plane (``dim == 2``).  Second-order cells
+        (``tetra10``, ``hexahedron20``, …) are curved through their midside
+        (face-centre, centre) nodes at ``order=2`` (isoparametric cells); at
+        ``order=1`` they are straight through their corners.
     material : Material or str
         The material, or the name of a preset (:meth:`Material.preset`).
     order : {1, 2}
@@ -148,7 +154,8 @@ def assemble(
     ------
     ValueError
         Bad argument (the message names it and what is valid), a clamp that
-        selects no node of the body, degenerate cells.
+        selects no node of the body, degenerate cells, curved cells folded
+        over (the Jacobian changing sign inside).
 
     Examples
     --------
@@ -235,31 +242,45 @@ def assemble(
 
 
 def _basis(mesh: Mesh, points: np.ndarray, dim: int, order: int):
-    """``(basis, fe_mesh, used)``: scikit-fem's basis on the straight body cells, its mesh, and the mesh node of
-    each of its vertices."""
+    """``(basis, fe_mesh, used)``: scikit-fem's basis on the body cells, the mesh of their corners, and the mesh
+    node of each of its vertices.
+
+    At order 2, cells with extra nodes are curved: the basis maps them through all their nodes
+    (:class:`~bladecase.fe.isoparametric.MappingCurved`) and its ``doflocs`` are the mesh's nodes.  At order 1
+    they stay straight through their corners (a curved map with a linear field would not hold the rigid
+    rotations: see :mod:`~bladecase.fe.isoparametric`).
+    """
     body_type = mesh.body_type
     kind = KINDS[body_type]
     used, local = _body_cells(mesh, points, dim)
-    if kind.family in ("tetra", "triangle"):  # unchanged: scikit-fem's meshes and default quadrature
-        fe_mesh = getattr(skfem, SKFEM_MESHES[kind.family])(np.ascontiguousarray(points[used, :dim].T),
-                                                           np.ascontiguousarray(local.T))
-        return CellBasis(fe_mesh, _ELEMENTS[dim, order]()), fe_mesh, used
-    element = _element(element_name(body_type, order))
-    t = np.ascontiguousarray(local[:, list(kind.skfem_corners)].T)
-    fe_mesh = getattr(skfem, SKFEM_MESHES[kind.family])(np.ascontiguousarray(points[used, :dim].T), t)
-    if kind.family == "wedge":
+    corners = local if kind.family in ("tetra", "triangle") else local[:, list(kind.skfem_corners)]
+    fe_mesh = getattr(skfem, SKFEM_MESHES[kind.family])(np.ascontiguousarray(points[used, :dim].T),
+                                                       np.ascontiguousarray(corners.T))
+    geometry = isoparametric.curved_geometry(mesh, used, fe_mesh) if order == 2 else None
+    if kind.family in ("tetra", "triangle"):  # scikit-fem's elements and default quadrature
+        element, options = _ELEMENTS[dim, order](), {}
+    elif kind.family == "wedge":
+        element = isoparametric.element(element_name(body_type, order))
         X, W = get_quadrature_tri(2 * order + 1)
         Z, V = get_quadrature_line(2 * order + 1)
-        quadrature = (np.vstack([np.tile(X, Z.shape[1]), np.repeat(Z, X.shape[1], axis=1)]), np.outer(V, W).ravel())
-        dofs = wedge_element.WedgeFaceDofs(fe_mesh, element) if isinstance(element, wedge_element.ElementWedge2) \
-            else None
-        return CellBasis(fe_mesh, element, quadrature=quadrature, dofs=dofs), fe_mesh, used
-    return CellBasis(fe_mesh, element, intorder=2 * order + 1), fe_mesh, used
-
-
-def _element(name: str) -> skfem.element.Element:
-    """An instance of the element called ``name``: bladecase's wedges, else scikit-fem's."""
-    return (getattr(wedge_element, name, None) or getattr(skfem, name))()
+        options = {"quadrature": (np.vstack([np.tile(X, Z.shape[1]), np.repeat(Z, X.shape[1], axis=1)]),
+                                  np.outer(V, W).ravel())}
+        if isinstance(element, wedge_element.ElementWedge2):
+            options["dofs"] = wedge_element.WedgeFaceDofs(fe_mesh, element)
+    else:
+        element, options = isoparametric.element(element_name(body_type, order)), {"intorder": 2 * order + 1}
+    if geometry is None:
+        return CellBasis(fe_mesh, element, **options), fe_mesh, used
+    options["dofs"] = geometry.dofs  # the field's element is the geometry's: the same dofs, at the mesh's nodes
+    basis = CellBasis(fe_mesh, element, mapping=isoparametric.MappingCurved(geometry), disable_doflocs=True,
+                      **options)
+    basis.doflocs = geometry.doflocs
+    folded = isoparametric.folded_cells(basis.mapping.detDF(basis.X))
+    if folded.size:
+        i = int(folded[0])
+        raise ValueError(f"mesh {mesh.source or ''} has {folded.size} folded curved {body_type} cell(s) (the Jacobian "
+                         f"changes sign inside), e.g. cell {i} with nodes {mesh.cells[body_type][i].tolist()}")
+    return basis, fe_mesh, used
 
 
 def _clamped_dofs(basis: CellBasis, fe_mesh, vertex_clamped: np.ndarray) -> np.ndarray:

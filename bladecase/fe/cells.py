@@ -6,10 +6,11 @@ extra node sits between (``parents``: an edge midpoint, a face centre, the cell 
 VTK order).  From the parents follow the midside-node checks, the order-1 interpolation of extra nodes
 (:func:`bladecase.fe.node_operator`) and the node permutation that reverses a cell (:attr:`CellKind.flip`).
 
-The assembly uses the corners only (straight-sided, trilinear or prismatic cells) with the scikit-fem
-element of :data:`SKFEM_ELEMENTS` (the second-order wedges are bladecase's own,
-:mod:`~bladecase.fe.wedge_element`); :attr:`CellKind.skfem_corners` reorders meshio's corners to the
-numbering of ``skfem.MeshHex1`` (``skfem.io.meshio.HEX_MAPPING``), the other families need no reordering.
+The assembly numbers the cells on their corners with the scikit-fem element of :data:`SKFEM_ELEMENTS` (the
+second-order wedges are bladecase's own, :mod:`~bladecase.fe.wedge_element`) and, at order 2, maps second-order
+cells through all their nodes (curved cells, :mod:`~bladecase.fe.isoparametric`; each extra node found by its
+``parents``); :attr:`CellKind.skfem_corners` reorders meshio's corners to the numbering of ``skfem.MeshHex1``
+(``skfem.io.meshio.HEX_MAPPING``), the other families need no reordering.
 
 >>> KINDS["hexahedron20"].family, KINDS["hexahedron20"].corners, KINDS["hexahedron20"].parents[16]
 ('hexahedron', 8, (0, 4))

@@ -3,8 +3,10 @@
 Degree-of-freedom numbering: the scalar dofs of skfem's basis, each carrying
 ``dim`` displacement components, component ``c`` of scalar dof ``s`` being
 unclamped dof ``dim * s + c``.  A :class:`DofMap` says for each free dof its
-location, its direction and its mesh node (``-1`` for the edge dofs of
-quadratic elements); :func:`node_operator` maps free-dof vectors to per-node displacements.
+location (on a second-order mesh at order 2, the edge, face and cell dofs are at the mesh's own midside,
+face-centre and centre nodes: the cells are curved through them), its direction and its mesh node (``-1``
+for the edge dofs of quadratic elements); :func:`node_operator` maps free-dof vectors to per-node
+displacements.
 """
 
 from __future__ import annotations
@@ -30,8 +32,10 @@ class DofMap:
     Attributes
     ----------
     node : (n,) int ndarray
-        Mesh node (index into ``mesh.points``) of a vertex dof; ``-1`` for a
-        dof that is not at a mesh node (edge dofs of quadratic elements).
+        Mesh node (index into ``mesh.points``) of a vertex dof; ``-1`` for the
+        other dofs of quadratic elements (edge, face and cell dofs; on a
+        second-order mesh they sit at its midside, face-centre and centre
+        nodes, see :func:`node_operator`).
     direction : (n,) int ndarray
         Displacement component: 0 = x, 1 = y, 2 = z.
     coords : (n, 3) float ndarray
@@ -183,11 +187,14 @@ def node_operator(model: FEModel) -> sp.csr_array:
 
     Row ``dim·p + c`` gives component ``c`` at mesh node ``p``: the vertex dof
     of ``p`` when it has one; for the midside nodes of quadratic mesh cells,
-    the FE field at the straight edge's midpoint (P2: the edge dof located
-    there; P1: the mean of the two end vertices), and likewise for the face and
-    cell centres of 27-node hexahedra, 18-node wedges and 9-node quadrilaterals
+    the FE field there (order 2: the edge dof, located at the node itself, the
+    cells being curved through it; order 1: the mean of the two end vertices,
+    the value at the edge's middle), and likewise for the face and cell
+    centres of 27-node hexahedra, 18-node wedges and 9-node quadrilaterals
     (the face or cell dof, or the mean of the corners); zero for clamped nodes
-    and nodes outside the body cells.
+    and nodes outside the body cells.  (A stored model whose edge dofs sit at
+    the straight edges' midpoints — built by a bladecase that did not curve
+    second-order cells — is matched there.)
     """
     dofs, dim = model.dofs, model.dim
     n_nodes = model.mesh.points.shape[0]
@@ -202,11 +209,16 @@ def node_operator(model: FEModel) -> sp.csr_array:
     table = np.full((n_nodes, dim), -1, dtype=np.int64)  # free dof of (node, direction), -1 if none
     table[dofs.node[vertex], dofs.direction[vertex]] = vertex
     for mids, parents in _extra_nodes(kind, cells):  # the extra nodes of quadratic mesh cells
-        if model.order == 2:  # the FE node at the straight entity's centre (an edge, face or cell dof)
+        if model.order == 2:  # the FE node there (an edge, face or cell dof), where the node is
             if tree is None:
                 continue
-            dist, k = tree.query(model.mesh.points[parents].mean(axis=1))
-            ok = dist <= 1e-9 * np.abs(model.mesh.points).max()  # else: a clamped edge
+            tol = 1e-9 * np.abs(model.mesh.points).max()
+            dist, k = tree.query(model.mesh.points[mids])
+            ok = dist <= tol  # else: a clamped edge, or a model whose dofs sit at the straight centres
+            if not ok.all():
+                dist2, k2 = tree.query(model.mesh.points[parents].mean(axis=1))
+                k = np.where(ok, k, k2)
+                ok |= dist2 <= tol
             for c in range(dim):
                 rows.append(dim * mids[ok] + c)
                 cols.append(edge[k[ok]] + c)
