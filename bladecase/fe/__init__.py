@@ -9,13 +9,17 @@ Modules: :mod:`~bladecase.fe.naca` (sections), :mod:`~bladecase.fe.geometry` (pa
 :mod:`~bladecase.fe.groups` (named groups of mesh files), :mod:`~bladecase.fe.quality` (cell checks),
 :mod:`~bladecase.fe.select` (:func:`select_nodes`: nodes by group name or coordinates),
 :mod:`~bladecase.fe.material` (:class:`Material`, presets), :mod:`~bladecase.fe.model` (:class:`FEModel`,
-:class:`DofMap`), :mod:`~bladecase.fe.assembly` (:func:`assemble`), :mod:`~bladecase.fe.eigen`
-(:func:`natural_frequencies`, :func:`stiffness_factor`), :mod:`~bladecase.fe.storage` (stage files).
+:class:`DofMap`), :mod:`~bladecase.fe.assembly` (:func:`assemble`), :mod:`~bladecase.fe.isoparametric` (the
+curved map of quadratic cells through their midside nodes), :mod:`~bladecase.fe.rotation`
+(:func:`~bladecase.fe.rotation.spin`), :mod:`~bladecase.fe.campbell` (frequencies against speed),
+:mod:`~bladecase.fe.eigen` (:func:`natural_frequencies`, :func:`stiffness_factor`),
+:mod:`~bladecase.fe.storage` (stage files).
 """
 
 from .assembly import assemble
 from .eigen import natural_frequencies, stiffness_factor
 from .geometry import BladeGeometry, PlateGeometry, blade_mesh, cad_volume
+from .isoparametric import MappingCurved, curved_geometry
 from .material import AL6061T6, INCONEL718, PRESETS, STEEL, TI6AL4V, Material
 from .mesh import Mesh, load_mesh, save_mesh
 from .model import DofMap, FEModel, node_operator
@@ -25,8 +29,9 @@ from .storage import load_model, model_from_arrays, model_to_arrays, save_model,
 
 __all__ = [
     "AL6061T6", "INCONEL718", "PRESETS", "STEEL", "TI6AL4V",
-    "BladeGeometry", "DofMap", "FEModel", "Material", "Mesh", "PlateGeometry",
-    "assemble", "blade_mesh", "cad_volume", "load_mesh", "load_model", "model_from_arrays", "model_to_arrays",
+    "BladeGeometry", "DofMap", "FEModel", "MappingCurved", "Material", "Mesh", "PlateGeometry",
+    "assemble", "blade_mesh", "cad_volume", "curved_geometry", "load_mesh", "load_model", "model_from_arrays",
+    "model_to_arrays",
     "naca_parameters", "naca_section", "natural_frequencies", "node_operator", "save_mesh", "save_model",
     "select_nodes",
     "sparse_from_arrays", "sparse_to_arrays", "stiffness_factor",

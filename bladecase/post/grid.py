@@ -1,9 +1,9 @@
 """The full nodal grid of a finite-element model: every FE node, and free-dof vectors placed on it.
 
-A P2 model has degrees of freedom at the vertices AND at the midpoints of the
-straight cell edges; the mesh it was built from may have only the vertices
-(``tetra``/``triangle``) or midside nodes that are not where the FE edge dofs
-are (curved ``tetra10`` from gmsh).  Results (animations, VTK files) must show
+A P2 model has degrees of freedom at the vertices AND on the cell edges: at the
+midpoints of straight edges when the mesh has only vertices (``tetra``/``triangle``),
+at the mesh's own midside nodes when it has them (curved ``tetra10`` from gmsh: the
+model's cells are curved through them).  Results (animations, VTK files) must show
 the field the model computed, so they are drawn on :func:`fe_grid`: one point
 per scalar FE node, quadratic cells (``tetra10``/``triangle6``, VTK node order)
 for order-2 models.  :func:`nodal_field` puts free-dof vectors (``x_free``, as
@@ -80,8 +80,8 @@ def fe_grid(model: FEModel) -> Mesh:
     Mesh
         ``points`` ``(n_points, 3)`` with ``n_points = model.dofs.n_total // dim``:
         point ``s`` is scalar FE dof ``s`` — the vertices of the body cells,
-        then (order 2) the midpoints of the straight cell edges, where the
-        P2 edge dofs are.  ``cells`` has one body block: ``tetra10`` /
+        then (order 2) the edge nodes, where the P2 edge dofs are: the mesh's
+        midside nodes, or the midpoints of straight edges when it has none.  ``cells`` has one body block: ``tetra10`` /
         ``triangle6`` (VTK node order: the corners, then the midside nodes of
         the edges :data:`VTK_EDGES`) for an order-2 model, ``tetra`` /
         ``triangle`` for order 1; cells keep the orientation of the mesh's
@@ -125,6 +125,10 @@ def fe_grid(model: FEModel) -> Mesh:
     else:
         edges, cell_edges = _edges(corners, dim)
         points = np.concatenate([vertex_points, 0.5 * (vertex_points[edges[:, 0]] + vertex_points[edges[:, 1]])])
+        if KINDS[mesh.body_type].order == 2:  # curved cells: the edge dofs sit at the mesh's own midside nodes
+            mid = np.empty(len(edges), dtype=np.int64)
+            mid[cell_edges.ravel()] = np.asarray(mesh.cells[mesh.body_type])[:, dim + 1:].ravel()
+            points[n_v:, :dim] = np.asarray(mesh.points, dtype=float)[mid, :dim]
         cells = np.concatenate([corners, n_v + cell_edges], axis=1)
     _check_dofs(model, points)
     groups = {}

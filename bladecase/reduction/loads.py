@@ -129,12 +129,15 @@ def pressure_load(model: FEModel, group: str, pressure: float = 1.0) -> np.ndarr
 
     ``f_i = −p ∫_Γ N_i n dS`` (``n`` outward; a positive pressure pushes into the body) over the boundary
     facets (triangles in 3-D, edges in 2-D) whose vertices are all in ``group``, with the model's own
-    elements (P1/P2, straight-sided facets); in 2-D times the thickness.  Forces on clamped dofs are dropped.
+    elements (P1/P2; at order 2 the facets are curved through the mesh's midside nodes, as the model's
+    cells); in 2-D times the thickness.  Forces on clamped dofs are dropped.
     On a flat face the forces add up to ``−p × area × n`` exactly.
 
     Raises ``ValueError`` when the group has no boundary facet.
     """
     from skfem import FacetBasis, LinearForm, asm
+
+    from ..fe import MappingCurved, curved_geometry
 
     model = _model(model)
     pressure = _finite("pressure", pressure)
@@ -146,7 +149,8 @@ def pressure_load(model: FEModel, group: str, pressure: float = 1.0) -> np.ndarr
     if facets.size == 0:
         raise ValueError(f"group {group!r} holds no boundary facet of the body (no "
                          f"{'triangle' if model.dim == 3 else 'edge'} of the surface has all its vertices in it)")
-    basis = FacetBasis(fe_mesh, element, facets=facets)
+    geometry = curved_geometry(model.mesh, used, fe_mesh) if model.order == 2 else None
+    basis = FacetBasis(fe_mesh, element, facets=facets, mapping=MappingCurved(geometry) if geometry else None)
     dim = model.dim
     scalar = model.dofs.fe_index // dim
     if not np.allclose(basis.doflocs[:, scalar].T, model.dofs.coords[:, :dim], rtol=0,
