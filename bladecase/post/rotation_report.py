@@ -24,7 +24,9 @@ def rotation_report(rotation: dict | None, campbell: dict | None) -> list[str]:
         lines += ["", "## Rotation", "",
                   f"- Operating speed {rotation['speed_rpm']:.6g} rpm ({rotation['speed_rad_s']:.6g} rad/s) about the "
                   f"axis {_vec(rotation['axis']['direction'])} through {_vec(rotation['axis']['origin'])} m: every "
-                  "result below is about the centrifugal state there (stress stiffening, spin softening).",
+                  "result below is about the centrifugal state there (stress stiffening, spin softening; "
+                  + ("a second-order static state, " + f"{rotation['static_iterations']} iterations"
+                     if rotation.get("static_state") == "second-order" else "the linear static state") + ").",
                   f"- Running clearance {rotation['clearance_running_m'] * 1e3:.4g} mm: cold clearance "
                   f"{rotation['clearance_cold_m'] * 1e3:.4g} mm, closed by {rotation['closure_m'] * 1e3:.4g} mm of "
                   "centrifugal growth along the casing normal."]

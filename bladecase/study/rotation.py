@@ -71,7 +71,8 @@ def running_clearance(study: Study, model, contact, state: SpinState) -> dict:
     given = float(contact.gap)
     running = given - closure if cold else given
     out = {"speed_rad_s": state.speed, "speed_rpm": state.speed * 60 / (2 * math.pi), "closure_m": closure,
-           "clearance_cold_m": given if cold else given + closure, "clearance_running_m": running}
+           "clearance_cold_m": given if cold else given + closure, "clearance_running_m": running,
+           "static_state": state.static, "static_iterations": state.iterations}
     if running <= 0 and closure > 0:  # the closure grows as Ω²: where the cold clearance is used up
         out["touches_at_rpm"] = out["speed_rpm"] * math.sqrt(out["clearance_cold_m"] / closure)
     return out
@@ -92,7 +93,7 @@ def operating_point(study: Study, model, contact, factor=None):
         return model, contact, factor, None
     axis = rotation_axis(study)
     try:
-        state = spin(model, omega, axis)
+        state = spin(model, omega, axis, static=_section(study).get("static", "auto"))
     except ValueError as exc:
         raise StudyError(f"[rotation] speed: {exc}") from None
     info = running_clearance(study, model, contact, state)
@@ -115,7 +116,7 @@ def _speed_point(omega: float, *, study: Study, model, contact, axis: RotationAx
     """One speed of the Campbell diagram (module level: an executor ships it to its workers)."""
     from .stages import build_reduced, search
 
-    state = spin(model, float(omega), axis)
+    state = spin(model, float(omega), axis, static=study["rotation"].get("static", "auto"))
     n = min(count + EXTRA_MODES, model.n_dofs - 1)
     lam, phi = lowest_modes(state.model.K, state.model.M, n, factor=state.factor)
     point = {"shapes": phi, "frequencies_hz": np.sqrt(np.maximum(lam, 0.0)) / (2 * math.pi),
