@@ -64,10 +64,11 @@ def operating_speed(study: Study) -> float | None:
     return to_rad_s(r["speed"] if r.get("speed") is not None else max(r["speeds"]), r["speed_unit"])
 
 
-def running_clearance(study: Study, model, contact, state: SpinState) -> dict:
-    """The contact's centrifugal closure at ``state``'s speed and the running clearance it leaves."""
+def running_clearance(study: Study, model, contact, state: SpinState, cold: bool | None = None) -> dict:
+    """The contact's centrifugal closure at ``state``'s speed and the running clearance it leaves; ``contact.gap``
+    is the cold clearance if ``cold`` (default: ``[contact] clearance_at = "cold"``), else the running one."""
     closure = float(contact.w(model) @ state.displacement)  # towards the casing: +
-    cold = study["contact"].get("clearance_at", "cold") == "cold"
+    cold = study["contact"].get("clearance_at", "cold") == "cold" if cold is None else cold
     given = float(contact.gap)
     running = given - closure if cold else given
     out = {"speed_rad_s": state.speed, "speed_rpm": state.speed * 60 / (2 * math.pi), "closure_m": closure,
@@ -120,7 +121,7 @@ def _speed_point(omega: float, *, study: Study, model, contact, axis: RotationAx
     n = min(count + EXTRA_MODES, model.n_dofs - 1)
     lam, phi = lowest_modes(state.model.K, state.model.M, n, factor=state.factor)
     point = {"shapes": phi, "frequencies_hz": np.sqrt(np.maximum(lam, 0.0)) / (2 * math.pi),
-             "clearance": running_clearance(study, model, contact, state), "band_hz": None, "note": None}
+             "clearance": running_clearance(study, model, contact, state, cold=True), "band_hz": None, "note": None}
     d = point["clearance"]["clearance_running_m"]
     if not bands:
         return point
@@ -140,7 +141,8 @@ def _speed_point(omega: float, *, study: Study, model, contact, axis: RotationAx
 
 def campbell_stage(study: Study, model, contact, executor, progress: bool = False) -> tuple[Campbell, dict]:
     """The Campbell diagram of the study (see the module): ``(campbell, summary section)``; the bands as
-    ``summary["bands"]``, one entry per speed."""
+    ``summary["bands"]``, one entry per speed.  ``contact.gap`` is the cold clearance (with ``clearance_at =
+    "speed"``, the running clearance at the operating speed plus the closure there: see :func:`operating_point`)."""
     r = _section(study)
     w = speeds(study)
     axis = rotation_axis(study)

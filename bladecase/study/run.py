@@ -8,6 +8,7 @@ plain tqdm, absent with ``progress=False``.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import shutil
 import time
@@ -181,6 +182,7 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         model, contact, factor, rotation = operating_point(study, model, contact, factor)
         if rotation is not None:
             rotation["axis"] = study["rotation"]["axis"]
+            cold_contact = dataclasses.replace(cold_contact, gap=rotation["clearance_cold_m"])
         count = min(study["fem"]["frequencies"], model.n_dofs - 1)
         fe = fe_reference(model, contact, min(max(count, FE_MODES), model.n_dofs - 1), factor=factor)
         f_fe = fe.frequencies[:count]
