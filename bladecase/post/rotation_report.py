@@ -50,8 +50,9 @@ def _campbell_lines(c: dict) -> list[str]:
              "|---:|---:|" + "---:|" * len(tracked) + "---|"]
     for s, w in enumerate(rpm):
         band = bands[s]
-        words = (f"mode {band['mode'] + 1}: {band['low_hz']:.2f} – {band['high_hz']:.2f}" if band
-                 else notes[s] or "—")
+        words = (f"mode {band['mode'] + 1}: {band['low_hz']:.2f} – {band['high_hz']:.2f}"
+                 + (" (or more: the band reaches the edge of [search] periods)" if band.get("truncated") else "")
+                 if band else notes[s] or "—")
         lines.append(f"| {w:.6g} | {c['running_clearance_m'][s] * 1e3:.4g} | "
                      + " | ".join(f"{f[s]:.2f}" for f in tracked) + f" | {words} |")
     if c["crossings"]:

@@ -115,7 +115,7 @@ def operating_point(study: Study, model, contact, factor=None):
 def _speed_point(omega: float, *, study: Study, model, contact, axis: RotationAxis, count: int,
                  bands: bool) -> dict:
     """One speed of the Campbell diagram (module level: an executor ships it to its workers)."""
-    from .stages import build_reduced, search
+    from .stages import build_reduced, period_unit, search
 
     state = spin(model, float(omega), axis, static=study["rotation"].get("static", "auto"))
     n = min(count + EXTRA_MODES, model.n_dofs - 1)
@@ -134,6 +134,10 @@ def _speed_point(omega: float, *, study: Study, model, contact, axis: RotationAx
     arcs = [a for f in families for a in f.arcs]
     if arcs:
         point["band_hz"] = (min(1.0 / a.T_hi for a in arcs), max(1.0 / a.T_lo for a in arcs))
+        unit, _ = period_unit(study, reduced.system)
+        edge = 1.0 / (study["search"]["periods"][0] * unit)  # the highest frequency the search looks at
+        if point["band_hz"][1] >= edge * (1 - 1e-6):
+            point["note"] = "the band reaches the edge of [search] periods: it may extend beyond"
     else:
         point["note"] = "no admissible orbit in [search] periods"
     return point
@@ -158,7 +162,8 @@ def campbell_stage(study: Study, model, contact, executor, progress: bool = Fals
     section["axis"] = {"origin": axis.origin.tolist(), "direction": axis.direction.tolist()}
     section["running_clearance_m"] = [p["clearance"]["clearance_running_m"] for p in points]
     section["closure_m"] = [p["clearance"]["closure_m"] for p in points]
-    section["bands"] = [None if b is None else {"mode": _rank0(c, s), "low_hz": b[0], "high_hz": b[1]}
+    section["bands"] = [None if b is None else {"mode": _rank0(c, s), "low_hz": b[0], "high_hz": b[1],
+                                                "truncated": bool(points[s]["note"])}
                         for s, b in enumerate(bands)]
     section["band_notes"] = [p["note"] for p in points]
     section["risks"] = band_risks(w, bands, section["engine_orders"])
