@@ -70,8 +70,13 @@ class Damping:
         object.__setattr__(self, "alpha", _finite_nonneg("alpha", self.alpha))
         object.__setattr__(self, "beta", _finite_nonneg("beta", self.beta))
         if self.zeta is not None:
-            z = np.atleast_1d(np.asarray(self.zeta, dtype=float))
-            if z.ndim != 1 or not np.all(np.isfinite(z)) or np.any(z < 0):
+            try:
+                if isinstance(self.zeta, (str, bytes)):
+                    raise TypeError
+                z = np.atleast_1d(np.asarray(self.zeta, dtype=float))
+            except (TypeError, ValueError):
+                z = np.array([np.nan])  # refused below
+            if z.ndim != 1 or z.size == 0 or not np.all(np.isfinite(z)) or np.any(z < 0):
                 raise ValueError(f"zeta must be a damping ratio >= 0 or a sequence of them, got {self.zeta!r}")
             if self.alpha or self.beta:
                 raise ValueError("give either Rayleigh coefficients (alpha, beta) or modal ratios zeta, not both")
@@ -102,6 +107,16 @@ class Damping:
         return MP @ np.diag(2 * self.rates(sp.omega)) @ MP.T
 
 
+def _real(name: str, value, what: str = "finite number") -> float:
+    """``float(value)`` of a number (not a bool, not a string), else ``ValueError`` naming ``name``."""
+    try:
+        if isinstance(value, (bool, np.bool_, str, bytes)):
+            raise TypeError
+        return float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a {what}, got {value!r}") from None
+
+
 def forcing_inputs(n: int, period, amplitude: float, damping, load):
     """Checked ``(period, Ω, damping, load)`` of a forced flight of ``n`` dofs (``load=None``: every dof)."""
     if period is None:
@@ -109,14 +124,20 @@ def forcing_inputs(n: int, period, amplitude: float, damping, load):
             raise ValueError("a forcing period is needed when the amplitude is not 0")
         Omega = 0.0
     else:
-        period = float(period)
+        period = _real("period", period, "finite number > 0")
         if not np.isfinite(period) or period <= 0:
             raise ValueError(f"period must be finite and > 0, got {period!r}")
         Omega = 2 * np.pi / period
     damping = Damping() if damping is None else damping
     if not isinstance(damping, Damping):
         raise ValueError(f"damping must be a Damping (e.g. Damping(alpha=0.005)) or None, got {damping!r}")
-    f = np.ones(n) if load is None else np.asarray(load, dtype=float).reshape(-1)
+    try:
+        if isinstance(load, (str, bytes)):
+            raise TypeError
+        f = np.ones(n) if load is None else np.asarray(load, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise ValueError(f"load must be a finite vector of {n} entries (or None: a unit force on every dof), got "
+                         f"{load!r}") from None
     if f.shape != (n,) or not np.all(np.isfinite(f)):
         raise ValueError(f"load must be a finite vector of {n} entries, got shape {f.shape}")
     return period, Omega, damping, f
@@ -141,13 +162,18 @@ class ForcedFlight(ModalFlight):
 
     def __init__(self, system: LinearSystem, period: float | None = None, amplitude: float = 0.0,
                  damping: Damping | None = None, load=None, horizon: float = np.inf):
+        if not isinstance(system, LinearSystem):
+            raise ValueError(f"ForcedFlight: system must be a LinearSystem (Newton's contact), got "
+                             f"{type(system).__name__}")
         super().__init__(system)
-        amplitude = float(amplitude)
+        amplitude = _real("amplitude", amplitude)
         if not np.isfinite(amplitude):
             raise ValueError(f"amplitude must be finite, got {amplitude!r}")
         period, Omega, damping, f = forcing_inputs(system.n, period, amplitude, damping, load)
         self.period, self.amplitude, self.damping, self.load = period, amplitude, damping, f
-        self.horizon = float(horizon)
+        self.horizon = _real("horizon", horizon, "number > 0 (inf: none)")
+        if not self.horizon > 0:
+            raise ValueError(f"horizon must be > 0 (inf: none), got {horizon!r}")
         self.modes = DampedModes(self.omega, damping.rates(self.omega), amplitude * (self.phi.T @ f), Omega)
 
     @property
@@ -255,6 +281,18 @@ class ForcedTrajectory(Trajectory):
                              work=float(wts @ pin), dissipated=float(wts @ pdis), impact_loss=loss)
 
 
+def _states(n: int, x0, v0) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`~bladecase.nsm.simulation._check_state`, with a value that is not numbers named."""
+    for name, a in (("x0", x0), ("v0", v0)):
+        try:
+            if a is None or isinstance(a, (str, bytes)):
+                raise TypeError
+            np.asarray(a, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f"{name} must be a vector of {n} finite numbers (the initial state), got {a!r}") from None
+    return _check_state(n, x0, v0)
+
+
 def simulate_forced(
     system: LinearSystem,
     x0,
@@ -309,10 +347,16 @@ def simulate_forced(
     >>> abs(b.residual) < 1e-10 * b.work
     True
     """
-    x0, v0 = _check_state(system.n, x0, v0)
-    t_end = float(t_end)
+    if not isinstance(system, LinearSystem):
+        hint = (": the massless contact model is simulate_forced_massless's"
+                if getattr(system, "contact_model", None) == "massless" else "")
+        raise ValueError(f"simulate_forced: system must be a LinearSystem (Newton's contact), got "
+                         f"{type(system).__name__}{hint}")
+    x0, v0 = _states(system.n, x0, v0)
+    t_end = _real("t_end", t_end, "finite number > 0")
     if not np.isfinite(t_end) or t_end <= 0:
         raise ValueError(f"t_end must be finite and > 0, got {t_end!r}")
+    restitution = _real("restitution", restitution, "number in (0, 1]")
     flight = ForcedFlight(system, period, amplitude, damping, load, horizon=t_end)
     tr = integrate(flight, NewtonImpact(restitution), x0, v0, t_end, max_impacts, _stacklevel=3)
     p_pre = tr._p + flight.b[:, None] * tr.impulses[None, :]

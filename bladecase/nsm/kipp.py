@@ -9,16 +9,29 @@ Levenberg–Marquardt from the most promising cells and from repeated lower-orde
 from __future__ import annotations
 
 from itertools import combinations
+from math import comb
 
 import numpy as np
 
 from .continuation import lstsq_stack
 from .modal import ModalKernel, _newton_stack, check_period, impact_kernels, impulses_for, solve_times
-from .orbits import REPEAT_RTOL, PeriodicOrbit, make_orbit, orbit_1ipp
+from .orbits import REPEAT_RTOL, PeriodicOrbit, check_newton_system, make_orbit, orbit_1ipp
 from .signals import TrigSum, all_roots
 from .system import LinearSystem
 
-__all__ = ["canonical_rotation", "check_k", "orbits_kipp"]
+__all__ = ["MAX_GRID_CELLS", "MAX_K", "canonical_rotation", "check_k", "check_newton_system", "check_period_range",
+           "check_resolution", "check_search_k", "orbits_kipp"]
+
+#: Largest ``k`` the k-ipp search takes (its start grid grows combinatorially with ``k``; as the CLI's ``--ipp``
+#: and the study's ``[search] ipp``).
+MAX_K = 8
+
+#: Most start cells of the k >= 3 grid at one period (``C(resolution - 1, k - 1)``; as the study's
+#: ``LIMITS["grid_cells"]``): beyond, one period's search would not end or not fit in memory.
+MAX_GRID_CELLS = 1_000_000
+
+#: Largest ``resolution`` (grid points per impact time) of the k >= 3 start search.
+MAX_RESOLUTION = 1000
 
 
 def check_k(k) -> int:
@@ -26,6 +39,69 @@ def check_k(k) -> int:
     if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
         raise ValueError(f"k (impacts per period) must be an integer >= 1, got {k!r}")
     return int(k)
+
+
+def check_search_k(k, name: str = "k") -> int:
+    """``k`` of a search (:func:`orbits_kipp`, :func:`~bladecase.nsm.nonsmooth_mode`): an integer in
+    ``1..MAX_K`` (the k-ipp start search grows combinatorially with ``k``).
+
+    >>> check_search_k(100)
+    Traceback (most recent call last):
+    ...
+    ValueError: k (impacts per period) must be an integer with 1 <= k <= 8, got 100
+    """
+    if isinstance(k, (bool, np.bool_)) or not isinstance(k, (int, np.integer)) or not 1 <= k <= MAX_K:
+        raise ValueError(f"{name} (impacts per period) must be an integer with 1 <= {name} <= {MAX_K}, got {k!r}")
+    return int(k)
+
+
+def check_period_range(name: str, value) -> tuple[float, float]:
+    """``(start, stop)`` of a period range: two finite numbers with ``0 < start < stop`` (``ValueError`` naming
+    ``name`` otherwise).
+
+    >>> check_period_range("T_range", (4.1, 3.2))
+    Traceback (most recent call last):
+    ...
+    ValueError: T_range must be (start, stop) with 0 < start < stop, got (4.1, 3.2)
+    """
+    try:
+        lo, hi = (float(x) for x in value)
+        if isinstance(value, (str, bytes)) or any(isinstance(x, (bool, np.bool_)) for x in value):
+            raise TypeError
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be (start, stop): two periods with 0 < start < stop, got {value!r}") from None
+    if not (np.isfinite(lo) and np.isfinite(hi)) or not 0 < lo < hi:
+        raise ValueError(f"{name} must be (start, stop) with 0 < start < stop, got {value!r}")
+    return lo, hi
+
+
+def check_resolution(resolution, k: int) -> int | None:
+    """``resolution`` of the k >= 3 start search: ``None`` (the default) or an integer with
+    ``k <= resolution <= MAX_RESOLUTION`` whose grid has at most :data:`MAX_GRID_CELLS` cells."""
+    if resolution is None:
+        return None
+    if isinstance(resolution, (bool, np.bool_)) or not isinstance(resolution, (int, np.integer)) or not (
+            1 <= resolution <= MAX_RESOLUTION):
+        raise ValueError(f"resolution (grid points per impact time) must be None or an integer with 1 <= resolution "
+                         f"<= {MAX_RESOLUTION}, got {resolution!r}")
+    if k >= 3:
+        if resolution < k:
+            raise ValueError(f"resolution must be >= k = {k} (a grid of resolution - 1 times holds k - 1 ordered "
+                             f"impact times), got {resolution!r}")
+        cells = comb(int(resolution) - 1, k - 1)
+        if cells > MAX_GRID_CELLS:
+            fit = _largest_resolution(k)
+            raise ValueError(f"resolution {resolution} makes {cells:.3g} start cells for k = {k} at each period (at "
+                             f"most {MAX_GRID_CELLS:g}): resolution <= {fit} for k = {k}")
+    return int(resolution)
+
+
+def _largest_resolution(k: int) -> int:
+    """The largest resolution whose k-ipp start grid has at most :data:`MAX_GRID_CELLS` cells."""
+    r = k
+    while r < MAX_RESOLUTION and comb(r, k - 1) <= MAX_GRID_CELLS:
+        r += 1
+    return r
 
 
 def orbits_kipp(system: LinearSystem, T: float, k: int, resolution: int | None = None,
@@ -40,7 +116,8 @@ def orbits_kipp(system: LinearSystem, T: float, k: int, resolution: int | None =
     (``Pf(Π) = 0`` and a two-dimensional null space for even k, the null
     vector of ``Π`` for odd k): Newton on ``(t₁…t_{k-1}, Λ)`` started from
     every cell of a grid on the ordered times, ``resolution`` points per time
-    (default: 4 per period of the highest contact mode, between 16 and 48),
+    (default: 4 per period of the highest contact mode, between 16 and 48,
+    and at most what keeps the grid within ``MAX_GRID_CELLS`` cells),
     from the equally spaced and repeated lower-order patterns, and
     Levenberg–Marquardt from the most promising cells; solutions closer than
     ``1e-7 T`` are merged.  For k >= 3 completeness is up to that resolution.
@@ -59,14 +136,29 @@ def orbits_kipp(system: LinearSystem, T: float, k: int, resolution: int | None =
     -------
     list of PeriodicOrbit, sorted by ``t₁``.
 
+    Raises
+    ------
+    ValueError
+        ``system`` not a :class:`LinearSystem`; ``T`` not a finite period > 0, or resonant; ``k`` not an
+        integer in ``1..MAX_K``; ``resolution`` not ``None`` or an integer ``>= k`` whose grid has at most
+        :data:`MAX_GRID_CELLS` cells; ``certify`` not a bool.
+
     Examples
     --------
     >>> from bladecase.nsm import chain
     >>> orbits = orbits_kipp(chain(2, k=1.0, m=0.5, gap=1.0), 13.5, 2)
     >>> [(round(float(o.impact_times[0]), 4), o.repeats, o.admissible) for o in orbits]
     [(3.6382, 1, False), (6.0829, 1, True), (6.75, 2, True)]
+    >>> orbits_kipp(chain(2, k=1.0, m=0.5, gap=1.0), 13.5, 100)
+    Traceback (most recent call last):
+    ...
+    ValueError: k (impacts per period) must be an integer with 1 <= k <= 8, got 100
     """
-    k = check_k(k)
+    check_newton_system(system, "orbits_kipp")
+    k = check_search_k(k)
+    resolution = check_resolution(resolution, k)
+    if not isinstance(certify, (bool, np.bool_)):
+        raise ValueError(f"certify must be True or False, got {certify!r}")
     if k == 1:
         return [orbit_1ipp(system, T, certify=certify)]
     T = check_period(system, T)
@@ -190,8 +282,8 @@ def _multistart(md: ModalKernel, k: int, d: float, resolution: int | None) -> li
     residual is a local minimum (non-strict) or among the lowest 5 %; Newton
     from every grid cell."""
     T = md.T
-    if resolution is None:
-        resolution = default_resolution(T, md.omega.max())
+    if resolution is None:  # the default, within the cap on the grid's cells
+        resolution = min(default_resolution(T, md.omega.max()), _largest_resolution(k))
     grid = T * (np.arange(1, resolution) / resolution)
     idx = np.array(list(combinations(range(grid.size), k - 1)))
     starts = np.column_stack([grid[idx], np.full(len(idx), T)])

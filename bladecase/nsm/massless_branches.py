@@ -13,8 +13,16 @@ import numpy as np
 
 from .. import log
 from .families import admissible_arcs
+from .kipp import check_period_range
 from .massless import MasslessSystem
-from .massless_orbits import SymmetricOrbit, _correct, closing_residual, follow_from_grazing, orbit_at_period
+from .massless_orbits import (
+    SymmetricOrbit,
+    _correct,
+    check_massless_system,
+    closing_residual,
+    follow_from_grazing,
+    orbit_at_period,
+)
 
 #: Relative precision (of ``T``) of the admissible arcs' ends.
 ARC_RTOL = 1e-9
@@ -29,7 +37,16 @@ def massless_modes(system: MasslessSystem, T_range: tuple[float, float], max_poi
     """
     from .branches import Arc, Branch
 
-    T_lo, T_hi = T_range
+    check_massless_system(system, "massless_modes")
+    T_lo, T_hi = check_period_range("T_range", T_range)
+    max_points = _integer("max_points", max_points, 2)
+    if not isinstance(refine, (bool, np.bool_)):
+        raise ValueError(f"refine must be True or False, got {refine!r}")
+    for name, value in (("ds", ds), ("ds_max", ds_max)):
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)) or \
+                not 0 < value <= 1:
+            raise ValueError(f"{name} must be a number with 0 < {name} <= 1 (a fraction of a quarter linear period), "
+                             f"got {value!r}")
     out = []
     for j in np.flatnonzero(2 * np.pi / system.open.omega >= T_lo):
         if abs(system.open.b[j]) <= 1e-12 * np.abs(system.open.b).max():
@@ -86,6 +103,12 @@ def _edge(system: MasslessSystem, bad: SymmetricOrbit, good: SymmetricOrbit) -> 
     return best
 
 
+def _integer(name: str, value, low: int) -> int:
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < low:
+        raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
+    return int(value)
+
+
 def massless_orbit_at(system: MasslessSystem, orbits: list[SymmetricOrbit], T: float) -> list[SymmetricOrbit]:
     """The orbits of period ``T`` on a massless branch (one per crossing), each solved by Newton from the
     interpolated contact half-time of its neighbours."""
@@ -120,9 +143,12 @@ def massless_mode(system: MasslessSystem, T_range: tuple[float, float], mode: in
     from .massless_follow import follow_mode
     from .massless_phases import PhasedOrbit
 
-    T_lo, T_hi = T_range
-    if not 0 <= int(mode) < system.n:
-        raise ValueError(f"mode must be an open-phase mode index in [0, {system.n}), got {mode!r}")
+    check_massless_system(system, "massless_mode")
+    T_lo, T_hi = check_period_range("T_range", T_range)
+    if isinstance(mode, (bool, np.bool_)) or not isinstance(mode, (int, np.integer)) or not 0 <= mode < system.n:
+        raise ValueError(f"mode must be an open-phase mode index, an integer in [0, {system.n}), got {mode!r}")
+    mode = int(mode)
+    max_points = _integer("max_points", max_points, 2)
     if abs(system.open.b[mode]) <= 1e-12 * np.abs(system.open.b).max():
         raise ValueError(f"the contact does not see open-phase mode {mode} (b = {system.open.b[mode]:.3g}): "
                          "no nonsmooth mode grows from it")

@@ -101,6 +101,20 @@ def follow_mode(system: MasslessSystem, start: PhasedOrbit, T_range: tuple[float
                 max_points: int = 4000, ds: float = 2e-3, ds_max: float = 0.05) -> list[PhasedOrbit]:
     """Admissible orbits of the mode through ``start`` (admissible), following it in the direction where half
     phase ``grow`` lengthens, across changes of its phase pattern, while ``T`` stays in ``T_range``."""
+    from .kipp import check_period_range
+    from .massless_orbits import check_massless_system
+
+    check_massless_system(system, "follow_mode")
+    if not isinstance(start, PhasedOrbit):
+        raise ValueError(f"follow_mode: start must be a PhasedOrbit (e.g. PhasedOrbit(system, 'open', [α, β], a)), got "
+                         f"{type(start).__name__}")
+    T_range = check_period_range("T_range", T_range)
+    if isinstance(grow, (bool, np.bool_)) or not isinstance(grow, (int, np.integer)) or not (
+            0 <= grow < start.durations.size):
+        raise ValueError(f"grow must be the index of a half-orbit phase of start, an integer in "
+                         f"[0, {start.durations.size}), got {grow!r}")
+    if isinstance(max_points, (bool, np.bool_)) or not isinstance(max_points, (int, np.integer)) or max_points < 1:
+        raise ValueError(f"max_points must be an integer >= 1, got {max_points!r}")
     omega = 2 * np.pi / start.T
     out = [start]
     first, tau, orient = start.first, start.durations, _unit(start.durations.size, grow)

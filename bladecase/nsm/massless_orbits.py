@@ -24,9 +24,40 @@ import scipy.linalg as sla
 
 from .massless import BoundOrbit, MasslessSystem
 from .signals import TrigSum, certified_max
+from .system import LinearSystem
 
 #: Relative tolerance (of the clearance) of the admissibility proofs.
 ADMISSIBILITY_RTOL = 1e-9
+
+
+def check_massless_system(system, what: str) -> MasslessSystem:
+    """``system`` if it is a :class:`MasslessSystem`, else ``ValueError`` naming ``what``."""
+    if isinstance(system, MasslessSystem):
+        return system
+    hint = (": a LinearSystem has Newton's contact; its modes come from nonsmooth_mode(system, k, T_range)"
+            if isinstance(system, LinearSystem) else "")
+    raise ValueError(f"{what} solves the massless contact model: system must be a MasslessSystem (bar(..., "
+                     f"contact='massless'), condense(...) or a massless reduced model's .system), got "
+                     f"{type(system).__name__}{hint}")
+
+
+def _number(name: str, value, low: float = 0.0, strict: bool = True) -> float:
+    """``float(value)`` if it is a finite number ``> low`` (``>= low`` unless ``strict``), else ``ValueError``."""
+    try:
+        if isinstance(value, (bool, np.bool_, str, bytes)):
+            raise TypeError
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a finite number {'>' if strict else '>='} {low:g}, got {value!r}") from None
+    if not np.isfinite(x) or (x <= low if strict else x < low):
+        raise ValueError(f"{name} must be a finite number {'>' if strict else '>='} {low:g}, got {value!r}")
+    return x
+
+
+def _mode(system: MasslessSystem, mode) -> int:
+    if isinstance(mode, (bool, np.bool_)) or not isinstance(mode, (int, np.integer)) or not 0 <= mode < system.n:
+        raise ValueError(f"mode must be an open-phase mode index, an integer in [0, {system.n}), got {mode!r}")
+    return int(mode)
 
 
 @dataclass(frozen=True, eq=False)
@@ -193,7 +224,9 @@ def closing_residual(system: MasslessSystem, alpha: float, beta: float, gradient
 
 def orbit_at_period(system: MasslessSystem, T: float, beta0: float, maxiter: int = 60) -> SymmetricOrbit | None:
     """The symmetric one-phase orbit of period ``T`` reached by Newton from contact half-time ``beta0``."""
-    b, prev = float(beta0), np.inf
+    check_massless_system(system, "orbit_at_period")
+    T = _number("T", T)
+    b, prev = _number("beta0", beta0), np.inf
     for _ in range(maxiter):
         _, r, g = closing_residual(system, T / 2 - b, b, True)
         step = r / (g[1] - g[0])
@@ -229,6 +262,12 @@ def follow_from_grazing(system: MasslessSystem, T_min: float, mode: int = 0, ds:
     ahead; adaptive step between ``1e-10`` and ``ds_max``. Steps are relative to a quarter of the mode's linear
     period ``π/(2ω)``, so the same ``ds`` serves a bar in units of ``L/c`` and a blade in seconds.
     """
+    check_massless_system(system, "follow_from_grazing")
+    T_min = _number("T_min", T_min, strict=False)
+    mode = _mode(system, mode)
+    ds, ds_max = _number("ds", ds), _number("ds_max", ds_max)
+    if isinstance(max_points, (bool, np.bool_)) or not isinstance(max_points, (int, np.integer)) or max_points < 1:
+        raise ValueError(f"max_points must be an integer >= 1, got {max_points!r}")
     w = system.open.omega[mode]
     L = np.pi / (2 * w)
     z = np.array([np.pi / w, 1e-6 / w])
@@ -275,11 +314,12 @@ def orbits_at_period(system: MasslessSystem, T: float, samples: int | None = Non
     """
     from scipy.optimize import brentq
 
-    if not (np.isfinite(T) and T > 0):
-        raise ValueError(f"T must be finite and > 0, got {T!r}")
+    check_massless_system(system, "orbits_at_period")
+    T = _number("T", T)
+    if samples is not None and (isinstance(samples, (bool, np.bool_)) or not isinstance(samples, (int, np.integer))
+                                or samples < 3):
+        raise ValueError(f"samples must be None or an integer >= 3, got {samples!r}")
     count = int(samples) if samples is not None else 20 * system.n
-    if count < 3:
-        raise ValueError(f"samples must be >= 3, got {samples!r}")
     betas = np.linspace(0.0, T / 2, count + 2)[1:-1]
     r = np.array([closing_residual(system, T / 2 - b, b)[1] for b in betas])
     out = []

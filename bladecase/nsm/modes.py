@@ -29,7 +29,8 @@ from .coverage import (  # noqa: F401 (PASS_GATE, passes, phase_distance(s), sta
     starts_passed,
 )
 from .families import FamilyTracer, complete_families
-from .kipp import canonical_rotation, check_k, orbits_kipp
+from .kipp import canonical_rotation, check_period_range, check_resolution, check_search_k, orbits_kipp
+from .massless import MasslessSystem
 from .modal import solve_times_stack
 from .orbits import REPEAT_RTOL, PeriodicOrbit
 from .system import LinearSystem
@@ -118,10 +119,20 @@ def nonsmooth_mode(
     >>> len(families), [(round(a.T_lo, 3), round(a.T_hi, 4), a.refined_hi) for f in families for a in f.arcs]
     (4, [(13.329, 13.7293, True)])
     """
-    k = check_k(k)
-    T_lo, T_hi = (float(x) for x in T_range)
-    if not (np.isfinite(T_lo) and np.isfinite(T_hi)) or not 0 < T_lo < T_hi:
-        raise ValueError(f"T_range must be (T_min, T_max) with 0 < T_min < T_max, got {T_range!r}")
+    k = check_search_k(k)
+    T_lo, T_hi = check_period_range("T_range", T_range)
+    scan = _integer("scan", scan, 1)
+    max_points = _integer("max_points", max_points, 2)
+    if isinstance(step, (bool, np.bool_)) or not isinstance(step, (int, float, np.integer, np.floating)) or not (
+            0 < step <= 1):
+        raise ValueError(f"step must be a number with 0 < step <= 1 (scaled arclength: impact times / T), got {step!r}")
+    for name, flag in (("refine", refine), ("progress", progress)):
+        if not isinstance(flag, (bool, np.bool_)):
+            raise ValueError(f"{name} must be True or False, got {flag!r}")
+    resolution = check_resolution(resolution, k)
+    if not isinstance(system, (LinearSystem, MasslessSystem)):
+        raise ValueError(f"nonsmooth_mode: system must be a LinearSystem (Newton's contact) or a MasslessSystem, got "
+                         f"{type(system).__name__}")
     if getattr(system, "contact_model", "newton") == "massless":
         if k != 1:
             raise ValueError(f"the massless contact model has modes with one contact phase per period (k = 1) "
@@ -141,6 +152,12 @@ def nonsmooth_mode(
             continue
         starts.extend((T, o) for o in sols if o.repeats == 1)
     return _follow_starts(system, k, starts, (T_lo, T_hi), step, max_points, refine, progress)
+
+
+def _integer(name: str, value, low: int) -> int:
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < low:
+        raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
+    return int(value)
 
 
 def _follow_starts(system: LinearSystem, k: int, starts: list[tuple[float, PeriodicOrbit]], T_range, step: float,

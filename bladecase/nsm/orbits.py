@@ -21,8 +21,8 @@ from .signals import POINTS_PER_PERIOD, TrigSum, certified_max, certified_max_st
 from .system import LinearSystem
 
 __all__ = [
-    "ADMISSIBILITY_RTOL", "REPEAT_RTOL", "RESONANCE_RTOL", "PeriodicOrbit", "check_period", "impact_matrices",
-    "make_orbit", "make_orbits", "orbit_1ipp", "repetitions",
+    "ADMISSIBILITY_RTOL", "REPEAT_RTOL", "RESONANCE_RTOL", "PeriodicOrbit", "check_newton_system", "check_period",
+    "impact_matrices", "make_orbit", "make_orbits", "orbit_1ipp", "repetitions",
 ]
 
 
@@ -34,6 +34,18 @@ def __getattr__(name: str):
 
         return getattr(kipp, name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def check_newton_system(system, what: str) -> LinearSystem:
+    """``system`` if it is a :class:`LinearSystem` (Newton's contact model), else ``ValueError`` naming ``what``."""
+    if isinstance(system, LinearSystem):
+        return system
+    if getattr(system, "contact_model", None) == "massless":
+        raise ValueError(f"{what} solves Newton's contact model (a LinearSystem); got a MasslessSystem: its modes "
+                         "come from nonsmooth_mode(system, 1, T_range) or massless_mode(system, T_range)")
+    raise ValueError(f"{what}: system must be a LinearSystem (e.g. chain(...), LinearSystem(M, K, w, gap) or a "
+                     f"reduced model's .system), got {type(system).__name__}")
+
 
 #: An orbit is admissible when its impulses are >= 0 and
 #: ``wᵀx(t) - d <= ADMISSIBILITY_RTOL · d`` is PROVED for every ``t`` of the
@@ -272,8 +284,11 @@ def make_orbit(
     >>> pulled.admissible, round(pulled.max_violation, 6)     # wᵀx - d > 0: it crosses the casing
     (False, 0.493426)
     """
-    times = np.asarray(impact_times, dtype=float)
-    lam = np.asarray(impulses, dtype=float)
+    if _md is None:  # a call from outside (the searches pass their kernel): the data checked
+        T, times, lam = _orbit_data(system, T, impact_times, impulses, "make_orbit")
+    else:
+        times = np.asarray(impact_times, dtype=float)
+        lam = np.asarray(impulses, dtype=float)
     md = _md if _md is not None else ModalKernel.of(system, T)
     d = system.gap
     q, qd = md.start_state(times, lam)  # energy from the post-impact modal state at t = 0
@@ -312,6 +327,26 @@ def make_orbit(
     )
 
 
+def _orbit_data(system, T, impact_times, impulses, what: str) -> tuple[float, np.ndarray, np.ndarray]:
+    """``(T, times, impulses)`` of one orbit checked: a LinearSystem, a finite period > 0, and as many finite
+    impulses as impact times, ``0 < t₁ < … < t_k <= T`` (``ValueError`` naming ``what`` otherwise)."""
+    check_newton_system(system, what)
+    try:
+        T = float(T)
+        times = np.asarray(impact_times, dtype=float).reshape(-1)
+        lam = np.asarray(impulses, dtype=float).reshape(-1)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{what}: T, impact_times and impulses must be numbers ({exc})") from None
+    if not np.isfinite(T) or T <= 0:
+        raise ValueError(f"{what}: period T must be finite and > 0, got {T!r}")
+    if times.size == 0 or lam.shape != times.shape or not (np.all(np.isfinite(times)) and np.all(np.isfinite(lam))):
+        raise ValueError(f"{what}: impact_times and impulses must be as many finite numbers (one impulse per impact), "
+                         f"got {times.size} time(s) and {lam.size} impulse(s)")
+    if times[0] <= 0 or np.any(np.diff(times) <= 0) or times[-1] > T * (1 + 1e-12):
+        raise ValueError(f"{what}: impact_times must satisfy 0 < t1 < ... < tk = T = {T!r}, got {times.tolist()}")
+    return T, times, lam
+
+
 def make_orbits(system: LinearSystem, T, impact_times, impulses, certify: bool = True, probe=None
                 ) -> list[PeriodicOrbit]:
     """:func:`make_orbit` with ``polish=False`` of many orbits with ``k`` impacts at once (periods ``T``
@@ -332,11 +367,16 @@ def make_orbits(system: LinearSystem, T, impact_times, impulses, certify: bool =
     ...                                                                     round(o.energy, 9)) for o in found]
     True
     """
-    T = np.atleast_1d(np.asarray(T, dtype=float))
-    if T.size == 0:
-        return []
-    times = np.asarray(impact_times, dtype=float).reshape(T.size, -1)
-    lam = np.asarray(impulses, dtype=float).reshape(times.shape)
+    check_newton_system(system, "make_orbits")
+    try:
+        T = np.atleast_1d(np.asarray(T, dtype=float))
+        if T.size == 0:
+            return []
+        times = np.asarray(impact_times, dtype=float).reshape(T.size, -1)
+        lam = np.asarray(impulses, dtype=float).reshape(times.shape)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"make_orbits: T (B,), impact_times and impulses (B, k) must be numbers of matching "
+                         f"shapes ({exc})") from None
     omega, b, _ = system.spectrum.contact_modes
     d = system.gap
     sh = np.sin(np.multiply.outer(T / 2, omega))  # (B, m)
@@ -470,6 +510,7 @@ def orbit_1ipp(system: LinearSystem, T: float, **options) -> PeriodicOrbit:
     >>> round(float(x[1, 0]), 12)
     1.0
     """
+    check_newton_system(system, "orbit_1ipp")
     T = check_period(system, T)
     md = ModalKernel.of(system, T)
     g0 = float(np.sum(md.b**2 * np.cos(md.omega * T / 2) / (2 * md.omega * md.sin_half)))

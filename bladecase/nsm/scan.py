@@ -14,7 +14,7 @@ import numpy as np
 
 from ..progress import progress_bar
 from .branches import Arc, Backbone, Branch, Interval
-from .orbits import PeriodicOrbit, orbit_1ipp
+from .orbits import PeriodicOrbit, check_newton_system, orbit_1ipp
 from .system import LinearSystem
 
 __all__ = ["BISECTION_RTOL", "Backbone", "Interval", "backbone"]  # Backbone, Interval: former names
@@ -24,6 +24,8 @@ BISECTION_RTOL = 1e-9
 
 
 def _solver(ipp: int) -> Callable[[LinearSystem, float], PeriodicOrbit]:
+    if isinstance(ipp, (bool, np.bool_)) or not isinstance(ipp, (int, np.integer)):
+        raise ValueError(f"ipp (impacts per period) must be the integer 1, got {ipp!r}")
     if ipp == 1:
         return orbit_1ipp
     raise ValueError(
@@ -128,8 +130,19 @@ def backbone(
     >>> [(round(iv.T_lo, 6), round(iv.T_hi, 6)) for iv in bb.intervals]
     [(2.504874, 2.745853), (3.745895, 5.491705), (5.650149, 7.188736)]
     """
+    check_newton_system(system, "backbone")
+    if not isinstance(progress, (bool, np.bool_)):
+        raise ValueError(f"progress must be True or False, got {progress!r}")
     solve = _solver(ipp)
-    P = np.asarray(periods, dtype=float).reshape(-1)
+    try:
+        if periods is None or isinstance(periods, (str, bytes)):
+            raise TypeError
+        P = np.asarray(periods, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"periods must be a sequence of periods (numbers > 0), got {periods!r}") from None
+    if P.ndim > 1:
+        raise ValueError(f"periods must be a 1-D sequence of periods, got an array of shape {P.shape}")
+    P = P.reshape(-1)
     if P.size == 0:
         raise ValueError("periods is empty: give at least one period")
     if not np.all(np.isfinite(P)) or np.any(P <= 0):

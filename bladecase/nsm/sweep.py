@@ -204,6 +204,21 @@ def _run(system, T: float, n_periods: int, x0, v0, kw: dict, restitution: float,
     return simulate_forced(system, x0, v0, n_periods * T, period=T, restitution=restitution, **kw)
 
 
+def _real(name: str, value) -> float:
+    try:
+        if isinstance(value, (bool, np.bool_, str, bytes)):
+            raise TypeError
+        return float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a finite number, got {value!r}") from None
+
+
+def _check_system(system, what: str) -> None:
+    if not isinstance(system, (LinearSystem, MasslessSystem)):
+        raise ValueError(f"{what}: system must be a LinearSystem (Newton's contact) or a MasslessSystem (massless "
+                         f"contact), got {type(system).__name__}")
+
+
 def forced_point(system: LinearSystem | MasslessSystem, T: float, *, damping: Damping | None = None,
                  amplitude: float = 1.0, load=None, n_periods: int = 500, x0=None, v0=None, restitution: float = 1.0,
                  tol: float = SWEEP_TOL, max_p: int = 4, contact_load: float = 0.0) -> SweepPoint:
@@ -223,15 +238,18 @@ def forced_point(system: LinearSystem | MasslessSystem, T: float, *, damping: Da
     >>> pt.label, round(pt.energy, 6), pt.impact_phases.round(6).tolist(), pt.residual < 1e-10
     ('1/1', 7.890714, [0.067096], True)
     """
-    T = float(T)
+    _check_system(system, "forced_point")
+    T = _real("forcing period T", T)
     if not np.isfinite(T) or T <= 0:
         raise ValueError(f"forcing period T must be finite and > 0, got {T!r}")
     if isinstance(max_p, bool) or not isinstance(max_p, (int, np.integer)) or max_p < 1:
         raise ValueError(f"max_p must be an integer >= 1, got {max_p!r}")
     if isinstance(n_periods, bool) or not isinstance(n_periods, (int, np.integer)) or n_periods < 2 * max_p + 1:
         raise ValueError(f"n_periods must be an integer >= 2*max_p + 1 = {2 * max_p + 1}, got {n_periods!r}")
-    if not (np.isfinite(tol) and tol > 0):
+    if not (np.isfinite(_real("tol", tol)) and tol > 0):
         raise ValueError(f"tol must be finite and > 0, got {tol!r}")
+    amplitude, restitution, contact_load = (_real(name, v) for name, v in (
+        ("amplitude", amplitude), ("restitution", restitution), ("contact_load", contact_load)))
     x0 = np.zeros(system.n) if x0 is None else x0
     v0 = np.zeros(system.n) if v0 is None else v0
     empty = np.zeros(0)
@@ -307,11 +325,26 @@ def forced_sweep(system: LinearSystem | MasslessSystem, periods, damping: Dampin
     >>> [(pt.T, pt.label, round(pt.energy, 4)) for pt in pts]
     [(4.6, '1/1', 6.7433), (4.5, '1/1', 7.8907)]
     """
-    if direction not in ("up", "down"):
+    _check_system(system, "forced_sweep")
+    if not isinstance(direction, str) or direction not in ("up", "down"):
         raise ValueError(f"direction must be 'up' (increasing forcing frequency) or 'down', got {direction!r}")
-    order = np.sort(np.asarray(periods, dtype=float).reshape(-1))
+    try:
+        if periods is None or isinstance(periods, (str, bytes)):
+            raise TypeError
+        order = np.sort(np.asarray(periods, dtype=float).reshape(-1))
+    except (TypeError, ValueError):
+        raise ValueError(f"periods must be a sequence of forcing periods (numbers > 0), got {periods!r}") from None
     if order.size == 0:
         raise ValueError("periods is empty: give at least one forcing period")
+    if not np.all(np.isfinite(order) & (order > 0)):
+        bad = order[~(np.isfinite(order) & (order > 0))][0]
+        raise ValueError(f"periods must be finite forcing periods > 0, got {float(bad)!r} among them")
+    for name, flag in (("continuation", continuation), ("progress", progress)):
+        if not isinstance(flag, (bool, np.bool_)):
+            raise ValueError(f"{name} must be True or False, got {flag!r}")
+    if executor is not None and not callable(getattr(executor, "map", None)):
+        raise ValueError(f"executor must have a map(fn, items, desc=, progress=) method (e.g. make_executor(...)) "
+                         f"or be None, got {executor!r}")
     if direction == "up":
         order = order[::-1]
     run = functools.partial(forced_point, system, damping=damping, amplitude=amplitude, load=load,

@@ -1,35 +1,126 @@
 """The JSON documents of a study: the modes file (every branch, every orbit) and the run's summary parts.
 
 Branches are serialised in one place, :meth:`bladecase.nsm.Branch.to_dict` / :meth:`~bladecase.nsm.Branch.from_dict`;
-this module only wraps them with the system they belong to.
+this module only wraps them with the system they belong to — and its fingerprint (:func:`system_fingerprint`), so
+that a modes file is never read back against another reduced model or clearance, and re-checks every orbit a
+modes file says is admissible (:func:`load_families`).
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 from pathlib import Path
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..checks import is_integer
 from ..fe import FEModel, Mesh
-from ..nsm import Branch, LinearSystem
+from ..nsm import Branch, LinearSystem, MasslessSystem, PeriodicOrbit
 from ..reduction import Contact, ReducedModel
 
+#: Largest scale-free residual of an orbit's equations (impact conditions ``ΠΛ = 0``, ``ΣΛ = d``; the massless
+#: closing conditions) accepted when a modes file is read back: solved orbits are at round-off (~1e-13).
+ORBIT_RTOL = 1e-8
 
-def families_document(families: list[Branch], system: LinearSystem) -> dict:
-    """The modes file's content: the system's size and gap, and every branch."""
-    return {"system_dofs": system.n, "gap": system.gap, "families": [f.to_dict() for f in families]}
+#: The modes file's key holding :func:`system_fingerprint` of the system its families were computed on.
+FINGERPRINT_KEY = "system_fingerprint"
 
 
-def load_families(path: str | os.PathLike, system: LinearSystem) -> list[Branch]:
-    """Branches from a modes JSON file (``bladecase modes``), attached to ``system`` (orbits as stored).
+def _check_system(system, what: str) -> None:
+    if not isinstance(system, (LinearSystem, MasslessSystem)):
+        raise ValueError(f"{what}: system must be a LinearSystem or a MasslessSystem (e.g. a reduced model's "
+                         f".system), got {type(system).__name__}")
 
-    ``ValueError`` naming the file for an unreadable or malformed file, a file computed on another system,
-    or arcs that do not point at admissible orbits of their family (a hand-edited or truncated file).
+
+def system_fingerprint(system: LinearSystem | MasslessSystem) -> str:
+    """``"sha256:…"`` of what defines ``system``: its contact model, matrices, contact vector, clearance (and, for
+    the massless model, the contact and casing stiffnesses) — exactly, as float64 values.
+
+    The same for a dense and a sparse copy of one matrix (its non-zero entries are hashed in row-major order with
+    their indices and its shape), different for another reduced model or another clearance.
+
+    >>> from bladecase.nsm import chain
+    >>> a, b = system_fingerprint(chain(2, gap=1.0)), system_fingerprint(chain(2, gap=0.5))
+    >>> a.startswith("sha256:"), a == system_fingerprint(chain(2, gap=1.0)), a == b
+    (True, True, False)
+    """
+    _check_system(system, "system_fingerprint")
+    h = hashlib.sha256()
+    if isinstance(system, MasslessSystem):
+        h.update(b"bladecase-system-1:massless")
+        parts = (("M", system.M), ("S", system.S), ("w", system.w), ("kc", system.kc), ("gap", system.gap),
+                 ("casing", system.casing))
+    else:
+        h.update(b"bladecase-system-1:newton")
+        parts = (("M", system.M), ("K", system.K), ("w", system.w), ("gap", system.gap))
+    for name, value in parts:
+        h.update(name.encode())
+        _hash_values(h, value)
+    return "sha256:" + h.hexdigest()
+
+
+def _hash_values(h, value) -> None:
+    """A matrix (dense or sparse) as its shape and its non-zero ``(row, column, value)`` in row-major order; a
+    vector or a number as its shape and its values (float64, ``-0.0`` as ``0.0``)."""
+    if sp.issparse(value) or np.ndim(value) == 2:
+        if sp.issparse(value):
+            A = sp.csr_array(value, dtype=float, copy=True)
+            A.sum_duplicates()
+            A.eliminate_zeros()
+            A.sort_indices()
+            rows = np.repeat(np.arange(A.shape[0]), np.diff(A.indptr))
+            cols, vals = A.indices, A.data
+        else:
+            A = np.asarray(value, dtype=float)
+            rows, cols = np.nonzero(A)
+            vals = A[rows, cols]
+        h.update(np.asarray(A.shape, dtype=np.int64).tobytes())
+        for arr, dtype in ((rows, np.int64), (cols, np.int64), (vals + 0.0, np.float64)):
+            h.update(np.ascontiguousarray(arr, dtype=dtype).tobytes())
+        return
+    arr = np.asarray(value, dtype=float)
+    h.update(np.asarray(arr.shape, dtype=np.int64).tobytes())
+    h.update(np.ascontiguousarray(arr + 0.0, dtype=np.float64).tobytes())
+
+
+def families_document(families: list[Branch], system: LinearSystem | MasslessSystem) -> dict:
+    """The modes file's content: the system's size, gap and fingerprint (:func:`system_fingerprint`), and every
+    branch (each computed on ``system``: ``ValueError`` otherwise)."""
+    _check_system(system, "families_document")
+    if isinstance(families, (str, bytes, dict)) or not hasattr(families, "__iter__"):
+        raise ValueError(f"families_document: families must be a list of Branch, got {type(families).__name__}")
+    families = list(families)
+    fingerprint = system_fingerprint(system)
+    for i, fam in enumerate(families):
+        if not isinstance(fam, Branch):
+            raise ValueError(f"families_document: family {i} must be a Branch, got {type(fam).__name__}")
+        if fam.system is not None and fam.system is not system and (
+                not isinstance(fam.system, (LinearSystem, MasslessSystem))
+                or system_fingerprint(fam.system) != fingerprint):
+            raise ValueError(f"families_document: family {i} ({fam.k}-ipp) was computed on another system "
+                             f"({fam.system!r}) than the one given ({system!r})")
+    return {"system_dofs": system.n, "gap": system.gap, FINGERPRINT_KEY: fingerprint,
+            "families": [f.to_dict() for f in families]}
+
+
+def load_families(path: str | os.PathLike, system: LinearSystem | MasslessSystem,
+                  reduced: str | os.PathLike | None = None) -> list[Branch]:
+    """Branches from a modes JSON file (``bladecase modes``), attached to ``system``.
+
+    ``ValueError`` naming the file for an unreadable or malformed file, a file computed on another system (its
+    size, or its fingerprint, :func:`system_fingerprint`: another reduced model or another clearance), a file
+    without a fingerprint (written by an older version), arcs that do not point at admissible orbits of their
+    family, or an orbit marked admissible that is not an admissible orbit of ``system`` — each such orbit is
+    re-checked (its equations solved to :data:`ORBIT_RTOL`, its admissibility proved again): a hand-edited or
+    truncated file is refused, naming the family and the period.  ``reduced``: the reduced-model file
+    ``system`` comes from, named in the messages.
     """
     where = f"modes file {str(path)!r}"
+    again = f"run `bladecase modes` again on {str(reduced) if reduced is not None else 'the reduced model'}"
+    _check_system(system, f"load_families({str(path)!r})")
     try:
         data = json.loads(Path(path).read_text(encoding="utf-8"))
     except (OSError, ValueError) as exc:
@@ -42,15 +133,132 @@ def load_families(path: str | os.PathLike, system: LinearSystem) -> list[Branch]
         raise ValueError(f"{where}: 'system_dofs' must be an integer number of dofs, got {n!r}")
     if n is not None and n != system.n:
         raise ValueError(f"{where} was computed on a system of {n} dofs, this one has {system.n}")
+    _check_fingerprint(data, system, where, again)
     try:
         fams = [Branch.from_dict(system, f) for f in data["families"]]
     except KeyError as exc:
         raise ValueError(f"cannot read {where}: field {exc} is missing") from None
     except (ValueError, TypeError, AttributeError, IndexError) as exc:
         raise ValueError(f"cannot read {where}: {exc}") from None
-    for i, fam in enumerate(fams):
+    for i, (fam, raw) in enumerate(zip(fams, data["families"])):
+        _recertify(fam, raw, system, f"{where}: family {i} ({fam.k}-ipp)", again)
         _check_arcs(fam, i, where)
     return fams
+
+
+def _check_fingerprint(data: dict, system, where: str, again: str) -> None:
+    """The file's fingerprint is the system's (``ValueError`` naming both otherwise, or when it has none)."""
+    stored = data.get(FINGERPRINT_KEY)
+    if stored is None:
+        raise ValueError(f"{where} has no fingerprint of the system it was computed on: it was written by an older "
+                         f"bladecase version, and cannot be checked against this reduced model and clearance; "
+                         f"{again}")
+    own = system_fingerprint(system)
+    if stored != own:
+        gap = data.get("gap")
+        note = (f"; its clearance is {gap!r}, this model's {system.gap!r}"
+                if isinstance(gap, (int, float)) and not isinstance(gap, bool) and gap != system.gap else "")
+        raise ValueError(f"{where} was computed for another reduced model or clearance (fingerprint "
+                         f"{str(stored)[:19]}…, this model's {own[:19]}…{note}): {again}")
+
+
+def _recertify(fam: Branch, raw: dict, system, where: str, again: str) -> None:
+    """Every orbit of ``fam`` the file marks admissible is an admissible orbit of ``system``: its equations hold
+    (:data:`ORBIT_RTOL`) and its admissibility is proved again (``ValueError`` naming it otherwise)."""
+    records = raw.get("orbits") if isinstance(raw, dict) else None
+    marked = [j for j, o in enumerate(fam.orbits) if o is not None and (
+        o.admissible if isinstance(o, PeriodicOrbit) else bool((records[j] or {}).get("admissible")))]
+    if not marked:
+        return
+    if isinstance(system, MasslessSystem):
+        problems = {j: _massless_problem(system, fam.orbits[j]) for j in marked}
+    else:
+        problems = _newton_problems(system, [fam.orbits[j] for j in marked])
+        problems = dict(zip(marked, problems))
+    bad = [(j, why) for j, why in problems.items() if why]
+    if bad:
+        j, why = bad[0]
+        more = f" (and {len(bad) - 1} more orbit(s) of this family)" if len(bad) > 1 else ""
+        raise ValueError(f"{where}, orbit {j} at T = {fam.orbits[j].T:.10g} is marked admissible but is not an "
+                         f"admissible orbit of this system: {why}{more} — a hand-edited file, or one computed on "
+                         f"another model; {again}")
+
+
+def _newton_problems(system: LinearSystem, orbits: list) -> list[str | None]:
+    """Why each of ``orbits`` (Newton contact, one family) is not an admissible orbit of ``system`` (``None``:
+    it is)."""
+    from ..nsm import ModalKernel, check_period
+    from ..nsm.modal import check_times
+    from ..nsm.orbits import make_orbits
+
+    out: list[str | None] = [None] * len(orbits)
+    ok = []
+    for j, o in enumerate(orbits):
+        try:
+            T = check_period(system, o.T)
+            times = check_times(o.impact_times)
+            lam = np.asarray(o.impulses, dtype=float).reshape(-1)
+            if lam.shape != times.shape or not np.all(np.isfinite(lam)):
+                raise ValueError(f"{lam.size} impulse(s) for {times.size} impact time(s)")
+            if abs(times[-1] - T) > 1e-12 * T:
+                raise ValueError(f"the last impact time {times[-1]!r} is not the period {T!r}")
+            md = ModalKernel.of(system, T)
+            Pi, Sigma = md.matrices(times)
+            scale = max(np.abs(Sigma).max(), np.abs(Pi).max()) * max(np.abs(lam).max(), np.finfo(float).tiny)
+            r_pi = np.abs(Pi @ lam).max() / scale
+            r_sigma = np.abs(Sigma @ lam - system.gap).max() / system.gap
+        except (ValueError, np.linalg.LinAlgError) as exc:
+            out[j] = f"its impact data do not define an orbit here ({exc})"
+            continue
+        if max(r_pi, r_sigma) > ORBIT_RTOL:
+            out[j] = (f"its impact times and impulses do not solve the orbit equations of this system (relative "
+                      f"residual {max(r_pi, r_sigma):.3g} > {ORBIT_RTOL:g})")
+            continue
+        ok.append(j)
+    if ok:
+        again = make_orbits(system, [orbits[j].T for j in ok], [orbits[j].impact_times for j in ok],
+                            [orbits[j].impulses for j in ok])
+        for j, o in zip(ok, again):
+            stored = float(orbits[j].energy)
+            if not abs(stored - o.energy) <= ORBIT_RTOL * abs(o.energy):  # NaN too
+                out[j] = f"its energy {stored:.10g} is not the orbit's ({o.energy:.10g})"
+                continue
+            if o.admissible:
+                continue
+            if np.any(o.impulses < 0):
+                out[j] = f"an impulse is negative ({float(o.impulses.min()):.6g}): the casing would pull"
+            else:
+                out[j] = (f"it crosses the casing (wᵀx - d = {o.max_violation:.6g} at t = {o.max_violation_time:.6g}, "
+                          "beyond the tolerance of the proof) or its admissibility cannot be proved")
+    return out
+
+
+def _massless_problem(system: MasslessSystem, orbit) -> str | None:
+    """Why ``orbit`` (massless contact) is not an admissible orbit of ``system`` (``None``: it is)."""
+    from ..nsm.massless_orbits import SymmetricOrbit, closing_residual
+    from ..nsm.massless_phases import PhasedOrbit, solve_half
+
+    try:
+        if isinstance(orbit, SymmetricOrbit):
+            a, r = closing_residual(system, orbit.alpha, orbit.beta)
+        elif isinstance(orbit, PhasedOrbit):
+            a, r = solve_half(system, orbit.first, orbit.durations)
+        else:
+            return f"it is a {type(orbit).__name__}, not an orbit of the massless contact model"
+        r = np.atleast_1d(np.asarray(r, dtype=float))
+        stored = np.asarray(orbit.a, dtype=float)
+        if stored.shape != np.shape(a) or not np.all(np.isfinite(r)):
+            raise ValueError(f"{stored.size} amplitude(s) for a system of {system.n} interior dofs")
+    except (ValueError, np.linalg.LinAlgError, IndexError, KeyError) as exc:
+        return f"its data do not define an orbit here ({exc})"
+    off = max(np.abs(r).max() / system.gap,
+              np.abs(stored - a).max() / max(np.abs(a).max(), np.finfo(float).tiny))
+    if off > ORBIT_RTOL:
+        return (f"its phases and amplitudes do not solve the orbit equations of this system (relative residual "
+                f"{off:.3g} > {ORBIT_RTOL:g})")
+    if not orbit.admissible:
+        return "its admissibility is not proved (the contact force turns negative, or it crosses the casing)"
+    return None
 
 
 def _check_arcs(fam: Branch, i: int, where: str) -> None:
