@@ -362,7 +362,7 @@ def _cmd_animate(args) -> int:
     check_inputs(study.output_dir(args.out), [args.study, args.reduced, args.modes], ("animations", "vtk"))
     check_output_dir(study.output_dir(args.out))
     reduced = load_reduced(args.reduced)
-    families = load_families(args.modes, reduced.system)
+    families = load_families(args.modes, reduced.system, reduced=args.reduced)
     written = animate_families(study, reduced, families, out=args.out, progress=progress)
     for entry in written:
         print(", ".join(str(entry[k]) for k in ("gif", "mp4", "pvd", "manifold") if k in entry))
