@@ -54,7 +54,7 @@ def test_comparison_table_figures_and_words(result):
 @pytest.mark.parametrize("edit, match", [
     ('methods = ["modal", "magic"]', r"\[reduction\] methods: unknown method 'magic'"),
     ("sizes = [8, 8]", r"\[reduction\] sizes: sizes repeat"),
-    ("sizes = [0]", r"\[reduction\] sizes: sizes must be integers >= 1"),
+    ("sizes = [0]", r"\[reduction\] sizes: sizes must be integers with 1 <= size <= 6000, got 0"),
 ])
 def test_grid_keys_are_checked(edit, match):
     with pytest.raises(StudyError, match=match):
