@@ -47,7 +47,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from ..progress import progress_bar
-from .forced import Damping, ForcedTrajectory, simulate_forced
+from .forced import Damping, ForcedTrajectory, _real, simulate_forced
 from .forced_massless import MasslessForcedTrajectory, simulate_forced_massless
 from .massless import MasslessSystem
 from .system import LinearSystem
@@ -202,15 +202,6 @@ def _run(system, T: float, n_periods: int, x0, v0, kw: dict, restitution: float,
     if contact_load != 0.0:
         raise ValueError(f"contact_load is for the massless contact model only, got {contact_load!r}")
     return simulate_forced(system, x0, v0, n_periods * T, period=T, restitution=restitution, **kw)
-
-
-def _real(name: str, value) -> float:
-    try:
-        if isinstance(value, (bool, np.bool_, str, bytes)):
-            raise TypeError
-        return float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a finite number, got {value!r}") from None
 
 
 def _check_system(system, what: str) -> None:

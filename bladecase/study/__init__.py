@@ -13,8 +13,9 @@
 The command line (:mod:`bladecase.cli`) is a thin layer over this package.
 """
 
+from .dask_executor import DaskExecutor
 from .demo import demo_study
-from .executor import DaskExecutor, Executor, ProcessExecutor, SerialExecutor, keyword_task, make_executor
+from .executor import Executor, ProcessExecutor, SerialExecutor, keyword_task, make_executor
 from .run import RunResult, run
 from .schema import Study, StudyError, load_study
 
