@@ -86,3 +86,25 @@ def file_groups(m, blocks, n_points: int, source: str) -> dict[str, np.ndarray]:
             raise ValueError(f"mesh {source}: group {name!r} refers to nodes outside 0..{n_points - 1}")
         groups[name] = nodes
     return groups
+
+
+#: The point-data key of a mesh file's own node numbers (written by the Abaqus reader and by ``save_mesh``).
+NODE_ID_KEY = "node_id"
+
+
+def file_node_ids(m, n_points: int, source: str) -> np.ndarray:
+    """The node numbers of the file (point data :data:`NODE_ID_KEY`: unique integers >= 0, one per point), else
+    the 0-based point index (formats that keep no node numbers: gmsh, VTK without it, MED, Nastran)."""
+    from .. import log
+
+    ids = (getattr(m, "point_data", None) or {}).get(NODE_ID_KEY)
+    if ids is None:
+        return np.arange(n_points, dtype=np.int64)
+    ids = np.asarray(ids).ravel()
+    whole = ids.dtype.kind in "iu" or (ids.dtype.kind == "f" and np.all(np.isfinite(ids))
+                                       and np.all(ids == np.round(ids)))
+    if ids.size != n_points or not whole or (ids.size and ids.min() < 0) or np.unique(ids).size != ids.size:
+        log.info("mesh %s: point data %r is not one distinct integer >= 0 per node: nodes are numbered by their "
+                 "0-based index", source, NODE_ID_KEY)
+        return np.arange(n_points, dtype=np.int64)
+    return ids.astype(np.int64)

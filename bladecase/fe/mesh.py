@@ -12,28 +12,31 @@ from __future__ import annotations
 import os
 import re
 from collections.abc import Sequence
-from contextlib import redirect_stderr, redirect_stdout
 from dataclasses import dataclass, field
-from io import StringIO
 
 import numpy as np
 
 from .. import log
 from ..io import atomic_path, check_output_file
-from .cells import BODY_TYPES, BOUNDARY_TYPES, GMSH_WEDGE18, KINDS
-from .cells import cell_dim as _cell_dim
-from .groups import GROUP_PREFIX, file_groups
+from .cells import BODY_TYPES, BOUNDARY_TYPES, KINDS
+from .groups import GROUP_PREFIX, NODE_ID_KEY, file_groups, file_node_ids
 from .mesh_checks import (  # noqa: F401  (public names of this module before they moved)
     _LINE_FORMATS,
     _OFFSET_FACTOR,
     COINCIDENT_RTOL,
     EXTENT_RANGE,
+    FORMAT_ALIASES,
+    LENGTH_UNITS,
+    _body_type,
     _check_blocks,
     _check_coincident,
     _check_complete,
     _check_one_body,
+    _read_quietly,
+    _wedge18_in_vtk_order,
     check_extent,
     check_input_file,
+    reader_formats,
 )
 from .quality import (  # noqa: F401  (the former home of these names)
     _P2_EDGES,
@@ -70,6 +73,13 @@ class Mesh:
         ``"blade"``.
     source : str
         Where the mesh came from (file path or generator), for messages.
+    node_ids : (n_nodes,) int ndarray
+        The node numbers of the file (Abaqus, CalculiX, ANSYS: as written there), used in every message that names
+        a node; for files without node numbers (gmsh, VTK) and generated meshes, the 0-based index
+        (``arange(n_nodes)``, the default). :attr:`numbering` says which.
+    unit : str
+        The length unit of the source's coordinates (:data:`~bladecase.fe.mesh_checks.LENGTH_UNITS`); ``points``
+        are always in metres.
 
     Examples
     --------
@@ -93,6 +103,54 @@ class Mesh:
     dim: int
     groups: dict = field(default_factory=dict)
     source: str = ""
+    node_ids: np.ndarray | None = None
+    unit: str = "m"
+
+    def __post_init__(self) -> None:
+        n = len(self.points)
+        ids = np.arange(n, dtype=np.int64) if self.node_ids is None else np.asarray(self.node_ids, dtype=np.int64)
+        if ids.shape != (n,) or (n and (ids.min() < 0 or np.unique(ids).size != n)):
+            raise ValueError(f"mesh {self.source or ''}: node_ids must be {n} distinct integers >= 0, one per node, "
+                             f"got an array of shape {ids.shape}")
+        object.__setattr__(self, "node_ids", ids)
+        if self.unit not in LENGTH_UNITS:
+            raise ValueError(f"mesh unit must be one of {', '.join(LENGTH_UNITS)}, got {self.unit!r}")
+
+    @property
+    def numbering(self) -> str:
+        """``"file"`` when nodes carry the file's own numbers (:attr:`node_ids`), ``"index"`` for the 0-based index."""
+        return "index" if np.array_equal(self.node_ids, np.arange(len(self.points))) else "file"
+
+    def node_id(self, index) -> int:
+        """The node number (as in the file) of the node at 0-based ``index``."""
+        return int(self.node_ids[int(index)])
+
+    def index_of(self, ids, what: str = "node") -> np.ndarray:
+        """0-based indices of the nodes numbered ``ids`` (as in the file); ``ValueError`` naming the first number
+        that is not a node of the mesh.
+
+        >>> m = Mesh(np.eye(3), {"triangle": np.array([[0, 1, 2]])}, 2, node_ids=np.array([1001, 1003, 1005]),
+        ...          source="m")
+        >>> m.numbering, m.index_of([1005, 1001]).tolist(), m.node_id(1)
+        ('file', [2, 0], 1003)
+        >>> m.index_of([1002])
+        Traceback (most recent call last):
+            ...
+        ValueError: node 1002 is not a node of mesh m (3 nodes numbered 1001 to 1005)
+        """
+        ids = np.asarray(ids).ravel()
+        if ids.dtype.kind not in "iu":
+            raise ValueError(f"{what} numbers must be integers, got {ids.tolist()[:5]!r}")
+        order = np.argsort(self.node_ids, kind="stable")
+        ranked = self.node_ids[order]
+        k = np.minimum(np.searchsorted(ranked, ids), max(ranked.size - 1, 0))
+        found = ranked[k] == ids if ranked.size else np.zeros(ids.size, dtype=bool)
+        if not found.all():
+            span = f"numbered {ranked[0]} to {ranked[-1]}" if self.numbering == "file" else \
+                f"numbered by their 0-based index, 0 to {ranked.size - 1}"
+            raise ValueError(f"{what} {int(ids[~found][0])} is not a node of mesh {self.source or ''} "
+                             f"({ranked.size} nodes {span})")
+        return order[k]
 
     @property
     def body_type(self) -> str:
@@ -120,8 +178,6 @@ class Mesh:
 
 
 
-#: meshio simplex cell types by topological dimension.
-_SIMPLEX = {0: ("vertex",), 1: ("line", "line3"), 2: ("triangle", "triangle6"), 3: ("tetra", "tetra10")}
 _ALIASES = {"tetra4": "tetra"}  # meshio's name for Abaqus C3D4H
 
 #: Abaqus element types missing from meshio 5.3's table (plane stress/strain, solids).
@@ -132,16 +188,25 @@ _ABAQUS_EXTRA = {
 }
 
 
-def load_mesh(path: str | os.PathLike, require: Sequence[str] = ()) -> Mesh:
+def load_mesh(path: str | os.PathLike, require: Sequence[str] = (), unit: str = "m",
+              file_format: str | None = None) -> Mesh:
     """Read a simplex mesh and its named groups from any file meshio reads.
 
     Parameters
     ----------
     path : path-like
-        ``.msh`` (gmsh 2.2/4.1), ``.vtu``/``.vtk``, ``.inp`` (Abaqus), ``.med``, ``.bdf`` (Nastran), ``.cdb``
-        (ANSYS archive, :mod:`bladecase.fe.cdb`: node and element components become groups), …
+        ``.msh`` (gmsh 2.2/4.1; a CalculiX ``.msh`` in Abaqus syntax is recognised by its content), ``.vtu``/``.vtk``,
+        ``.inp`` (Abaqus, CalculiX: :mod:`bladecase.fe.abaqus`, includes, sets and ``*BOUNDARY`` read), ``.med``,
+        ``.bdf`` (Nastran), ``.cdb`` (ANSYS archive, :mod:`bladecase.fe.cdb`: node and element components become
+        groups), …
     require : sequence of str
         Group names that must exist and be non-empty (e.g. ``("root", "tip")``).
+    unit : str
+        Length unit of the file's coordinates (:data:`~bladecase.fe.mesh_checks.LENGTH_UNITS`: ``"m"``, ``"mm"``,
+        ``"cm"``, ``"in"``, ``"ft"``): the points are scaled to metres.
+    file_format : str, optional
+        ``"abaqus"`` (also ``"calculix"``), ``"gmsh"``, ``"ansys"`` (an ANSYS ``.msh``), ``"ansys-cdb"`` or any
+        format name meshio reads (:func:`mesh_formats`). Not given: from the suffix and the content.
 
     Returns
     -------
@@ -188,39 +253,32 @@ def load_mesh(path: str | os.PathLike, require: Sequence[str] = ()) -> Mesh:
     import meshio
 
     source = check_input_file(path)  # a pipe or a device would hang the readers
+    if unit not in LENGTH_UNITS:
+        raise ValueError(f"mesh unit must be one of {', '.join(LENGTH_UNITS)}, got {unit!r}")
     head = _check_complete(source)
     _register_types()
-    # ".msh" is also an ANSYS suffix: name gmsh first, try ANSYS if gmsh fails (not for a gmsh file).
-    formats = ["gmsh", "ansys"] if source.lower().endswith(".msh") and not head.startswith(b"$MeshFormat") \
-        else ["gmsh"] if source.lower().endswith(".msh") else [None]
+    formats, why = reader_formats(source, head, file_format)
     reasons = []
     for fmt in formats:
         m, reason = _read_quietly(meshio, path, fmt)
         if m is not None:
             break
-        reasons.append(reason)
+        reasons.append(f"{fmt or 'from the suffix'}: {reason}" if len(formats) > 1 else reason)
     else:
+        tried = ", ".join(f or "from the suffix" for f in formats)
+        named = "" if file_format else (f" Formats tried: {tried} ({why}); name the format with [mesh] format (e.g. "
+                                        "\"abaqus\", \"gmsh\", \"ansys\", or any meshio format).")
         raise ValueError(f"cannot read mesh file {source!r} (corrupt, truncated or not a mesh?): "
-                         f"{'; '.join(reasons)}")
-    return from_meshio(m, source=source, require=require)
+                         f"{'; '.join(reasons)}.{named}")
+    return from_meshio(m, source=source, require=require, unit=unit)
 
 
-def _read_quietly(meshio, path, file_format):
-    """``(meshio.Mesh, None)`` or ``(None, reason)``; meshio's prints and ``sys.exit`` are captured."""
-    out = StringIO()
-    try:
-        with redirect_stdout(out), redirect_stderr(out):
-            return meshio.read(path, file_format=file_format), None
-    except (Exception, SystemExit) as exc:  # meshio raises ReadError, KeyError, …, or exits
-        said = " ".join(out.getvalue().split())
-        from .cdb import CdbError
+def mesh_formats() -> list[str]:
+    """The format names :func:`load_mesh` takes as ``file_format`` (``[mesh] format``)."""
+    from meshio import _helpers
 
-        if isinstance(exc, CdbError) and file_format is None:  # names the file, the line and the field already
-            raise CdbError(str(exc)) from None
-
-        text = ("" if isinstance(exc, SystemExit) else str(exc) if isinstance(exc, CdbError)  # names file and line
-                else f"{type(exc).__name__}: {exc}".rstrip(": "))
-        return None, " ".join(filter(None, [text, said])) or type(exc).__name__
+    _register_types()
+    return sorted(set(_helpers.reader_map) | set(FORMAT_ALIASES))
 
 
 def _register_types() -> None:
@@ -234,12 +292,13 @@ def _register_types() -> None:
         _abaqus.abaqus_to_meshio_type.setdefault(key, value)
     for key in ("wedge15", "wedge18"):
         _mesh.topological_dimension.setdefault(key, 3)
-    from .cdb import register
+    from . import abaqus, cdb
 
-    register()  # ANSYS archives (.cdb), which meshio does not read
+    cdb.register()  # ANSYS archives (.cdb), which meshio does not read
+    abaqus.register()  # Abaqus/CalculiX decks with includes, node numbers and *BOUNDARY
 
 
-def from_meshio(m, source: str = "", require: Sequence[str] = ()) -> Mesh:
+def from_meshio(m, source: str = "", require: Sequence[str] = (), unit: str = "m") -> Mesh:
     """Convert a ``meshio.Mesh`` to a checked :class:`Mesh`.
 
     * **Dimension**: 3 if the mesh has volume cells (tetrahedra, hexahedra,
@@ -255,7 +314,9 @@ def from_meshio(m, source: str = "", require: Sequence[str] = ()) -> Mesh:
       wedges (which meshio 5.3 leaves in gmsh's order) are put in VTK order.
     * **Nodes**: all points of the file are kept, with their indices, even the
       ones no kept cell uses (e.g. geometry vertices); points are padded to
-      three columns.
+      three columns and scaled from ``unit`` to metres; the file's node numbers
+      (point data ``node_id``, kept by the Abaqus reader) become
+      :attr:`Mesh.node_ids`.
     * **Groups** (node sets, unions when a name appears in several sources):
       gmsh physical groups (``cell_sets``, or ``field_data`` + ``cell_data
       ["gmsh:physical"]`` for MSH 2.2) → the nodes of their cells; Abaqus
@@ -288,6 +349,9 @@ def from_meshio(m, source: str = "", require: Sequence[str] = ()) -> Mesh:
         raise ValueError(f"mesh {source} has {bad} point(s) with non-finite coordinates")
     if points.shape[1] == 2:
         points = np.column_stack([points, np.zeros(len(points))])
+    if unit not in LENGTH_UNITS:
+        raise ValueError(f"mesh unit must be one of {', '.join(LENGTH_UNITS)}, got {unit!r}")
+    points *= LENGTH_UNITS[unit]
 
     blocks = [(_ALIASES.get(b.type, b.type), np.asarray(b.data)) for b in m.cells]
     _check_blocks(blocks, len(points), source)
@@ -302,6 +366,7 @@ def from_meshio(m, source: str = "", require: Sequence[str] = ()) -> Mesh:
         points[:, 2] = 0.0
 
     groups = file_groups(m, blocks, len(points), source)
+    ids = file_node_ids(m, len(points), source)
     body = np.concatenate([d for t, d in blocks if t == btype]).astype(np.int64)
     if body.min() < 0 or body.max() >= len(points):
         raise ValueError(f"mesh {source}: {btype} cells refer to nodes outside 0..{len(points) - 1}")
@@ -309,7 +374,7 @@ def from_meshio(m, source: str = "", require: Sequence[str] = ()) -> Mesh:
     if btype == "wedge18":
         body = _wedge18_in_vtk_order(points, body, source)
     body = _check_orientation(points, body, btype, dim, source)
-    _check_coincident(points, body, btype, source)  # after the cells' own checks (a collapsed cell: named there)
+    _check_coincident(points, body, btype, source, ids)  # after the cells' own checks (a collapsed cell: named there)
     cells = {btype: body}
     for d in range(dim - 1, -1, -1):  # boundary cells: faces, edges, vertices
         for t in BOUNDARY_TYPES[d]:
@@ -319,59 +384,13 @@ def from_meshio(m, source: str = "", require: Sequence[str] = ()) -> Mesh:
     if dropped:
         log.info("mesh %s: %s dropped (cell types a %d-D model does not use)", source,
                  ", ".join(f"{n} {t} cell(s)" for t, n in dropped.items()), dim)
-    mesh = Mesh(points=points, cells=cells, dim=dim, groups=groups, source=source)
+    mesh = Mesh(points=points, cells=cells, dim=dim, groups=groups, source=source, node_ids=ids, unit=unit)
     for name in require:
         if len(mesh.group(name)) == 0:
             raise ValueError(f"mesh {source}: group {name!r} is empty")
     return mesh
 
 
-def _body_type(blocks, present: set, source: str) -> tuple[str, int]:
-    """``(body cell type, dimension)``: the one accepted cell type of the highest dimension; ``ValueError``
-    naming the counts when that dimension has several cell types, or none that a model accepts."""
-    dim = max((d for d in (3, 2) if any(_cell_dim(t) == d for t in present)), default=0)
-    body_types = sorted(t for t in present if _cell_dim(t) == dim)
-    if not body_types or not set(body_types) & set(BODY_TYPES[dim]):
-        found = ", ".join(sorted(present)) or "none"
-        raise ValueError(f"mesh {source} has no volume cells ({', '.join(BODY_TYPES[3])}) nor planar cells "
-                         f"({', '.join(BODY_TYPES[2])}); cell types: {found}")
-    if len(body_types) == 1:
-        return body_types[0], dim
-    if len({KINDS[t].family if t in KINDS else t for t in body_types}) == 1:
-        raise ValueError(f"mesh {source} mixes element orders ({', '.join(body_types)}); use one order")
-    counts = ", ".join(f"{sum(len(c) for tt, c in blocks if tt == t)} {t}" for t in body_types)
-    simplex = [t for t in body_types if t in _SIMPLEX[dim]]
-    other = [t for t in body_types if t not in _SIMPLEX[dim]]
-    what = (f"non-simplex {dim}-D cells ({', '.join(other)}) beside {', '.join(simplex)} cells" if simplex
-            else f"{dim}-D cell types")
-    unknown = [t for t in body_types if t not in KINDS]
-    note = f"; {', '.join(unknown)} cells have no scikit-fem element" if unknown else ""
-    valid = "; ".join(" or ".join(t for t in BODY_TYPES[dim] if KINDS[t].family == f)
-                      for f in dict.fromkeys(KINDS[t].family for t in BODY_TYPES[dim]))
-    raise ValueError(f"mesh {source} mixes {what} ({counts} cells){note}: a model has one body cell type "
-                     f"(scikit-fem assembles one per mesh); valid bodies: {valid}. Remesh with one type (e.g. "
-                     f"split the cells into tetrahedra), or export each part separately")
-
-
-def _wedge18_in_vtk_order(points: np.ndarray, body: np.ndarray, source: str) -> np.ndarray:
-    """18-node wedges in VTK order: gmsh's order (which meshio 5.3 keeps) is recognised by its midside nodes
-    sitting on other edges, and permuted."""
-    parents = KINDS["wedge18"].parents[6:15]
-
-    def misfit(cells):
-        mids = np.stack([points[cells[:, list(p)]].mean(axis=1) for p in parents], axis=1)
-        return float(np.abs(points[cells[:, 6:15]] - mids).sum())
-
-    gmsh = body[:, list(GMSH_WEDGE18)]
-    if misfit(gmsh) < misfit(body):
-        log.info("mesh %s: 18-node wedges in gmsh node order, put in VTK order", source)
-        return gmsh
-    return body
-
-
-_ABAQUS_TYPES = {"tetra": "C3D4", "tetra10": "C3D10", "triangle": "CPS3", "triangle6": "CPS6",
-                 "hexahedron": "C3D8", "hexahedron20": "C3D20", "wedge": "C3D6", "wedge15": "C3D15",
-                 "quad": "CPS4", "quad8": "CPS8"}
 _ABAQUS_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,79}$")
 
 
@@ -379,10 +398,12 @@ def save_mesh(mesh: Mesh, path: str | os.PathLike) -> None:
     """Write ``mesh`` with its groups, atomically, in a form :func:`load_mesh` reads back.
 
     * ``.vtu`` / ``.vtk``: all cells; each group as a ``uint8`` point-data
-      mask ``group:<name>`` (1 = in the group), viewable in ParaView.
-    * ``.inp`` (Abaqus): nodes, the body elements (``C3D4``, ``C3D10``, or
-      plane-stress ``CPS3``, ``CPS6``) and one ``*NSET`` per group (names:
-      a letter then letters, digits, ``_``).
+      mask ``group:<name>`` (1 = in the group), viewable in ParaView; the file's
+      node numbers (:attr:`Mesh.node_ids`, when the mesh has them) as the point
+      data ``node_id``.
+    * ``.inp`` (Abaqus): nodes with their numbers (the file's, else 1-based), the
+      body elements (``C3D4``, ``C3D10``, …, plane-stress ``CPS3``, ``CPS6``, …)
+      and one ``*NSET`` per group (names: a letter then letters, digits, ``_``).
 
     gmsh ``.msh`` files come from :func:`bladecase.blade_mesh`.
 
@@ -413,16 +434,17 @@ def save_mesh(mesh: Mesh, path: str | os.PathLike) -> None:
     if suffix in (".vtu", ".vtk"):
         import meshio
 
-        out = meshio.Mesh(
-            mesh.points,
-            [(t, np.asarray(c)) for t, c in mesh.cells.items()],
-            point_data={GROUP_PREFIX + name: _mask(nodes, len(mesh.points)) for name, nodes in mesh.groups.items()},
-        )
+        data = {GROUP_PREFIX + name: _mask(nodes, len(mesh.points)) for name, nodes in mesh.groups.items()}
+        if mesh.numbering == "file":
+            data[NODE_ID_KEY] = mesh.node_ids
+        out = meshio.Mesh(mesh.points, [(t, np.asarray(c)) for t, c in mesh.cells.items()], point_data=data)
         with atomic_path(path) as tmp:
             meshio.write(tmp, out, file_format="vtu" if suffix == ".vtu" else "vtk")
     elif suffix == ".inp":
-        if mesh.body_type not in _ABAQUS_TYPES:
-            valid = ", ".join(f"{k} ({v})" for k, v in _ABAQUS_TYPES.items())
+        from .abaqus import ABAQUS_TYPES, abaqus_text
+
+        if mesh.body_type not in ABAQUS_TYPES:
+            valid = ", ".join(f"{k} ({v})" for k, v in ABAQUS_TYPES.items())
             raise ValueError(f"save_mesh cannot write {mesh.body_type} cells to Abaqus {path!r} (meshio reads no "
                              f"such element back); valid: {valid}; write .vtu or .vtk instead")
         for name in mesh.groups:
@@ -431,7 +453,7 @@ def save_mesh(mesh: Mesh, path: str | os.PathLike) -> None:
                     f"group name {name!r} is not a valid Abaqus set name (a letter, then letters, digits, _)"
                 )
         with atomic_path(path) as tmp:
-            tmp.write_text(_abaqus_text(mesh), encoding="ascii")
+            tmp.write_text(abaqus_text(mesh), encoding="ascii")
     else:
         raise ValueError(f"save_mesh cannot write {path!r}: suffix {suffix or '(none)'!r}, valid: .vtu, .vtk, .inp")
 
@@ -442,26 +464,13 @@ def _mask(nodes: np.ndarray, n: int) -> np.ndarray:
     return mask
 
 
-def _abaqus_text(mesh: Mesh) -> str:
-    btype = mesh.body_type
-    origin = os.path.basename(mesh.source) or "memory"
-    lines = ["*HEADING", f"bladecase mesh from {origin}".encode("ascii", "replace").decode(), "*NODE"]
-    lines += [f"{i + 1}, {x!r}, {y!r}, {z!r}" for i, (x, y, z) in enumerate(mesh.points.tolist())]
-    lines.append(f"*ELEMENT, TYPE={_ABAQUS_TYPES[btype]}")
-    lines += [f"{e + 1}, " + ", ".join(str(v + 1) for v in row) for e, row in enumerate(mesh.cells[btype].tolist())]
-    for name, nodes in mesh.groups.items():
-        lines.append(f"*NSET, NSET={name}")
-        ids = [str(v + 1) for v in np.asarray(nodes).tolist()]
-        lines += [", ".join(ids[i : i + 16]) for i in range(0, len(ids), 16)]
-    return "\n".join(lines) + "\n"
-
-
 # ----------------------------------------------------------------------------- arrays (for .npz stage files)
 
 def mesh_to_arrays(mesh: Mesh, prefix: str = "mesh/") -> dict[str, np.ndarray]:
-    """The mesh as flat named arrays (for ``np.savez``): points, cells by type, groups."""
+    """The mesh as flat named arrays (for ``np.savez``): points, cells by type, groups, node numbers, unit."""
     out = {f"{prefix}points": mesh.points, f"{prefix}dim": np.array(mesh.dim),
-           f"{prefix}source": np.array(mesh.source)}
+           f"{prefix}source": np.array(mesh.source), f"{prefix}node_ids": mesh.node_ids,
+           f"{prefix}unit": np.array(mesh.unit)}
     out.update({f"{prefix}cells/{t}": np.asarray(c) for t, c in mesh.cells.items()})
     out.update({f"{prefix}groups/{g}": np.asarray(n) for g, n in mesh.groups.items()})
     return out
@@ -485,5 +494,10 @@ def mesh_from_arrays(data, prefix: str = "mesh/", source: str = "data") -> Mesh:
         for name, idx in table.items():
             if idx.size and (idx.min() < 0 or idx.max() >= n):
                 raise ValueError(f"{source}: field '{prefix}{kind}/{name}' refers to nodes outside 0..{n - 1}")
-    return Mesh(points=points, cells=cells, dim=dim, groups=groups,
-                source=npz_scalar(data, f"{prefix}source", source, "str"))
+    ids = npz_array(data, f"{prefix}node_ids", source, 1, "int") if f"{prefix}node_ids" in data else None
+    unit = npz_scalar(data, f"{prefix}unit", source, "str") if f"{prefix}unit" in data else "m"
+    try:  # files written before node numbers and units were kept have neither: the 0-based index, metres
+        return Mesh(points=points, cells=cells, dim=dim, groups=groups,
+                    source=npz_scalar(data, f"{prefix}source", source, "str"), node_ids=ids, unit=unit)
+    except ValueError as exc:
+        raise ValueError(f"{source}: field '{prefix}node_ids' or '{prefix}unit': {exc}") from None

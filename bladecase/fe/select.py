@@ -7,12 +7,16 @@
 * ``{"box": [[xmin, ymin, zmin], [xmax, ymax, zmax]], "tol": t}``: the nodes inside the box (bounds
   included, widened by ``t``);
 * ``{"sphere": [x, y, z, r], "tol": t}``: the nodes within ``r + t`` of the centre;
-* ``{"nearest": [x, y, z]}``: the one corner node of the body cells nearest to the point.
+* ``{"nearest": [x, y, z]}``: the one corner node of the body cells nearest to the point;
+* ``{"nodes": [id, …]}``: the nodes numbered so in the mesh file (:attr:`~bladecase.fe.mesh.Mesh.node_ids`: an
+  Abaqus, CalculiX or ANSYS node list as it is; the 0-based index for files without node numbers).
 
 In 2-D, points may leave out ``z`` and a plane may be ``[x0, y0, nx, ny]``.
 
 ``tol`` defaults to :data:`TOL_FRACTION` of the shortest edge of the body cells (a node one element away is
-never caught).  Everything is vectorised over the nodes.
+never caught).  Everything is vectorised over the nodes.  Messages name nodes by their number in the file.
+
+:func:`held_nodes` counts every node a clamp holds (midside nodes included).
 """
 
 from __future__ import annotations
@@ -30,14 +34,14 @@ RULES = {"plane": 6, "box": 6, "sphere": 4, "nearest": 3}
 
 
 def select_nodes(mesh: Mesh, spec: str | dict, what: str = "selection", allow_all: bool = True) -> np.ndarray:
-    """Sorted mesh node indices selected by ``spec`` (a group name, or a dict: see the module docstring).
+    """Sorted mesh node indices (0-based) selected by ``spec`` (a group name, or a dict: see the module docstring).
 
     Parameters
     ----------
     mesh : Mesh
     spec : str or dict
         A group name of ``mesh``, or one rule among ``plane``, ``box``, ``sphere``, ``nearest`` with an optional
-        ``tol`` (length, >= 0; not with ``nearest``).
+        ``tol`` (length, >= 0; not with ``nearest``), or ``nodes`` (node numbers as in the file).
     what : str
         What the selection is for (``"clamp"``, ``"contact"``), named in the messages.
     allow_all : bool
@@ -48,7 +52,8 @@ def select_nodes(mesh: Mesh, spec: str | dict, what: str = "selection", allow_al
     ValueError
         An unknown group or rule, a value that is not the right count of finite numbers, a zero normal, a
         negative radius or tolerance, an empty selection (with the mesh's bounding box and the distance of
-        the nearest node), a selection of every node when ``allow_all`` is false.
+        the nearest node), a node number that is not in the mesh, a selection of every node when ``allow_all`` is
+        false.
 
     Examples
     --------
@@ -74,7 +79,18 @@ def select_nodes(mesh: Mesh, spec: str | dict, what: str = "selection", allow_al
     Traceback (most recent call last):
         ...
     ValueError: selection {'circle': [0, 0, 0, 1]}: unknown key 'circle'; valid: one of plane, box, sphere,
-    nearest, and tol
+    nearest, and tol (or nodes alone: node numbers as in the file)
+
+    Nodes by their numbers in the file (here the bar's nodes numbered 101, 103, …):
+
+    >>> from dataclasses import replace
+    >>> numbered = replace(bar, node_ids=101 + 2 * np.arange(20))
+    >>> select_nodes(numbered, {"nodes": [101, 103]}).tolist()
+    [0, 1]
+    >>> select_nodes(numbered, {"nodes": [101, 102]}, what="clamp")
+    Traceback (most recent call last):
+        ...
+    ValueError: clamp node 102 is not a node of mesh bar (20 nodes numbered 101 to 139)
     """
     if isinstance(spec, str):
         nodes = np.asarray(mesh.group(spec), dtype=np.int64)
@@ -83,7 +99,15 @@ def select_nodes(mesh: Mesh, spec: str | dict, what: str = "selection", allow_al
         return _checked_all(mesh, nodes, spec, what, allow_all)
     if not isinstance(spec, dict):
         raise ValueError(f"{what} must be a group name or a dict with one of {', '.join(RULES)} "
-                         f"(and tol), got {spec!r}")
+                         f"(and tol), got {spec!r}; or node numbers as in the file, {{'nodes': [...]}}")
+    if "nodes" in spec:
+        if len(spec) != 1:
+            others = ", ".join(k for k in spec if k != "nodes")
+            raise ValueError(f"{what} {describe(spec)}: nodes goes alone (not with {others})")
+        ids = np.asarray(spec["nodes"])
+        if ids.ndim != 1 or ids.size == 0 or ids.dtype.kind not in "iu":
+            raise ValueError(f"{what} nodes must be a non-empty list of node numbers (integers), got {describe(spec)}")
+        return _checked_all(mesh, mesh.index_of(ids, f"{what} node"), spec, what, allow_all)
     rule = _rule(spec, what)
     values = _numbers(spec, rule, mesh.dim, what)
     points = np.asarray(mesh.points, dtype=float)
@@ -113,7 +137,7 @@ def select_nodes(mesh: Mesh, spec: str | dict, what: str = "selection", allow_al
         k = int(np.argmin(dist))
         box = np.array([points.min(axis=0), points.max(axis=0)])
         raise ValueError(f"{what} {spec!r} selects no node of mesh {mesh.source or ''} (tol {tol:.3g}): its "
-                         f"bounding box is {_fmt(box)}, the nearest node ({k} at {_fmt(points[k])}) is "
+                         f"bounding box is {_fmt(box)}, the nearest node ({mesh.node_id(k)} at {_fmt(points[k])}) is "
                          f"{dist[k]:.3g} away")
     return _checked_all(mesh, nodes, spec, what, allow_all)
 
@@ -121,7 +145,8 @@ def select_nodes(mesh: Mesh, spec: str | dict, what: str = "selection", allow_al
 def _rule(spec: dict, what: str) -> str:
     unknown = [k for k in spec if k not in RULES and k != "tol"]
     if unknown:
-        raise ValueError(f"{what} {spec!r}: unknown key {unknown[0]!r}; valid: one of {', '.join(RULES)}, and tol")
+        raise ValueError(f"{what} {spec!r}: unknown key {unknown[0]!r}; valid: one of {', '.join(RULES)}, and tol "
+                         "(or nodes alone: node numbers as in the file)")
     rules = [k for k in spec if k in RULES]
     if len(rules) != 1:
         raise ValueError(f"{what} {spec!r} needs exactly one of {', '.join(RULES)}, got "
@@ -179,7 +204,7 @@ def _checked_all(mesh: Mesh, nodes: np.ndarray, spec, what: str, allow_all: bool
     if not allow_all:
         body = np.unique(np.asarray(mesh.cells[mesh.body_type]))
         if np.isin(body, nodes).all():
-            raise ValueError(f"{what} {spec!r} selects every node of the body of mesh {mesh.source or ''} "
+            raise ValueError(f"{what} {describe(spec)} selects every node of the body of mesh {mesh.source or ''} "
                              f"({body.size} nodes): it must leave nodes free (e.g. select the root face only)")
     return nodes
 
@@ -188,3 +213,42 @@ def _fmt(a) -> str:
     """``[x, y, z]`` or ``[[…], […]]`` with 4 significant digits, on one line."""
     a = np.asarray(a)
     return "[" + ", ".join(_fmt(r) if a.ndim > 1 else f"{r:.4g}" for r in a) + "]"
+
+
+def describe(spec) -> str:
+    """``spec`` for a message: a long node list is cut (its first numbers and its length)."""
+    if isinstance(spec, dict) and isinstance(spec.get("nodes"), (list, tuple, np.ndarray)) and len(spec["nodes"]) > 6:
+        ids = list(spec["nodes"])
+        return f"{{'nodes': [{', '.join(str(int(k)) for k in ids[:4])}, … ({len(ids)} nodes)]}}"
+    return repr(spec)
+
+
+def held_nodes(mesh: Mesh, clamped) -> np.ndarray:
+    """Every mesh node a clamp of the corner nodes ``clamped`` holds fixed (sorted 0-based indices): those corners,
+    and the midside and face-centre nodes of the body cells whose edge or face has all its corners clamped — the
+    nodes whose dofs the assembly fixes with them (a cell's centre node never is).  A clamp of a quadratic mesh's
+    root face holds its midside nodes too: this is the count an Abaqus or ANSYS user compares with the deck.
+
+    >>> from skfem import MeshTri
+    >>> t = MeshTri.init_tensor(np.linspace(0, 0.02, 3), np.linspace(0, 0.01, 2)).oriented()
+    >>> six = np.c_[t.p.T, np.zeros(t.p.shape[1])]
+    >>> edges = {tuple(sorted(e)) for c in t.t.T for e in ((c[0], c[1]), (c[1], c[2]), (c[2], c[0]))}
+    >>> mid = {e: len(six) + k for k, e in enumerate(sorted(edges))}
+    >>> points = np.vstack([six, [(six[a] + six[b]) / 2 for a, b in sorted(edges)]])
+    >>> tri6 = np.array([[*c, mid[tuple(sorted((c[0], c[1])))], mid[tuple(sorted((c[1], c[2])))],
+    ...                   mid[tuple(sorted((c[2], c[0])))]] for c in t.t.T])
+    >>> strip = Mesh(points, {"triangle6": tri6}, dim=2)
+    >>> root = np.flatnonzero(six[:, 0] == 0)                  # the two corners at x = 0
+    >>> points[held_nodes(strip, root)][:, :2].tolist()        # and the midside node between them
+    [[0.0, 0.0], [0.0, 0.01], [0.0, 0.005]]
+    """
+    kind = KINDS[mesh.body_type]
+    cells = np.asarray(mesh.cells[mesh.body_type])
+    fixed = np.zeros(len(mesh.points), dtype=bool)
+    fixed[np.asarray(clamped, dtype=np.int64)] = True
+    held = [np.flatnonzero(fixed)]
+    for j in range(kind.corners, kind.n_nodes):
+        parents = list(kind.parents[j])
+        if len(parents) < kind.corners:  # an edge or a face, not the cell's centre
+            held.append(cells[fixed[cells[:, parents]].all(axis=1), j])
+    return np.unique(np.concatenate(held))

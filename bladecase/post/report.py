@@ -18,16 +18,17 @@ def report(summary: dict) -> str:
              f"total {summary['timings_s']['total']:.1f} s.", "",
              "## Model", "",
              f"- Mesh: {m['mesh']['nodes']} nodes, {m['mesh']['cells']} `{m['mesh']['type']}` cells "
-             f"({m['mesh']['source']}).",
+             f"({m['mesh']['source']}{_mesh_words(m['mesh'])}).",
              f"- FE model: {m['dim']}-D, P{m['order']}, {m['dofs']} free dofs, {m['mass_matrix']} mass, "
              f"{m['material']['name']} (E = {m['material']['E']:.4g} Pa, ν = {m['material']['nu']:g}, "
              f"ρ = {m['material']['rho']:g} kg/m³), total mass {m['total_mass_kg']:.5g} kg, "
-             f"{m['clamped_nodes']} clamped nodes.",
+             f"{_clamp_words(m)}.",
              "- Linear frequencies (full FE model, Hz): " + ", ".join(f"{f:.2f}" for f in m["linear_frequencies_hz"]),
+             *_plausibility_words(m),
              "", "## Contact", "",
              (f"- Face of {len(c['face_nodes'])} nodes ({c.get('face_weights', 'equal')} weights; mean normal "
-              f"displacement), centre node {c['node']}" if len(c.get("face_nodes", [])) > 1 else f"- Node {c['node']}")
-             + f" at ({', '.join(f'{x:.5g}' for x in c['position'])}) m, casing normal "
+              f"displacement), centre node {_node(c)}" if len(c.get("face_nodes", [])) > 1 else f"- Node {_node(c)}")
+             + f" at ({', '.join(f'{x * 1e3:.5g}' for x in c['position'])}) mm, casing normal "
              f"({', '.join(f'{x:.4g}' for x in c['normal'])}), clearance {c['clearance_m'] * 1e3:.4g} mm.",
              _casing_words(c.get("casing_stiffness_n_per_m")),
              *rotation_report(summary.get("rotation"), summary.get("campbell")),
@@ -107,6 +108,41 @@ def report(summary: dict) -> str:
             lines.append(f"\n  ![{a['gif']}]({a['gif']})\n")
     lines += ["", "Timings (s): " + ", ".join(f"{k} {v:.2f}" for k, v in summary["timings_s"].items()), ""]
     return "\n".join(lines)
+
+
+def _mesh_words(mesh: dict) -> str:
+    """The mesh's length unit and node numbering, when the summary has them and they are not the plain defaults."""
+    words = []
+    if mesh.get("unit", "m") != "m":
+        words.append(f"coordinates in {mesh['unit']}, scaled to metres")
+    if mesh.get("node_numbering") == "file":
+        words.append("nodes numbered as in the file")
+    return "".join(f"; {w}" for w in words)
+
+
+def _clamp_words(m: dict) -> str:
+    corners = m.get("clamped_corner_nodes")
+    extra = f" ({corners} corner nodes)" if corners is not None and corners != m["clamped_nodes"] else ""
+    return f"{m['clamped_nodes']} clamped nodes{extra}"
+
+
+def _node(c: dict) -> str:
+    """The contact node as the mesh file numbers it (with the 0-based index of ``mesh.vtu`` when they differ)."""
+    node_id = c.get("node_id", c["node"])
+    return f"{node_id}" + ("" if node_id == c["node"] else f" (index {c['node']} in `mesh.vtu`)")
+
+
+def _plausibility_words(m: dict) -> list[str]:
+    """A warning when the model's total mass or first frequency is not a blade's (the likely unit slip named)."""
+    from ..fe.mesh_checks import plausibility, thin_plate
+
+    f = m["linear_frequencies_hz"]
+    source = "geometry" if str(m["mesh"].get("source", "")).startswith("gmsh (parametric") else "mesh"
+    sentences = [plausibility(m["total_mass_kg"], f[0] if f else None, unit=m["mesh"].get("unit", "m"),
+                              source=source, dim=m["dim"], E=m["material"]["E"])]
+    if m.get("thickness_m") and m.get("plane") == "stress" and m["mesh"].get("extent_m"):
+        sentences.append(thin_plate(m["thickness_m"], m["mesh"]["extent_m"]))
+    return [x for s in sentences if s for x in ("", f"**Warning — {s}.**")]
 
 
 def _casing_words(k: float | None) -> str:

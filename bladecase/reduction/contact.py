@@ -98,16 +98,33 @@ def free_nodes(model: FEModel) -> np.ndarray:
     return np.unique(nodes[nodes >= 0])
 
 
-def _in_group(model: FEModel, nodes: np.ndarray, group: str | None) -> np.ndarray:
-    """``nodes`` restricted to mesh group ``group`` (all of them for ``None``)."""
+def _name(model: FEModel, node: int) -> int:
+    """A mesh node as messages name it: its number in the mesh file (:attr:`bladecase.fe.Mesh.node_ids`)."""
+    ids = getattr(model.mesh, "node_ids", None)
+    return int(ids[node]) if ids is not None and 0 <= node < len(ids) else int(node)
+
+
+def _members(model: FEModel, group) -> tuple[np.ndarray, str]:
+    """The mesh nodes of ``group`` (a group name, or 0-based node indices) and how messages name them."""
+    if isinstance(group, str):
+        return np.asarray(model.mesh.group(group)), f"group {group!r}"
+    nodes = np.unique(np.asarray(group, dtype=np.int64).ravel())
+    n = model.mesh.points.shape[0]
+    if nodes.size == 0 or nodes[0] < 0 or nodes[-1] >= n:
+        raise ValueError(f"face nodes must be mesh node indices 0..{n - 1}, got {np.asarray(group).tolist()[:8]!r}")
+    return nodes, f"the {nodes.size} face nodes"
+
+
+def _in_group(model: FEModel, nodes: np.ndarray, group) -> np.ndarray:
+    """``nodes`` restricted to mesh group ``group`` (a name or node indices; all of them for ``None``)."""
     if group is None:
         return nodes
-    members = model.mesh.group(group)
+    members, what = _members(model, group)
     nodes = nodes[np.isin(nodes, members)]
     if nodes.size == 0:
-        raise ValueError(
-            f"group {group!r} has no free node (all {len(members)} of its nodes are clamped or off the body)"
-        )
+        one = what.startswith("group")
+        raise ValueError(f"{what} {'has' if one else 'have'} no free node (all {len(members)} of "
+                         f"{'its nodes' if one else 'them'} are clamped or off the body)")
     return nodes
 
 
@@ -309,9 +326,10 @@ class Contact:
             raise ValueError(f"contact node {self.node} is not a mesh node (mesh nodes 0..{n_nodes - 1})")
         idx = np.flatnonzero(model.dofs.node == self.node)
         if idx.size == 0:
+            name = _name(model, self.node)
             if np.isin(self.node, model.clamped):
-                raise ValueError(f"contact node {self.node} is clamped: pick a free node (e.g. a tip node)")
-            raise ValueError(f"contact node {self.node} is not a vertex of the body cells: it has no dof")
+                raise ValueError(f"contact node {name} is clamped: pick a free node (e.g. a tip node)")
+            raise ValueError(f"contact node {name} is not a vertex of the body cells: it has no dof")
         return idx[np.argsort(model.dofs.direction[idx])]
 
     def w(self, model: FEModel) -> np.ndarray:
@@ -332,7 +350,8 @@ class Contact:
             scale = 1.0 / max(len(self.nodes), 1)
         w[idx] = nu[model.dofs.direction[idx]] * scale
         if not np.any(w):  # a free node always has all its directions free; guard anyway
-            raise ValueError(f"the normal {tuple(nu)} has no component on the free dofs of node {self.node}")
+            raise ValueError(f"the normal {tuple(nu)} has no component on the free dofs of node "
+                             f"{_name(model, self.node)}")
         return w
 
     def system(self, model: FEModel) -> LinearSystem:
@@ -359,9 +378,11 @@ class Contact:
         return Contact(self.node, tuple(self.normal_for(model)), self.gap, self.nodes, self.weights, self.casing)
 
     @classmethod
-    def face(cls, model: FEModel, group: str = "tip", normal: Sequence[float] | None = None,
+    def face(cls, model: FEModel, group: str | Sequence[int] = "tip", normal: Sequence[float] | None = None,
              gap: float | None = None, weights: str = "equal") -> Contact:
-        """The contact of a whole face: ``wᵀx`` = the mean normal displacement of the free vertices of ``group``.
+        """The contact of a whole face: ``wᵀx`` = the mean normal displacement of the free vertices of ``group`` (a
+        mesh group, or the face's mesh node indices, 0-based: ``model.mesh.index_of(ids)`` turns the node numbers
+        of a file into them).
 
         One constraint vector all the same. Unlike a single node in 3-D — a point load, whose static compliance
         ``wᵀK⁻¹w`` grows without bound as the mesh is refined (like ``1/h``; like ``log(1/h)`` in 2-D) — a face's
@@ -387,6 +408,8 @@ class Contact:
         (Contact(face of 5 nodes around node=102, normal=(1.0, 0.0), gap=0.0001), 5, 1.0)
         >>> np.round(Contact.face(model, "tip", (1.0, 0.0), 1e-4, weights="area").weights, 12)  # ends: half
         array([0.125, 0.25 , 0.25 , 0.25 , 0.125])
+        >>> Contact.face(model, tip.tolist(), (1.0, 0.0), 1e-4).w(model).tolist() == c.w(model).tolist()  # by nodes
+        True
         """
         if weights not in ("equal", "area"):
             raise ValueError(f"weights must be 'equal' or 'area', got {weights!r}")
@@ -424,15 +447,16 @@ def _facet_measure(P: np.ndarray, face: np.ndarray) -> np.ndarray:
     return 0.5 * np.linalg.norm(np.cross(P[face[:, 2]] - P[face[:, 0]], P[face[:, 3]] - P[face[:, 1]]), axis=1)
 
 
-def _area_weights(model: FEModel, group: str, nodes: np.ndarray) -> np.ndarray:
-    """Tributary weights of ``nodes``: each boundary facet of the body cells whose corners all lie in ``group``
-    gives ``|f|/c`` to each of its ``c`` corners; divided by the face's total measure (see :meth:`Contact.face`)."""
+def _area_weights(model: FEModel, group, nodes: np.ndarray) -> np.ndarray:
+    """Tributary weights of ``nodes``: each boundary facet of the body cells whose corners all lie in ``group`` (a
+    name or node indices) gives ``|f|/c`` to each of its ``c`` corners; divided by the face's total measure (see
+    :meth:`Contact.face`)."""
     from ..fe.cells import KINDS
 
     mesh, dim = model.mesh, model.dim
     cells = mesh.cells[mesh.body_type]  # meshio order: the corner vertices first
     inside = np.zeros(mesh.points.shape[0], dtype=bool)
-    inside[mesh.group(group)] = True
+    inside[_members(model, group)[0]] = True
     P = np.zeros((mesh.points.shape[0], 3))
     P[:, :dim] = mesh.points[:, :dim]
     share, total = np.zeros(mesh.points.shape[0]), 0.0
@@ -445,8 +469,9 @@ def _area_weights(model: FEModel, group: str, nodes: np.ndarray) -> np.ndarray:
         np.add.at(share, face.ravel(), np.repeat(size / face.shape[1], face.shape[1]))
         total += size.sum()
     if total == 0:
-        raise ValueError(f"group {group!r} holds no boundary facet of the body cells: weights='area' needs a face "
-                         "(use weights='equal' for a set of nodes)")
+        what = _members(model, group)[1]
+        raise ValueError(f"{what} {'holds' if what.startswith('group') else 'hold'} no boundary facet of the body "
+                         "cells: weights='area' needs a face (use weights='equal' for a set of nodes)")
     return share[nodes] / total
 
 

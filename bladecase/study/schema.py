@@ -26,6 +26,7 @@ from typing import Any
 
 from ..fe import BladeGeometry, Material, PlateGeometry
 from ..fe.geometry import estimate_cells
+from ..fe.mesh_checks import LENGTH_UNITS
 from ..post.outputs import FORMATS as OUTPUT_FORMATS
 from ..reduction import METHODS
 from .demo import NEWTON_DEMO, demo_study, demo_text  # noqa: F401 (re-exported: they lived here)
@@ -45,6 +46,7 @@ from .values import (  # noqa: F401  (RANGES, LIMITS: part of the schema's docum
     RANGES,
     _clamp_spec,
     _compare_periods,
+    _density,
     _direction,
     _file,
     _folder,
@@ -54,8 +56,10 @@ from .values import (  # noqa: F401  (RANGES, LIMITS: part of the schema's docum
     _int_between,
     _ipp,
     _manifold_size,
+    _mesh_format,
     _method_names,
     _name,
+    _node_list,
     _nonzero,
     _num,
     _one_of,
@@ -99,20 +103,25 @@ SCHEMA: dict[str, dict[str, Key]] = {
     "mesh": {
         "path": Key(_STR, REQUIRED, "Mesh file (any meshio format with named groups), relative to the study file.",
                     _file),
+        "unit": Key(_STR, "m", "Length unit of the mesh file's coordinates ('m', 'mm', 'cm', 'in', 'ft'): scaled to "
+                    "metres when read; every result stays SI.", _one_of(*LENGTH_UNITS)),
+        "format": Key(_STR, None, "Format of the mesh file ('abaqus' for Abaqus/CalculiX syntax, 'gmsh', 'ansys', or "
+                      "any meshio format name); default: from the suffix and the content.", _mesh_format),
     },
     "material": {
         "preset": Key(_STR, "Ti-6Al-4V", "Material preset (Ti-6Al-4V, steel, Inconel 718, Al 6061-T6); "
                       "ignored when E, nu and rho are given."),
         "E": Key(_NUM, None, "Young's modulus (Pa).", _in_range("E")),
         "nu": Key(_NUM, None, "Poisson's ratio.", lambda v: None if -1 < v < 0.5 else "must be in (-1, 0.5)"),
-        "rho": Key(_NUM, None, "Density (kg/m³).", _in_range("rho")),
+        "rho": Key(_NUM, None, "Density (kg/m³).", _density),
     },
     "fem": {
         "order": Key(_INT, 2, "Polynomial order of the elements (1 or 2).", _one_of(1, 2)),
         "mass": Key(_STR, "consistent", "'consistent' or 'lumped' mass matrix.", _one_of("consistent", "lumped")),
         "clamp": Key((str, dict), "root", "Clamped nodes: a mesh group, or by coordinates (meshes without groups): "
                      "{plane = [x0, y0, z0, nx, ny, nz]}, {box = [[xmin, ymin, zmin], [xmax, ymax, zmax]]} or "
-                     "{sphere = [x, y, z, r]}, with an optional tol (m).", _clamp_spec),
+                     "{sphere = [x, y, z, r]}, with an optional tol (m); or node numbers as in the mesh file: "
+                     "{nodes = [...]} or {nodes_file = 'root.txt'}.", _clamp_spec),
         "thickness": Key(_NUM, None, "Out-of-plane thickness of a 2-D model (m); required in 2-D.",
                          lambda v: "must be > 0 (metres)" if not v > 0 else _in_range("thickness")(v)),
         "plane": Key(_STR, "stress", "'stress' or 'strain' (2-D models).", _one_of("stress", "strain")),
@@ -125,14 +134,18 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "group": Key(_STR, None, "Mesh group of the contact node: alone, a one-node group (default "
                      "'contact'); with 'farthest', the group searched (default 'tip'); with 'nearest', the group "
                      "searched (default: every free node).", _name),
-        "node": Key(_INT, None, "Mesh node index of the contact (overrides group).", _int_between(0, LIMITS["node"])),
+        "node": Key(_INT, None, "Node number of the contact as in the mesh file (the 0-based index for files without "
+                    "node numbers); overrides group.", _int_between(0, LIMITS["node"])),
+        "nodes": Key(_LIST, None, "A contact face given as node numbers of the mesh file: the mean normal "
+                     "displacement of its free nodes, as 'face' does for a group.", _node_list),
         "farthest": Key(_LIST, None, "Pick the free node of 'group' (default 'tip') farthest along this "
                         "direction, e.g. [-1, 0, 0].", _direction),
         "nearest": Key(_LIST, None, "Pick the free node nearest this point (within 'group' if given).", _point),
         "face": Key((str, dict), None, "Contact on a whole face instead of one node: the mean normal displacement "
                     "of the free nodes of this mesh group (e.g. 'tip'), one constraint all the same; or the face's "
                     "nodes by coordinates: {plane = [x0, y0, z0, nx, ny, nz]}, {box = [[..], [..]]} or "
-                    "{sphere = [x, y, z, r]}, with an optional tol (m).", _clamp_spec),
+                    "{sphere = [x, y, z, r]}, with an optional tol (m); or node numbers: {nodes = [...]} or "
+                    "{nodes_file = 'tip.txt'}.", _clamp_spec),
         "normal": Key(_LIST, None, "Casing normal, from the blade towards the casing; default: radial "
                       "(+z in 3-D, +y in 2-D).", _direction),
         "weights": Key(_STR, None, "With 'face': how the face's nodes are weighted in the mean normal "
@@ -484,16 +497,17 @@ def _cross_checks(c: dict) -> None:
         missing = [k for k in ("E", "nu", "rho") if m[k] is None]
         raise StudyError(f"[material] {', '.join(missing)}: give E, nu and rho together (or only 'preset')")
     ct = c["contact"]
-    pickers = [k for k in ("node", "farthest", "nearest", "face") if ct[k] is not None]
+    pickers = [k for k in ("node", "farthest", "nearest", "face", "nodes") if ct[k] is not None]
     if len(pickers) > 1:
-        raise StudyError(f"[contact] {pickers[1]}: give at most one of node, farthest, nearest, face (got {pickers})")
+        raise StudyError(f"[contact] {pickers[1]}: give at most one of node, farthest, nearest, face, nodes (got "
+                         f"{pickers})")
     for key in ("normal", "farthest"):  # directions: scaled to a largest component of 1 (no overflow later)
         v = ct[key]
         if v is not None:
             top = max(abs(x) for x in v)
             ct[key] = [x / top for x in v]
-    if ct["weights"] is not None and ct["face"] is None:
-        raise StudyError(f"[contact] weights: only with [contact] face (the weights of its nodes), got "
+    if ct["weights"] is not None and ct["face"] is None and ct["nodes"] is None:
+        raise StudyError(f"[contact] weights: only with [contact] face or nodes (the weights of its nodes), got "
                          f"{ct['weights']!r} without a face")
     if not given:
         try:

@@ -43,7 +43,13 @@ def build_mesh(study: Study, path: str | os.PathLike | None = None) -> Mesh:
         source = study.mesh_path()
         if not source.exists():
             raise StudyError(f"[mesh] path: no such file {str(source)!r}")
-        mesh = load_mesh(source)
+        m = study["mesh"]
+        mesh = load_mesh(source, unit=m.get("unit") or "m", file_format=m.get("format"))
+        if mesh.unit != "m":
+            log.info("mesh %s: coordinates in %s, scaled to metres (every result is SI)", mesh.source, mesh.unit)
+        if mesh.numbering == "file":
+            log.info("mesh %s: nodes numbered as in the file (%d to %d): messages and summary.json name them so",
+                     mesh.source, mesh.node_ids.min(), mesh.node_ids.max())
         if path is not None:
             from ..fe import save_mesh
 
@@ -67,19 +73,61 @@ def material(study: Study) -> Material:
 
 
 def build_model(study: Study, mesh: Mesh) -> FEModel:
-    """Assemble the FE model of ``[material]`` and ``[fem]`` on ``mesh``."""
+    """Assemble the FE model of ``[material]`` and ``[fem]`` on ``mesh``; log the nodes the clamp holds (midside
+    nodes included) and warn when the model's mass is not a blade's (:func:`check_plausibility`)."""
     f = study["fem"]
     if mesh.dim == 2 and f["thickness"] is None:
         raise StudyError("[fem] thickness: required for a 2-D (plane) mesh, e.g. thickness = 0.002 (metres)")
     if mesh.dim == 3 and f["thickness"] is not None:
         raise StudyError(f"[fem] thickness: only for 2-D meshes; this mesh is 3-D (got {f['thickness']!r})")
+    clamp = f["clamp"]
+    if isinstance(clamp, dict):  # by coordinates or node numbers: the nodes, named in the messages
+        clamp = selected_nodes(study, mesh, clamp, "[fem] clamp", allow_all=False)
     try:
-        return assemble(mesh, material(study), order=f["order"], mass=f["mass"], clamp=f["clamp"],
-                        thickness=f["thickness"], plane=f["plane"])
+        model = assemble(mesh, material(study), order=f["order"], mass=f["mass"], clamp=clamp,
+                         thickness=f["thickness"], plane=f["plane"])
     except ValueError as exc:
         if isinstance(f["clamp"], dict) and str(exc).startswith("clamp"):
             raise StudyError(f"[fem] {exc}") from None
         raise
+    _log_clamp(f["clamp"], mesh, model, mesh.group(clamp) if isinstance(clamp, str) else clamp)
+    check_plausibility(study, model)
+    return model
+
+
+def _log_clamp(spec, mesh: Mesh, model: FEModel, chosen: np.ndarray) -> None:
+    """The nodes the clamp holds — corners and midside nodes, as a deck counts them — and a warning for the nodes of
+    the selection it cannot hold (a midside node whose edge has a free end)."""
+    from ..fe.select import describe, held_nodes
+
+    held = held_nodes(mesh, model.clamped)
+    name = repr(spec) if isinstance(spec, str) else describe(spec)
+    log.info("clamp %s: %d nodes held fixed (%d corner nodes, %d midside or face nodes)", name, held.size,
+             model.clamped.size, held.size - model.clamped.size)
+    body = np.unique(np.asarray(mesh.cells[mesh.body_type]))
+    loose = np.setdiff1d(np.intersect1d(chosen, body), held)
+    if loose.size:
+        log.warning("clamp %s: %d of its nodes are not held (midside nodes whose edge has a free corner; first: node "
+                    "%d): the elements clamp an edge's middle only with its corners", name, loose.size,
+                    mesh.node_id(loose[0]))
+
+
+def check_plausibility(study: Study, model: FEModel, f1_hz: float | None = None) -> str | None:
+    """Warn (log) when ``model`` is not a blade: its total mass (and, given, its first frequency ``f1_hz``) far
+    outside :data:`~bladecase.fe.mesh_checks.BLADE_MASS_KG` (:data:`~bladecase.fe.mesh_checks.BLADE_F1_HZ`), naming
+    the likely unit slip; a plane-stress thickness beyond the plate's size.  Returns the sentence (``None``: plausible).
+    With ``f1_hz``, only a first frequency out of range is logged (the mass was, by :func:`build_model`)."""
+    from ..fe.mesh_checks import BLADE_F1_HZ, plausibility, thin_plate
+
+    sentence = plausibility(model.total_mass, f1_hz, unit=model.mesh.unit, dim=model.dim, E=model.material.E,
+                            source="geometry" if study.parametric else "mesh")
+    if f1_hz is None and model.dim == 2 and model.plane == "stress":
+        thick = thin_plate(model.thickness, float(np.ptp(model.mesh.points[:, :2], axis=0).max()))
+        if thick:
+            log.warning("%s", thick)
+    if sentence and (f1_hz is None or not BLADE_F1_HZ[0] <= f1_hz <= BLADE_F1_HZ[1]):
+        log.warning("FE model of %s: %s", model.mesh.source or "the mesh", sentence)
+    return sentence
 
 
 #: The mesh group made from a ``[contact] face`` given by coordinates (a plane, box or sphere table).
@@ -87,25 +135,95 @@ SELECTED_FACE = "contact_face_selected"
 
 
 def _with_selections(study: Study, mesh: Mesh) -> Mesh:
-    """``mesh`` with the node sets the study selects by coordinates as named groups (``[contact] face``)."""
-    face = study["contact"]["face"]
-    if not isinstance(face, dict):
+    """``mesh`` with the node sets the study selects by coordinates or node numbers as named groups
+    (``[contact] face`` given as a table, ``[contact] nodes``)."""
+    c = study["contact"]
+    face, key = (c["face"], "[contact] face") if isinstance(c["face"], dict) else (
+        ({"nodes": c["nodes"]}, "[contact] nodes") if c.get("nodes") is not None else (None, ""))
+    if face is None:
         return mesh
     from dataclasses import replace
 
+    nodes = selected_nodes(study, mesh, face, key)
+    return replace(mesh, groups={**mesh.groups, SELECTED_FACE: nodes})
+
+
+def selected_nodes(study: Study, mesh: Mesh, spec: dict, key: str, allow_all: bool = True) -> np.ndarray:
+    """The 0-based nodes of a selection table of ``key`` (``[fem] clamp``, ``[contact] face``): by coordinates
+    (:func:`bladecase.fe.select_nodes`) or by node numbers as in the mesh file, ``nodes = [...]`` or ``nodes_file``
+    (relative to the study file; a number not in the mesh is named, with its line)."""
     from ..fe import select_nodes
 
     try:
-        nodes = select_nodes(mesh, face, what="[contact] face")
+        if "nodes_file" in spec:
+            listed = read_node_list(study.base / spec["nodes_file"], key)
+            _check_listed(mesh, listed, key, spec["nodes_file"])
+            spec = {"nodes": [k for k, _ in listed]}
+        if "nodes" in spec:
+            mesh.index_of(spec["nodes"], f"{key}: node")  # the first number that is not a node, named
+        return select_nodes(mesh, spec, what=key, allow_all=allow_all)
+    except StudyError:
+        raise
     except ValueError as exc:
-        raise StudyError(str(exc) if str(exc).startswith("[contact]") else f"[contact] face: {exc}") from None
-    return replace(mesh, groups={**mesh.groups, SELECTED_FACE: nodes})
+        raise StudyError(str(exc) if str(exc).startswith("[") else f"{key}: {exc}") from None
+
+
+def _check_listed(mesh: Mesh, listed: list[tuple[int, int]], key: str, name: str) -> None:
+    """``StudyError`` naming the first listed number (and its line in the file ``name``) that is not a node of
+    ``mesh``."""
+    ids = np.array([k for k, _ in listed], dtype=np.int64)
+    missing = np.flatnonzero(~np.isin(ids, mesh.node_ids))
+    if missing.size:
+        k, line = listed[int(missing[0])]
+        try:
+            mesh.index_of([k], f"{key}: node")
+        except ValueError as exc:
+            raise StudyError(str(exc).replace(f"node {k} ", f"node {k} ({name}, line {line}) ", 1)) from None
+
+
+#: Largest node list file read (bytes): a million node numbers take under 10 MB.
+MAX_NODE_FILE_BYTES = 100_000_000
+
+
+def read_node_list(path, key: str) -> list[tuple[int, int]]:
+    """``(node number, line)`` of a node list file: one number per line, or numbers separated by commas or spaces;
+    ``#``, ``!`` and ``**`` comments, blank lines and one Abaqus ``*NSET`` line (a CalculiX ``.nam`` file of one set)
+    allowed.  ``StudyError`` naming ``key``, the file and the line of anything else."""
+    from ..fe.mesh_checks import check_input_file
+
+    try:
+        name = check_input_file(path, "node list file")
+    except ValueError as exc:
+        raise StudyError(f"{key}: nodes_file: {exc}") from None
+    if os.path.getsize(name) > MAX_NODE_FILE_BYTES:
+        raise StudyError(f"{key}: nodes_file {name!r} is larger than {MAX_NODE_FILE_BYTES} bytes: not a node list")
+    out, keywords = [], 0
+    with open(name, encoding="latin-1") as fh:
+        for line, text in enumerate(fh, start=1):
+            text = text.split("#", 1)[0].split("!", 1)[0].strip()
+            if not text or text.startswith("**"):
+                continue
+            if text.startswith("*"):
+                keywords += 1
+                if keywords > 1 or not text[1:].lstrip().upper().startswith("NSET"):
+                    raise StudyError(f"{key}: nodes_file {name!r}, line {line}: {text!r}: a node list holds node "
+                                     "numbers (and at most one *NSET line: one set of a .nam file)")
+                continue
+            for token in text.replace(",", " ").split():
+                try:
+                    out.append((int(token), line))
+                except ValueError:
+                    raise StudyError(f"{key}: nodes_file {name!r}, line {line}: {token!r} is not a node number "
+                                     "(integers, one per line or separated by commas or spaces)") from None
+    if not out:
+        raise StudyError(f"{key}: nodes_file {name!r} lists no node number")
+    return out
 
 
 def contact_group(study: Study) -> str | None:
     """The mesh group ``[contact]`` selects from (``None``: a node index, or every free node)."""
     c = study["contact"]
-    if c["face"] is not None:
+    if c["face"] is not None or c.get("nodes") is not None:
         return c["face"] if isinstance(c["face"], str) else SELECTED_FACE
     if c["node"] is not None:
         return None
@@ -119,12 +237,17 @@ def contact_group(study: Study) -> str | None:
 def build_contact(study: Study, model: FEModel) -> Contact:
     """The contact of ``[contact]`` on ``model`` (node checked to be free).
 
-    ``node`` → that node; ``farthest`` → the free node of ``group`` (default
-    ``tip``) farthest along the direction; ``nearest`` → the free node nearest
-    the point (within ``group`` if given); otherwise the node of the one-node
-    ``group`` (default ``contact``).
+    ``node`` → that node (its number in the mesh file); ``face`` or ``nodes`` →
+    the mean normal displacement of the face's free nodes; ``farthest`` → the
+    free node of ``group`` (default ``tip``) farthest along the direction;
+    ``nearest`` → the free node nearest the point (within ``group`` if given);
+    otherwise the node of the one-node ``group`` (default ``contact``).
     """
     contact = _picked_contact(study, model)
+    mesh = model.mesh
+    if mesh.numbering == "file":  # the file's number, beside the 0-based index of mesh.vtu
+        log.info("contact: node %d of %s (index %d in mesh.vtu)%s", mesh.node_id(contact.node), mesh.source,
+                 contact.node, f", the centre of a face of {len(contact.nodes)} nodes" if contact.nodes else "")
     casing = study["contact"]["casing_stiffness"]
     return contact if casing is None else contact.with_casing(casing)
 
@@ -134,10 +257,14 @@ def _picked_contact(study: Study, model: FEModel) -> Contact:
     normal, gap = c["normal"], c["clearance"]
     group = contact_group(study)
     try:
-        if c["face"] is not None:
+        if c["face"] is not None or c.get("nodes") is not None:
             return Contact.face(model, group, normal, gap, weights=c["weights"] or "equal")
-        if c["node"] is not None:
-            return Contact.at(model, c["node"], normal, gap)
+        if c["node"] is not None:  # a node number as in the mesh file
+            try:
+                index = int(model.mesh.index_of([c["node"]])[0])
+            except ValueError as exc:
+                raise StudyError(f"[contact] node: {exc}") from None
+            return Contact.at(model, index, normal, gap)
         if c["farthest"] is not None:
             return Contact.farthest(model, c["farthest"], normal, gap, group=group)
         if c["nearest"] is not None:

@@ -292,17 +292,41 @@ def _nonzero(v) -> str | None:
 #: The coordinate rules of a clamp (:func:`bladecase.fe.select_nodes`); ``tol`` may go with any of them.
 CLAMP_RULES = ("plane", "box", "sphere")
 
+#: The node-list rules of a clamp or a contact face: node numbers as in the mesh file, in the study or in a file.
+NODE_RULES = ("nodes", "nodes_file")
+
+#: Most node numbers a node list may hold, and the largest number (32-bit, as Abaqus, CalculiX and ANSYS number).
+MAX_NODE_LIST, MAX_NODE_ID = 10_000_000, 2**31 - 1
+
+
+def _node_list(v) -> str | None:
+    """A non-empty list of node numbers (integers in ``[0, MAX_NODE_ID]``) as in the mesh file."""
+    if not v or len(v) > MAX_NODE_LIST or not all(_count(x, 0, MAX_NODE_ID) for x in v):
+        bad = next((x for x in v if not _count(x, 0, MAX_NODE_ID)), None)
+        return (f"must be a non-empty list of node numbers as in the mesh file (integers 0 to {MAX_NODE_ID})"
+                + (f", got {show(bad)} in it" if bad is not None else ""))
+    return None
+
 
 def _clamp_spec(v) -> str | None:
-    """A group name, or a table with exactly one coordinate rule (its values are checked by ``select_nodes``)."""
+    """A group name, or a table with exactly one coordinate rule (its values are checked by ``select_nodes``) or one
+    node list (``nodes = [...]``, ``nodes_file = "..."``)."""
     if isinstance(v, str):
         return None if v.strip() else "must be a mesh group name or a table such as {plane = [0, 0, 0, 0, 0, 1]}"
-    rules = [k for k in v if k in CLAMP_RULES]
-    unknown = sorted(set(v) - set(CLAMP_RULES) - {"tol"})
+    rules = [k for k in v if k in CLAMP_RULES + NODE_RULES]
+    unknown = sorted(set(v) - set(CLAMP_RULES + NODE_RULES) - {"tol"})
     if unknown or len(rules) != 1:
-        return (f"must hold exactly one of {', '.join(CLAMP_RULES)} (and optionally tol)"
-                + (f"; unknown keys {unknown}" if unknown else ""))
+        return (f"must hold exactly one of {', '.join(CLAMP_RULES + NODE_RULES)} (and optionally tol with "
+                f"{', '.join(CLAMP_RULES)})" + (f"; unknown keys {unknown}" if unknown else ""))
     rule, value = rules[0], v[rules[0]]
+    if rule in NODE_RULES and "tol" in v:
+        return f"tol goes with {', '.join(CLAMP_RULES)}, not with {rule}"
+    if rule == "nodes":
+        return _node_list(value) if isinstance(value, list) else "nodes must be a list of node numbers, e.g. [1, 2, 3]"
+    if rule == "nodes_file":
+        return (_file(value) if isinstance(value, str) else
+                'nodes_file must be a file name (one node number per line, or separated by commas or spaces), e.g. '
+                '"root.txt"')
     top = RANGES["coordinate"][1]
     numbers = value if rule != "box" else (
         [x for corner in value for x in corner] if isinstance(value, list) and len(value) == 2
@@ -335,3 +359,29 @@ def sweep_periods(ratios, periods: int, sweeps: int) -> float:
     """
     return float(sweeps * periods * sum(max(1.0, 1.0 / r) for r in ratios))
 
+
+
+#: Densities in t/mm³ — the N-mm-t units of an Abaqus or CalculiX deck in millimetres (metals: 2.7e-9 to 8.9e-9).
+NMM_DENSITY = (1e-12, 1e-6)
+
+
+def _density(v) -> str | None:
+    """``[material] rho`` in kg/m³, with what to do when it is a density in t/mm³ (a deck's N-mm-t units)."""
+    lo, hi, _ = RANGES["rho"]
+    if math.isfinite(v) and lo <= v <= hi:
+        return None
+    if NMM_DENSITY[0] <= v <= NMM_DENSITY[1]:
+        return (f"must be a density in kg/m³ in [{lo:g}, {hi:g}]; {v:g} looks like t/mm³, the N-mm-t units of a deck "
+                f"in millimetres. bladecase takes SI material constants whatever the mesh's unit: give rho = "
+                f"{v * 1e12:.6g} (kg/m³) and E in Pa (MPa × 1e6, e.g. 113800 MPa is E = 1.138e11), and read the mesh "
+                'in millimetres with [mesh] unit = "mm"')
+    return f"must be in [{lo:g}, {hi:g}] (kg/m³)"
+
+
+def _mesh_format(v) -> str | None:
+    """A format name :func:`bladecase.fe.load_mesh` takes."""
+    from ..fe.mesh import mesh_formats
+
+    valid = mesh_formats()
+    return None if v.lower() in valid else f"must be a mesh format name, e.g. 'abaqus', 'gmsh', 'ansys'; valid: " \
+        f"{', '.join(valid)}"

@@ -1,0 +1,460 @@
+"""Abaqus keyword files — Abaqus ``.inp``, and CalculiX's ``.inp``/``.msh``/``.nam`` — read into a ``meshio.Mesh``.
+
+meshio's own Abaqus reader drops the node numbers, follows no ``*INCLUDE`` relative to the including file, keeps
+only the last ``*NODE`` block and reads no ``*BOUNDARY``; :func:`read_abaqus` reads a whole deck:
+
+* ``*INCLUDE, INPUT=file`` followed, relative to the including file, nested (a missing file names both files);
+* ``*NODE`` blocks (any number; node numbers in any order, gaps allowed) — the numbers are kept as the point data
+  :data:`NODE_ID_KEY`, so that every message can name a node as the file does;
+* ``*ELEMENT, TYPE=…``: solids ``C3D4``, ``C3D6``, ``C3D8``, ``C3D10``, ``C3D15``, ``C3D20`` and their variants
+  (``R``, ``H``, ``I``, ``M``, ``T``, …: ``C3D20R``, ``C3D8I``, ``C3D10MH``), plane ``CPS3/4/6/8``, ``CPE3/4/6/8``
+  (same variants); other elements (shells, beams, springs, masses, axisymmetric ``CAX``) are left out with a log
+  line counting them;
+* ``*NSET`` / ``*ELSET`` (``GENERATE``, nested set names, case-insensitive as in Abaqus) as named node groups
+  (``point_sets``; an element set becomes the nodes of its elements);
+* ``*BOUNDARY`` (node numbers or node sets, a dof range or ``ENCASTRE``, ``PINNED``, ``XSYMM``, …) as the groups
+  ``boundary`` (every node with a fixed dof), ``boundary_fixed`` (the nodes whose three translations are all
+  fixed, by one line or several) and ``boundary_<first>_<last>`` per dof range as written (``boundary_1_3``;
+  ``ENCASTRE`` is ``boundary_1_6``, ``PINNED`` ``boundary_1_3``, ``XSYMM`` ``boundary_xsymm``); a prescribed
+  non-zero displacement is not a fixed dof.
+
+Coordinates are taken as they are (the length unit is the study's ``[mesh] unit``). Errors name the file, the line
+and what was expected. :func:`looks_like_abaqus` tells an Abaqus-syntax file from its content (a CalculiX ``.msh``).
+
+>>> import tempfile, os
+>>> folder = tempfile.TemporaryDirectory()
+>>> _ = open(os.path.join(folder.name, "cube.msh"), "w").write('''*NODE, NSET=NALL
+... 101, 0, 0, 0
+... 103, 1, 0, 0
+... 105, 1, 1, 0
+... 107, 0, 1, 0
+... 109, 0, 0, 1
+... 111, 1, 0, 1
+... 113, 1, 1, 1
+... 115, 0, 1, 1
+... *ELEMENT, TYPE=C3D8R, ELSET=EALL
+... 7, 101, 103, 105, 107, 109, 111, 113, 115
+... ''')
+>>> _ = open(os.path.join(folder.name, "cube.inp"), "w").write('''*INCLUDE, INPUT=cube.msh
+... *BOUNDARY
+... 101, 1, 3
+... 103, 1, 3
+... 105, 1, 1
+... 105, 2, 3
+... ''')
+>>> m = read_abaqus(os.path.join(folder.name, "cube.inp"))
+>>> m.cells[0].type, m.cells[0].data.tolist(), m.point_data[NODE_ID_KEY].tolist()
+('hexahedron', [[0, 1, 2, 3, 4, 5, 6, 7]], [101, 103, 105, 107, 109, 111, 113, 115])
+>>> {k: v.tolist() for k, v in sorted(m.point_sets.items())}  # doctest: +NORMALIZE_WHITESPACE
+{'EALL': [0, 1, 2, 3, 4, 5, 6, 7], 'NALL': [0, 1, 2, 3, 4, 5, 6, 7], 'boundary': [0, 1, 2],
+ 'boundary_1_1': [2], 'boundary_1_3': [0, 1], 'boundary_2_3': [2], 'boundary_fixed': [0, 1, 2]}
+>>> looks_like_abaqus(os.path.join(folder.name, "cube.msh"))
+True
+>>> folder.cleanup()
+"""
+
+from __future__ import annotations
+
+import os
+import re
+
+import numpy as np
+
+from .. import log
+from .groups import NODE_ID_KEY  # the point-data key of the file's node numbers (Mesh.node_ids)
+
+#: Corner/quadratic node count of the solid and plane elements → meshio type (Abaqus and VTK share node orders).
+_SOLID = {4: "tetra", 10: "tetra10", 6: "wedge", 15: "wedge15", 8: "hexahedron", 20: "hexahedron20"}
+_PLANE = {3: "triangle", 6: "triangle6", 4: "quad", 8: "quad8"}
+_ELEMENT_NAME = re.compile(r"^(C3D|CPS|CPE)(\d+)([A-Z]*)$")
+
+#: Fixed dofs of the named ``*BOUNDARY`` types, and the group each makes.
+_NAMED_BC = {"ENCASTRE": ((1, 2, 3, 4, 5, 6), "boundary_1_6"), "PINNED": ((1, 2, 3), "boundary_1_3"),
+             "XSYMM": ((1, 5, 6), "boundary_xsymm"), "YSYMM": ((2, 4, 6), "boundary_ysymm"),
+             "ZSYMM": ((3, 4, 5), "boundary_zsymm"), "XASYMM": ((2, 3, 4), "boundary_xasymm"),
+             "YASYMM": ((1, 3, 5), "boundary_yasymm"), "ZASYMM": ((1, 2, 6), "boundary_zasymm")}
+
+#: Deepest chain of ``*INCLUDE`` files followed.
+MAX_INCLUDE_DEPTH = 32
+
+#: Bytes of a file's beginning searched by :func:`looks_like_abaqus`.
+SNIFF_BYTES = 65536
+
+
+class AbaqusError(ValueError):
+    """An Abaqus file that cannot be read: the message names the file and the line."""
+
+
+def element_type(name: str) -> tuple[str, int] | None:
+    """``(meshio type, nodes)`` of an Abaqus/CalculiX solid or plane element name, ``None`` for the elements
+    left out.
+
+    >>> element_type("C3D20R"), element_type("c3d15"), element_type("CPS8R"), element_type("S8R")
+    (('hexahedron20', 20), ('wedge15', 15), ('quad8', 8), None)
+    """
+    m = _ELEMENT_NAME.match(name.strip().upper())
+    if m is None or "V" in m.group(3):  # C3D15V, C3D27: variable node counts
+        return None
+    kind = (_SOLID if m.group(1) == "C3D" else _PLANE).get(int(m.group(2)))
+    return None if kind is None else (kind, int(m.group(2)))
+
+
+def looks_like_abaqus(path: str | os.PathLike) -> bool:
+    """True when the file's beginning holds an Abaqus keyword line ``*NODE``, ``*ELEMENT`` or ``*INCLUDE``."""
+    with open(path, "rb") as fh:
+        head = fh.read(SNIFF_BYTES).decode("latin-1")
+    return re.search(r"^[ \t]*\*[ \t]*(NODE|ELEMENT|INCLUDE)[ \t]*(,|\r?$)", head, re.I | re.M) is not None
+
+
+def _where(place: tuple[str, int]) -> str:
+    return f"Abaqus file {place[0]!r}, line {place[1]}"
+
+
+def _params(text: str) -> tuple[str, dict[str, str | None]]:
+    """``(KEYWORD, {PARAMETER: value or None})`` of a keyword line; keywords and parameter names upper case."""
+    fields = [f.strip() for f in text.strip().lstrip("*").split(",")]
+    params: dict[str, str | None] = {}
+    for f in fields[1:]:
+        if f:
+            key, eq, value = f.partition("=")
+            params[" ".join(key.split()).upper()] = value.strip().strip('"').strip() if eq else None
+    return " ".join(fields[0].split()).upper(), params
+
+
+def _read_text(path: str, place: tuple[str, int] | None = None, target: str = "") -> list[str]:
+    """The lines of ``path``; ``AbaqusError`` naming the including file and line (``place``) when it is missing."""
+    from .mesh_checks import check_input_file
+
+    by = f"{_where(place)}: *INCLUDE, INPUT={target}: " if place else ""
+    if place and not os.path.exists(path):
+        raise AbaqusError(f"{by}no such file {path!r} (an include is found relative to the folder of the file that "
+                          "includes it)")
+    try:
+        check_input_file(path, "Abaqus file")
+    except ValueError as exc:
+        raise AbaqusError(f"{by}{exc}") from None
+    with open(path, "rb") as fh:
+        data = fh.read()
+    if not data.endswith((b"\n", b"\r")):
+        last = data.rstrip().rsplit(b"\n", 1)[-1][-60:].decode("latin-1")
+        raise AbaqusError(f"{by}Abaqus file {path!r} is truncated or corrupt: it does not end with a line break "
+                          f"(its last line: {last!r}); if the file is complete, end it with a line break")
+    return data.decode("latin-1").splitlines()
+
+
+def _blocks(path: str):
+    """``(place, keyword, params, data)`` per keyword line of ``path`` with its ``*INCLUDE`` files read in place
+    (an included file may hold whole blocks or the data lines of the block before it); ``data``: the
+    ``(place, text)`` of its data lines (comments and blank lines left out)."""
+    stack = [[os.path.abspath(path), 0, _read_text(path)]]
+    block = None
+    while stack:
+        top = stack[-1]
+        name, lines = top[0], top[2]
+        if top[1] >= len(lines):
+            stack.pop()
+            continue
+        place, stripped = (name, top[1] + 1), lines[top[1]].strip()
+        top[1] += 1
+        if not stripped or stripped.startswith("**"):
+            continue
+        if not stripped.startswith("*"):
+            if block is not None:
+                block[3].append((place, stripped))
+            continue
+        while stripped.endswith(",") and top[1] < len(lines) and "=" in lines[top[1]] \
+                and not lines[top[1]].strip().startswith("*"):
+            stripped += lines[top[1]].strip()  # a keyword line continued (parameters); a sloppy comma is not one
+            top[1] += 1
+        keyword, params = _params(stripped)
+        if keyword != "INCLUDE":
+            if block is not None:
+                yield block
+            block = (place, keyword, params, [])
+            continue
+        target = params.get("INPUT")
+        if not target:
+            raise AbaqusError(f"{_where(place)}: *INCLUDE needs INPUT=<file>, got {stripped!r}")
+        full = os.path.normpath(os.path.join(os.path.dirname(name), os.path.expanduser(target)))
+        if full in {s[0] for s in stack} or len(stack) >= MAX_INCLUDE_DEPTH:
+            chain = " → ".join(repr(s[0]) for s in stack)
+            raise AbaqusError(f"{_where(place)}: *INCLUDE, INPUT={target} includes {full!r} again (or too deep): "
+                              f"{chain}")
+        stack.append([full, 0, _read_text(full, place, target)])
+    if block is not None:
+        yield block
+
+
+def _ints(place, text: str, what: str) -> list[int]:
+    try:
+        return [int(f) for f in text.replace(",", " ").split()]
+    except ValueError:
+        raise AbaqusError(f"{_where(place)}: expected {what} (integers separated by commas), got {text!r}") from None
+
+
+class _Deck:
+    """What a deck defines, as it is read."""
+
+    def __init__(self, source: str):
+        self.source = source
+        self.ids: list[int] = []
+        self.xyz: list[list[float]] = []
+        self.node_place: list[tuple[str, int]] = []
+        self.elements: dict[str, list[tuple[int, list[int]]]] = {}
+        self.element_nodes: dict[int, list[int]] = {}  # element number -> node numbers (every element read)
+        self.left_out: dict[str, int] = {}
+        self.nsets: dict[str, tuple[str, set[int]]] = {}  # upper-case name -> (name as written, node numbers)
+        self.elsets: dict[str, tuple[str, set[int]]] = {}
+        self.fixed: dict[str, set[int]] = {}  # boundary group -> node numbers
+        self.translations: dict[int, set[int]] = {}  # node number -> its fixed translations (1, 2, 3)
+        self.boundary: list[tuple[tuple[str, int], str]] = []
+        self.materials: list[str] = []
+
+    # -------------------------------------------------------------- keywords
+    def node(self, place, params, data) -> None:
+        members = []
+        for where, text in data:
+            fields = [f for f in (x.strip() for x in text.split(",")) if f]
+            try:
+                number, coords = int(fields[0]), [float(x) for x in fields[1:4]]
+            except (ValueError, IndexError):
+                raise AbaqusError(f"{_where(where)}: a *NODE line is 'number, x, y, z', got {text!r}") from None
+            self.ids.append(number)
+            self.xyz.append(coords + [0.0] * (3 - len(coords)))
+            self.node_place.append(where)
+            members.append(number)
+        if params.get("NSET"):
+            self._add(self.nsets, params["NSET"], members)
+
+    def element(self, place, params, data) -> None:
+        name = (params.get("TYPE") or "").upper()
+        if not name:
+            raise AbaqusError(f"{_where(place)}: *ELEMENT needs TYPE=<element type> (e.g. C3D20R)")
+        known = element_type(name)
+        if known is None:
+            records = [r for r in self._records(data) if r]
+            self.left_out[name] = self.left_out.get(name, 0) + len(records)
+            for numbers in records:
+                self.element_nodes[numbers[0]] = numbers[1:]
+            if params.get("ELSET"):
+                self._add(self.elsets, params["ELSET"], [r[0] for r in records])
+            return
+        kind, width = known[0], known[1] + 1
+        values = [v for where, text in data for v in _ints(where, text, f"{name} element records")]
+        if len(values) % width:
+            raise AbaqusError(f"{_where(place)}: the {len(values)} numbers under *ELEMENT, TYPE={name} are not "
+                              f"records of {width} (element number and {width - 1} nodes): a truncated or corrupt "
+                              "file?")
+        rows = np.asarray(values, dtype=np.int64).reshape(-1, width)
+        block = self.elements.setdefault(kind, [])
+        for row in rows.tolist():
+            block.append((row[0], row[1:]))
+            self.element_nodes[row[0]] = row[1:]
+        if params.get("ELSET"):
+            self._add(self.elsets, params["ELSET"], rows[:, 0].tolist())
+
+    def sets(self, place, params, data, which: str) -> None:
+        table = self.nsets if which == "NSET" else self.elsets
+        name = params.get(which)
+        if not name:
+            raise AbaqusError(f"{_where(place)}: *{which} needs {which}=<name>")
+        members: list[int] = []
+        of_elements = which == "NSET" and "ELSET" in params  # *NSET, NSET=A, ELSET: the nodes of these elements
+        for where, text in data:
+            fields = [f.strip() for f in text.split(",") if f.strip()]
+            if "GENERATE" in params:
+                v = _ints(where, text, "'first, last, step' of a GENERATE set")
+                if len(v) not in (2, 3) or (len(v) == 3 and v[2] <= 0) or v[1] < v[0]:
+                    raise AbaqusError(f"{_where(where)}: a GENERATE line is 'first, last[, step]' with first <= "
+                                      f"last and step > 0, got {text!r}")
+                span = range(v[0], v[1] + 1, v[2] if len(v) == 3 else 1)
+                members += [n for e in span for n in self.element_nodes.get(e, [])] if of_elements else span
+                continue
+            for f in fields:
+                number = re.fullmatch(r"[+-]?\d+", f) is not None
+                if of_elements:
+                    elements = [int(f)] if number else self._lookup(self.elsets, f, where, "ELSET")[1]
+                    members += [n for e in elements for n in self.element_nodes.get(e, [])]
+                else:
+                    members += [int(f)] if number else self._lookup(table, f, where, which)[1]
+        self._add(table, name, members)
+
+    def bc(self, place, params, data) -> None:
+        if (params.get("TYPE") or "DISPLACEMENT").upper() != "DISPLACEMENT":
+            return  # velocities, accelerations: not fixed dofs
+        for where, text in data:
+            fields = [f.strip() for f in text.split(",")]
+            if len(fields) < 2 or not fields[0]:
+                raise AbaqusError(f"{_where(where)}: a *BOUNDARY line is 'node or set, first dof[, last dof[, "
+                                  f"value]]', got {text!r}")
+            target, first = fields[0], fields[1].upper()
+            if first in _NAMED_BC:
+                dofs, group = _NAMED_BC[first]
+            else:
+                try:
+                    a = int(first)
+                    b = int(fields[2]) if len(fields) > 2 and fields[2] else a
+                    value = float(fields[3]) if len(fields) > 3 and fields[3] else 0.0
+                except ValueError:
+                    raise AbaqusError(f"{_where(where)}: a *BOUNDARY line is 'node or set, first dof[, last dof[, "
+                                      f"value]]' (or a type such as ENCASTRE), got {text!r}") from None
+                if not 1 <= a <= b:
+                    raise AbaqusError(f"{_where(where)}: *BOUNDARY dofs must be 1 <= first <= last, got {text!r}")
+                if value != 0.0:
+                    log.info("%s: *BOUNDARY %s prescribes a displacement %g, not a fixed dof: left out of the "
+                             "group 'boundary'", _where(where), text, value)
+                    continue
+                dofs, group = tuple(range(a, b + 1)), f"boundary_{a}_{b}"
+            self.boundary.append((where, target))
+            nodes = [int(target)] if re.fullmatch(r"[+-]?\d+", target) else \
+                self._lookup(self.nsets, target, where, "NSET")[1]
+            for key in ("boundary", group):
+                self.fixed.setdefault(key, set()).update(nodes)
+            for n in nodes:
+                self.translations.setdefault(n, set()).update(d for d in dofs if d <= 3)
+
+    # -------------------------------------------------------------- helpers
+    @staticmethod
+    def _records(data) -> list[list[int]]:
+        """Element records of an unknown element type: a line ending with a comma continues on the next."""
+        out, current = [], []
+        for where, text in data:
+            current += _ints(where, text, "element records")
+            if not text.rstrip().endswith(","):
+                out.append(current)
+                current = []
+        return out + ([current] if current else [])
+
+    @staticmethod
+    def _add(table, name: str, members) -> None:
+        written, have = table.get(name.upper(), (name, set()))
+        table[name.upper()] = (written, have | set(members))
+
+    @staticmethod
+    def _lookup(table, name: str, where, which: str):
+        if name.upper() not in table:
+            have = ", ".join(sorted(v[0] for v in table.values())[:20]) or "none"
+            raise AbaqusError(f"{_where(where)}: no {which} named {name!r} is defined before this line "
+                              f"({which}s: {have})")
+        return table[name.upper()]
+
+
+def read_abaqus(path: str | os.PathLike):
+    """The mesh of an Abaqus/CalculiX deck as a ``meshio.Mesh`` (see the module docstring for what is read)."""
+    import meshio
+
+    source = os.fspath(path)
+    deck = _Deck(source)
+    for place, keyword, params, data in _blocks(source):
+        if keyword == "NODE":
+            deck.node(place, params, data)
+        elif keyword == "ELEMENT":
+            deck.element(place, params, data)
+        elif keyword in ("NSET", "ELSET"):
+            deck.sets(place, params, data, keyword)
+        elif keyword == "BOUNDARY":
+            deck.bc(place, params, data)
+        elif keyword == "MATERIAL":
+            deck.materials.append(params.get("NAME") or "?")
+    if not deck.ids:
+        raise AbaqusError(f"Abaqus file {source!r} defines no node (*NODE): not a mesh (a deck whose mesh is in "
+                          "another file needs *INCLUDE, INPUT=<mesh file>)")
+    ids = np.asarray(deck.ids, dtype=np.int64)
+    order = np.argsort(ids, kind="stable")
+    ranked = ids[order]
+    twice = np.flatnonzero(ranked[1:] == ranked[:-1])
+    if twice.size:
+        a, b = order[twice[0]], order[twice[0] + 1]
+        raise AbaqusError(f"{_where(deck.node_place[b])}: node {ids[a]} is defined a second time (first at "
+                          f"{deck.node_place[a][0]!r}, line {deck.node_place[a][1]}): a deck of several parts "
+                          "(*PART, *INSTANCE) is not read; export the assembly as one flat input file")
+
+    def index(numbers, what: str, where) -> np.ndarray:
+        numbers = np.asarray(list(numbers), dtype=np.int64)
+        k = np.minimum(np.searchsorted(ranked, numbers), ranked.size - 1)
+        found = ranked[k] == numbers
+        if not found.all():
+            raise AbaqusError(f"{what} refers to node {numbers[~found][0]}, which no *NODE of {where} defines")
+        return order[k]
+
+    cells = []
+    for kind, rows in deck.elements.items():
+        conn = np.asarray([r[1] for r in rows], dtype=np.int64)
+        missing = ~np.isin(conn, ranked)
+        if missing.any():
+            e = rows[int(np.flatnonzero(missing.any(axis=1))[0])][0]
+            raise AbaqusError(f"Abaqus file {source!r}: element {e} ({kind}) refers to node "
+                              f"{conn[missing][0]}, which no *NODE defines")
+        cells.append((kind, index(conn.ravel(), "", source).reshape(conn.shape)))
+    if deck.left_out:
+        log.info("Abaqus file %s: %s left out (not solid or plane elements)", source,
+                 ", ".join(f"{n} {t}" for t, n in sorted(deck.left_out.items())))
+    if not cells:
+        found = ", ".join(f"{n} × {t}" for t, n in deck.left_out.items()) or "none"
+        raise AbaqusError(f"Abaqus file {source!r} has no solid or plane element bladecase reads (found: {found}; "
+                          "read: C3D4, C3D6, C3D8, C3D10, C3D15, C3D20 and variants, CPS/CPE 3, 4, 6, 8)")
+    point_sets: dict[str, np.ndarray] = {}
+    for written, members in deck.nsets.values():
+        point_sets[written] = index(sorted(members), f"*NSET {written!r}", source)
+    for written, members in deck.elsets.values():
+        nodes = {n for e in members for n in deck.element_nodes.get(e, [])}
+        extra = point_sets.get(written, np.zeros(0, dtype=np.int64))
+        point_sets[written] = np.union1d(extra, index(sorted(nodes), f"*ELSET {written!r}", source))
+    for group, members in deck.fixed.items():
+        point_sets[group] = np.sort(index(sorted(members), "*BOUNDARY", source))
+    full = {n for n, dofs in deck.translations.items() if dofs >= {1, 2, 3}}
+    if deck.fixed:
+        point_sets["boundary_fixed"] = np.sort(index(sorted(full), "*BOUNDARY", source))
+        _log_boundary(source, deck, full)
+    if deck.materials:
+        log.info("Abaqus file %s: material(s) %s of the deck not used (the study's [material] is, in SI units)",
+                 source, ", ".join(deck.materials))
+    return meshio.Mesh(np.asarray(deck.xyz, dtype=float), cells, point_sets=point_sets,
+                       point_data={NODE_ID_KEY: ids})
+
+
+def _log_boundary(source: str, deck: _Deck, full: set[int]) -> None:
+    groups = ", ".join(f"{g} ({len(m)})" for g, m in sorted(deck.fixed.items()) if g != "boundary")
+    log.info("Abaqus file %s: *BOUNDARY fixes %d nodes: group boundary; all three translations fixed: "
+             "boundary_fixed (%d); per dof range: %s", source, len(deck.fixed["boundary"]), len(full), groups)
+    partial = sorted(deck.fixed["boundary"] - full)
+    if partial:
+        log.info("Abaqus file %s: %d of the *BOUNDARY nodes have only some translations fixed (symmetry or "
+                 "sliding conditions; first: node %d): a clamp fixes all three — clamp = \"boundary_fixed\" takes "
+                 "only the nodes fixed in x, y and z", source, len(partial), partial[0])
+
+
+#: meshio body type → the Abaqus element :func:`abaqus_text` writes (one that :func:`read_abaqus` reads back).
+ABAQUS_TYPES = {"tetra": "C3D4", "tetra10": "C3D10", "triangle": "CPS3", "triangle6": "CPS6",
+                "hexahedron": "C3D8", "hexahedron20": "C3D20", "wedge": "C3D6", "wedge15": "C3D15",
+                "quad": "CPS4", "quad8": "CPS8"}
+
+
+def abaqus_text(mesh) -> str:
+    """An Abaqus input file of ``mesh`` (a :class:`bladecase.fe.mesh.Mesh`): its nodes with their numbers (the
+    file's own, else 1-based), the body elements and one ``*NSET`` per group."""
+    btype = mesh.body_type
+    numbers = mesh.node_ids if mesh.numbering == "file" and mesh.node_ids.min() >= 1 else \
+        np.arange(1, len(mesh.points) + 1)
+    origin = os.path.basename(mesh.source) or "memory"
+    lines = ["*HEADING", f"bladecase mesh from {origin}".encode("ascii", "replace").decode(), "*NODE"]
+    lines += [f"{k}, {x!r}, {y!r}, {z!r}" for k, (x, y, z) in zip(numbers.tolist(), mesh.points.tolist())]
+    lines.append(f"*ELEMENT, TYPE={ABAQUS_TYPES[btype]}")
+    for e, row in enumerate(mesh.cells[btype].tolist()):
+        items = [str(e + 1)] + [str(numbers[v]) for v in row]
+        lines += [", ".join(items[i : i + 16]) + ("," if i + 16 < len(items) else "") for i in range(0, len(items), 16)]
+    for name, nodes in mesh.groups.items():
+        lines.append(f"*NSET, NSET={name}")
+        ids = [str(v) for v in numbers[np.asarray(nodes, dtype=np.int64)].tolist()]
+        lines += [", ".join(ids[i : i + 16]) for i in range(0, len(ids), 16)]
+    return "\n".join(lines) + "\n"
+
+
+def register() -> None:
+    """Teach meshio the format ``"abaqus-deck"`` (this reader, no suffix: meshio's own ``"abaqus"`` keeps
+    ``.inp``; :func:`bladecase.fe.load_mesh` chooses this one); idempotent."""
+    import meshio
+    from meshio import _helpers
+
+    if "abaqus-deck" not in _helpers.reader_map:
+        meshio.register_format("abaqus-deck", [], read_abaqus, {})
