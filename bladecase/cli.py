@@ -292,7 +292,10 @@ def _cmd_assemble(args) -> int:
     _not_onto_inputs({"-o": args.output}, {"STUDY": args.study, "--mesh": args.mesh,
                                            "[mesh] path": None if study.parametric else study.mesh_path()})
     if args.mesh is not None:
-        mesh = load_mesh(args.mesh, require=[study["fem"]["clamp"]])
+        clamp = study["fem"]["clamp"]
+        m = study.config.get("mesh") or {}
+        mesh = load_mesh(args.mesh, require=[clamp] if isinstance(clamp, str) else [], unit=m.get("unit") or "m",
+                         file_format=m.get("format"))
     else:
         mesh = build_mesh(study)
     model = build_model(study, mesh)
@@ -317,7 +320,7 @@ def _cmd_reduce(args) -> int:
     reduced = build_reduced(study, model, contact, args.method, args.size)
     save_reduced(reduced, args.output)
     sp = reduced.system.spectrum
-    print(f"{args.output}: {reduced}; contact node {contact.node}")
+    print(f"{args.output}: {reduced}; contact node {model.mesh.node_id(contact.node)}")
     print("reduced frequencies (Hz): " + ", ".join(f"{x:.3f}" for x in sp.frequencies[sp.active][:12]))
     return 0
 

@@ -156,7 +156,7 @@ def read_cdb(path: str | os.PathLike):
             nodes = [np.asarray(by_number[int(e)], dtype=np.int64) for part in chosen for e in part]
         point_sets[name] = np.unique(np.concatenate(nodes)) if nodes else np.zeros(0, dtype=np.int64)
     return meshio.Mesh(xyz, [(t, np.asarray(c, dtype=np.int64)) for t, c in cells.items()], point_sets=point_sets,
-                       field_data={"ansys:types": counts})
+                       point_data={"node_id": np.asarray(ids, dtype=np.int64)}, field_data={"ansys:types": counts})
 
 
 #: Largest node or element number read: ANSYS numbers them with 32-bit integers.

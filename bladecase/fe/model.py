@@ -166,10 +166,13 @@ class FEModel:
         return int(out) if out.ndim == 0 else out
 
     def __repr__(self) -> str:
+        from .select import held_nodes
+
         extra = f", thickness={self.thickness:g}, plane {self.plane}" if self.dim == 2 else ""
+        held = held_nodes(self.mesh, self.clamped).size  # midside nodes of clamped edges included, as in a deck
         return (
             f"FEModel({self.dim}-D, P{self.order}, {self.n_dofs} free dofs, {self.mass} mass, "
-            f"{self.material.name or 'material'}{extra}, {self.clamped.size} clamped nodes)"
+            f"{self.material.name or 'material'}{extra}, {held} clamped nodes)"
         )
 
 

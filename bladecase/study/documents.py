@@ -18,6 +18,7 @@ import scipy.sparse as sp
 
 from ..checks import is_integer
 from ..fe import FEModel, Mesh
+from ..fe.select import held_nodes
 from ..nsm import Branch, LinearSystem, MasslessSystem, PeriodicOrbit
 from ..reduction import Contact, ReducedModel
 
@@ -372,17 +373,22 @@ def model_summary(mesh: Mesh, model: FEModel, f_fe: np.ndarray, source: str) -> 
     m = model.material
     return {
         "mesh": {"nodes": len(mesh.points), "cells": len(mesh.cells[mesh.body_type]), "type": mesh.body_type,
-                 "source": source},
+                 "source": source, "unit": mesh.unit, "node_numbering": mesh.numbering,
+                 "extent_m": float(np.ptp(mesh.points, axis=0).max())},
         "dim": model.dim, "dofs": model.n_dofs, "order": model.order, "mass_matrix": model.mass,
+        "thickness_m": model.thickness, "plane": model.plane,
         "material": {"name": m.name, "E": m.E, "nu": m.nu, "rho": m.rho},
-        "total_mass_kg": model.total_mass, "clamped_nodes": int(model.clamped.size),
+        "total_mass_kg": model.total_mass, "clamped_nodes": int(held_nodes(mesh, model.clamped).size),
+        "clamped_corner_nodes": int(model.clamped.size),
         "linear_frequencies_hz": np.asarray(f_fe).tolist(),
     }
 
 
 def contact_summary(contact: Contact, model: FEModel) -> dict:
     """Contact node, its position, the casing normal, the clearance and the casing's stiffness (None: rigid)."""
-    return {"node": contact.node, "face_nodes": list(contact.nodes),
+    ids = model.mesh.node_ids
+    return {"node": contact.node, "node_id": int(ids[contact.node]), "face_nodes": list(contact.nodes),
+            "face_node_ids": [int(ids[k]) for k in contact.nodes],
             "casing_stiffness_n_per_m": None if np.isinf(contact.casing) else contact.casing,
             "face_weights": "area" if contact.weights else "equal",
             "position": model.mesh.points[contact.node].tolist(),

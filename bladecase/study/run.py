@@ -33,7 +33,7 @@ from .reference import reference_model
 from .render import render_all
 from .rotation import campbell_stage, operating_point
 from .schema import Study, load_study
-from .stages import build_contact, build_mesh, build_model, build_reduced, period_unit, search
+from .stages import build_contact, build_mesh, build_model, build_reduced, check_plausibility, period_unit, search
 
 
 @dataclass
@@ -116,8 +116,8 @@ def run(study: Study | str | os.PathLike, out: str | os.PathLike | None = None, 
     >>> with tempfile.TemporaryDirectory() as out:
     ...     result = run(study, out, progress=False)
     ...     written = sorted(p.name for p in Path(out).iterdir())
-    >>> written
-    ['mesh.vtu', 'modes.json', 'report.md', 'run.log', 'summary.json']
+    >>> written   # and the signed manifest of what the run wrote (bladecase.study.manifest)
+    ['.bladecase-manifest.json', 'mesh.vtu', 'modes.json', 'report.md', 'run.log', 'summary.json']
     >>> model = result.summary["model"]
     >>> model["dim"], model["material"]["name"], round(model["total_mass_kg"], 6)   # 7850 × 0.1 × 0.02 × 0.002
     (2, 'steel', 0.0314)
@@ -187,6 +187,7 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         fe = fe_reference(model, contact, min(max(count, FE_MODES), model.n_dofs - 1), factor=factor)
         f_fe = fe.frequencies[:count]
         log.info("FE model: %s; first frequencies %s Hz", model, ", ".join(f"{x:.1f}" for x in f_fe[:6]))
+        check_plausibility(study, rest_model, float(f_fe[0]) if rotation is None else None)
     with stage("reduce"):
         build_s = []
         t0 = time.perf_counter()
@@ -197,9 +198,9 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
             t0 = time.perf_counter()
             compares.append(build_reduced(study, model, contact, c["method"], c.get("size"), factor=factor))
             build_s.append(time.perf_counter() - t0)
-        log.info("contact: node %d at %s, normal %s, clearance %g m", contact.node,
-                 np.round(mesh.points[contact.node], 6).tolist(), np.round(contact.normal_for(model), 6).tolist(),
-                 contact.gap)
+        log.info("contact: node %d at %s mm, normal %s, clearance %g mm", mesh.node_id(contact.node),
+                 np.round(mesh.points[contact.node] * 1e3, 4).tolist(), np.round(contact.normal_for(model), 6).tolist(),
+                 contact.gap * 1e3)
         log.info("reduced model: %s", reduced)
         t0 = time.perf_counter()
         reference = reference_model(model, contact, reduced, factor) if o["reference"] else None
