@@ -27,3 +27,8 @@ class Key:
 
 
 _STR, _INT, _NUM, _BOOL, _LIST = (str,), (int,), (int, float), (bool,), (list,)
+
+
+def one_line(exc: BaseException) -> str:
+    """An exception's message on one line (its lines joined with ``; ``)."""
+    return "; ".join(line.strip() for line in str(exc).splitlines() if line.strip())

@@ -24,21 +24,18 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..fe import BladeGeometry, Material, PlateGeometry
-from ..fe.geometry import estimate_cells
+from ..fe import BladeGeometry, PlateGeometry
 from ..fe.mesh_checks import LENGTH_UNITS
 from ..post.outputs import FORMATS as OUTPUT_FORMATS
 from ..reduction import METHODS
+from .cross_checks import MASSLESS_METHODS, cross_checks  # noqa: F401 (MASSLESS_METHODS lived here)
 from .demo import NEWTON_DEMO, demo_study, demo_text  # noqa: F401 (re-exported: they lived here)
-from .keys import _BOOL, _INT, _LIST, _NUM, _STR, REQUIRED, Key, StudyError  # noqa: F401
+from .keys import _BOOL, _INT, _LIST, _NUM, _STR, REQUIRED, Key, StudyError, one_line  # noqa: F401
 from .sections import (
     EXECUTION_KEYS,
     FORCING_KEYS,
     LIMIT_KEYS,
     ROTATION_KEYS,
-    execution_checks,
-    forcing_checks,
-    rotation_checks,
 )
 from .values import (  # noqa: F401  (RANGES, LIMITS: part of the schema's documented surface)
     LIMITS,
@@ -387,7 +384,7 @@ def _geometry_section(raw: dict) -> dict:
         missing = re.findall(r"'(\w+)'", str(exc))
         raise StudyError(f"[geometry] {', '.join(missing) or '?'}: required for kind = {kind!r} ({exc})") from None
     except ValueError as exc:
-        text = _one_line(exc)
+        text = one_line(exc)
         name = re.match(r"(\w+)\b", text)
         if name and name.group(1) in allowed and not text.startswith(f"{name.group(1)}:"):
             text = f"{name.group(1)}:{text[name.end():]}"  # "[geometry] span: must be ..."
@@ -400,42 +397,6 @@ def _geometry_section(raw: dict) -> dict:
         raise StudyError(f"[geometry] mesh_order: cells = 'hexahedron' makes order-1 cells: mesh_order = 1, got "
                          f"{g['mesh_order']!r} ([fem] order chooses the element order)")
     return out
-
-
-def _one_line(exc: BaseException) -> str:
-    return "; ".join(line.strip() for line in str(exc).splitlines() if line.strip())
-
-
-def _cell_checks(c: dict) -> None:
-    """The mesh gmsh would make from ``[geometry]`` within ``[limits] cells`` (estimated before meshing)."""
-    if "geometry" not in c:
-        return
-    g, cap = c["geometry"], c["limits"]["cells"]
-    geometry = Study({"geometry": g}).geometry()
-    try:
-        n = estimate_cells(geometry, size=g["size"], tip_size=g["tip_size"], cells=g["cells"])
-    except ValueError as exc:
-        raise StudyError(f"[geometry] {_one_line(exc)}") from None
-    if n <= cap:
-        return
-    size = g["size"] if g["size"] is not None else geometry.default_size()
-    uniform = estimate_cells(geometry, size=size, cells=g["cells"])
-    dim = 2 if isinstance(geometry, PlateGeometry) else 3
-    if g["tip_size"] is not None and uniform <= cap:
-        key, value, fix = "tip_size", g["tip_size"], "a larger tip_size"
-    else:
-        key, value = "size", size
-        least = size * (uniform / cap) ** (1 / dim)  # cells ~ size^-dim
-        for _ in range(60):
-            if estimate_cells(geometry, size=least, cells=g["cells"]) <= cap:
-                break
-            least *= 1.05
-        e = math.floor(math.log10(least)) - 1
-        fix = f"size >= {math.ceil(least / 10**e) * 10**e:.2g} m"  # 2 digits, rounded up
-        fix += " (without a finer tip_size)" if g["tip_size"] is not None else ""
-    shown = f"{value:g} m" + ("" if g["size"] is not None or key != "size" else " (the geometry's default)")
-    raise StudyError(f"[geometry] {key}: {key} = {shown} makes about {n:.2g} mesh cells (estimated before meshing), "
-                     f"more than [limits] cells = {cap}: {fix}, or raise [limits] cells")
 
 
 def validate(raw: dict, source: str = "<string>", base: str | os.PathLike | None = None,
@@ -486,117 +447,8 @@ def validate(raw: dict, source: str = "<string>", base: str | os.PathLike | None
                     raise StudyError(f"[{section}] {key}: required ({spec.doc})")
                 out[key] = list(spec.default) if isinstance(spec.default, list) else spec.default
         config[section] = out
-    _cross_checks(config)
+    cross_checks(config)
     return Study(config=config, source=source, base=Path(base) if base is not None else Path.cwd())
-
-
-def _cross_checks(c: dict) -> None:
-    m = c["material"]
-    given = [k for k in ("E", "nu", "rho") if m[k] is not None]
-    if given and len(given) != 3:
-        missing = [k for k in ("E", "nu", "rho") if m[k] is None]
-        raise StudyError(f"[material] {', '.join(missing)}: give E, nu and rho together (or only 'preset')")
-    ct = c["contact"]
-    pickers = [k for k in ("node", "farthest", "nearest", "face", "nodes") if ct[k] is not None]
-    if len(pickers) > 1:
-        raise StudyError(f"[contact] {pickers[1]}: give at most one of node, farthest, nearest, face, nodes (got "
-                         f"{pickers})")
-    for key in ("normal", "farthest"):  # directions: scaled to a largest component of 1 (no overflow later)
-        v = ct[key]
-        if v is not None:
-            top = max(abs(x) for x in v)
-            ct[key] = [x / top for x in v]
-    if ct["weights"] is not None and ct["face"] is None and ct["nodes"] is None:
-        raise StudyError(f"[contact] weights: only with [contact] face or nodes (the weights of its nodes), got "
-                         f"{ct['weights']!r} without a face")
-    if not given:
-        try:
-            Material.preset(m["preset"])
-        except ValueError as exc:
-            raise StudyError(f"[material] preset: {exc}") from None
-    r = c["reduction"]
-    if r["method"] == "full":
-        r["size"] = None
-    _expand_grid(r)
-    _contact_model_checks(c)
-    _work_checks(c["search"])
-    _cell_checks(c)
-    forcing_checks(c)
-    execution_checks(c)
-    rotation_checks(c)
-    o, s = c["output"], c["search"]
-    for i, item in enumerate(o["orbits"]):
-        if item["ipp"] not in s["ipp"]:
-            raise StudyError(f"[output] orbits: item {i} asks for ipp = {item['ipp']}, which [search] ipp = "
-                             f"{s['ipp']} does not look for")
-
-
-def _work_checks(s: dict) -> None:
-    """Searches that would not end: periods of very many linear periods, too fine a k-ipp start grid."""
-    top = LIMITS["period_multiple"]
-    if s["period_unit"] != "s" and s["periods"][1] > top:
-        raise StudyError(f"[search] periods: the upper period must be <= {top} × {s['period_unit']} (the work grows "
-                         f"with the number of linear periods per orbit), got {s['periods']}")
-    low = LIMITS["period_fraction"]
-    if s["period_unit"] != "s" and s["periods"][0] < low:
-        raise StudyError(f"[search] periods: the lower period must be >= {low:g} × {s['period_unit']} (shorter orbits "
-                         f"belong to modes far above it: use their T<j>), got {s['periods']}")
-    k = max(s["ipp"])
-    if s["resolution"] is not None and k >= 3:
-        cells = math.comb(s["resolution"] - 1, k - 1)
-        cap = LIMITS["grid_cells"]
-        if cells > cap:
-            fit = max((r for r in range(4, s["resolution"]) if math.comb(r - 1, k - 1) <= cap), default=4)
-            raise StudyError(f"[search] resolution: {s['resolution']} points per impact time make "
-                             f"{cells:.3g} start cells for ipp = {k} at each scanned period (at most {cap}): "
-                             f"resolution <= {fit} for ipp = {k}, got {s['resolution']}")
-
-
-def _expand_grid(r: dict) -> None:
-    """``methods`` × ``sizes`` appended to ``compare`` (the main model and repeats left out)."""
-    if not (r["methods"] or r["sizes"]):
-        return
-    methods = r["methods"] or [r["method"]]
-    sizes = r["sizes"] or [r["size"]]
-    seen = {(r["method"], r["size"])} | {(x["method"], x.get("size")) for x in r["compare"]}
-    for m in methods:
-        for n in ([None] if m == "full" else sizes):
-            if (m, n) not in seen:
-                seen.add((m, n))
-                r["compare"].append({"method": m, "size": n})
-    if len(r["compare"]) > LIMITS["models"]:
-        raise StudyError(f"[reduction] methods × sizes: {len(r['compare']) + 1} models, at most "
-                         f"{LIMITS['models'] + 1}")
-
-
-#: The reductions of the massless contact model (:data:`bladecase.reduction.massless.BASES`).
-MASSLESS_METHODS = ("massless", "massless-lanczos", "massless-modal")
-
-
-def _contact_model_checks(c: dict) -> None:
-    """The massless contact model and the keys it needs go together."""
-    massless = c["contact"]["model"] == "massless"
-    if c["contact"]["casing_stiffness"] is not None and not massless:
-        raise StudyError(f"[contact] casing_stiffness: a compliant casing needs model = 'massless' (Newton's impact "
-                         f"law is for a rigid casing), got {c['contact']['casing_stiffness']!r} with model = "
-                         f"{c['contact']['model']!r}")
-    methods = [c["reduction"]["method"]] + [x["method"] for x in c["reduction"]["compare"]]
-    if massless:
-        bad = [m for m in methods if m not in MASSLESS_METHODS]
-        if bad:
-            raise StudyError(f"[reduction] method: the massless contact model needs a massless method "
-                             f"({', '.join(map(repr, MASSLESS_METHODS))}) for every model, compare included; "
-                             f"got {bad[0]!r}")
-        if c["search"]["ipp"] != [1]:
-            raise StudyError(f"[search] ipp: the massless contact model has modes with one contact phase per "
-                             f"period: ipp = [1], got {c['search']['ipp']}")
-        if c["fem"]["mass"] != "lumped":
-            raise StudyError("[fem] mass: the massless contact model moves lumped masses: mass = 'lumped', got "
-                             f"{c['fem']['mass']!r}")
-    elif any(m in MASSLESS_METHODS for m in methods):
-        m = next(m for m in methods if m in MASSLESS_METHODS)
-        raise StudyError(f"[reduction] method: {m!r} is a reduction of the massless contact model: set "
-                         "[contact] model = 'massless'")
 
 
 #: Largest study file read (bytes): a study is a few kilobytes; a bigger file is not a study (a mesh, a log).
@@ -619,7 +471,7 @@ def loads(text: str, source: str = "<string>", base: str | os.PathLike | None = 
     try:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise StudyError(f"{source}: not valid TOML: {_one_line(exc)}") from None
+        raise StudyError(f"{source}: not valid TOML: {one_line(exc)}") from None
     except RecursionError:
         raise StudyError(f"{source}: not valid TOML: nested too deeply (arrays or tables inside each other)") from None
     try:
