@@ -71,22 +71,22 @@ def _study_name(v) -> str | None:
         "must be a plain folder name: 1-64 characters among letters, digits, '_', '.', '-', not starting with '.'")
 
 
-def _folder(v) -> str | None:
-    """A folder path: not empty, no control characters (a NUL byte cannot be in a path)."""
-    if not v.strip():
-        return 'must name a folder (give a folder, e.g. "results/plate")'
-    if any(ord(c) < 32 or ord(c) == 127 for c in v):
-        return "must be a folder path without control characters"
-    return None
+def _path(kind: str, example: str):
+    """A check of a ``kind`` path (``"folder"``, ``"file"``): not empty, no control characters (no NUL byte)."""
+
+    def check(v) -> str | None:
+        if not v.strip():
+            return f'must name a {kind} (e.g. "{example}")' if kind == "file" else \
+                f'must name a {kind} (give a {kind}, e.g. "{example}")'
+        if any(ord(c) < 32 or ord(c) == 127 for c in v):
+            return f"must be a {kind} path without control characters"
+        return None
+
+    return check
 
 
-def _file(v) -> str | None:
-    """A file path: not empty, no control characters."""
-    if not v.strip():
-        return 'must name a file (e.g. "meshes/plate.vtu")'
-    if any(ord(c) < 32 or ord(c) == 127 for c in v):
-        return "must be a file path without control characters"
-    return None
+_folder = _path("folder", "results/plate")
+_file = _path("file", "meshes/plate.vtu")
 
 
 def _name(v) -> str | None:
