@@ -104,6 +104,10 @@ def report(summary: dict) -> str:
             lines.append(f"  - {a['energy_words']}")
         if "stability" in a:
             lines.append(f"  - Stability (Floquet multipliers with saltation matrices): {a['stability']}.")
+        if a.get("tip_excursion"):
+            x = a["tip_excursion"]
+            lines.append(f"  - {'**Tip nodes beyond the clearance:** ' if x['nodes_beyond'] else 'Tip: '}"
+                         f"{x['words'][:1].upper()}{x['words'][1:]}.")
         if "gif" in a:
             lines.append(f"\n  ![{a['gif']}]({a['gif']})\n")
     lines += ["", "Timings (s): " + ", ".join(f"{k} {v:.2f}" for k, v in summary["timings_s"].items()), ""]

@@ -16,6 +16,8 @@ from ..nsm.floquet import floquet
 from ..nsm.verify import verify
 from ..post.grid import fe_grid, grid_index, nodal_field
 from ..post.outputs import FORMATS, OrbitScene
+from ..post.tip_excursion import tip_excursion
+from ..post.tip_excursion import words as tip_words
 from ..progress import progress_bar
 from ..reduction import ReducedModel
 from .choose import Choice, choose_orbits, frame_times
@@ -67,6 +69,12 @@ def render(study: Study, reduced: ReducedModel, families: list[Branch], choice: 
         entry["reference_check"] = check_in_reference(orbit, reduced, reference)
         log_check(entry["reference_check"], orbit.k, orbit.T)
     entry.update(_energy_split(orbit, reference))
+    excursion = tip_excursion(reduced, orbit)
+    if excursion is not None:
+        entry["tip_excursion"] = excursion
+        entry["tip_excursion"]["words"] = tip_words(excursion)
+        if excursion["nodes_beyond"]:
+            log.warning("orbit T = %.8g s: %s", orbit.T, entry["tip_excursion"]["words"])
     try:
         entry["stability"] = floquet(orbit).verdict
     except ValueError as exc:  # e.g. a grazing impact: no verdict, said so
