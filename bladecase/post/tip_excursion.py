@@ -15,7 +15,6 @@ and how many nodes pass the clearance at all — the numbers a single averaged c
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
 
 __all__ = ["SAMPLES", "tip_excursion", "words"]
 
@@ -23,45 +22,34 @@ __all__ = ["SAMPLES", "tip_excursion", "words"]
 SAMPLES = 400
 
 
-def _normal_rows(reduced) -> tuple[np.ndarray, sp.csr_array]:
-    """``(nodes, N)``: the face's nodes and the sparse map from free-dof vectors to their normal displacements."""
-    model, contact = reduced.model, reduced.contact
-    nodes = np.asarray(contact.nodes, dtype=np.int64)
-    nu = contact.normal_for(model)
-    rows, cols, vals = [], [], []
-    for r, k in enumerate(nodes):
-        idx = np.flatnonzero(model.dofs.node == k)
-        rows += [r] * idx.size
-        cols += idx.tolist()
-        vals += nu[model.dofs.direction[idx]].tolist()
-    return nodes, sp.csr_array((vals, (rows, cols)), shape=(nodes.size, model.n_dofs))
-
-
 def tip_excursion(reduced, orbit, samples: int = SAMPLES) -> dict | None:
     """How far beyond the clearance the face's mean and each of its nodes go over one period of ``orbit``
     (``None`` for a single-node contact).
 
-    Returns ``{"clearance_m", "mean_max_m", "node_max_m", "node", "node_id", "position_mm", "t_over_T",
-    "nodes_beyond", "nodes"}``: the largest ``ν·u − d`` of the face mean and of any node (m; negative: never
-    reaches the clearance), the node reaching farthest (0-based index and the mesh file's number), its position
-    (mm), when (``t/T``), and how many of the face's nodes pass the clearance at some instant.
+    Returns ``{"clearance_m", "mean_max_m", "node_max_m", "node", "node_id", "position_mm", "node_clearance_m",
+    "t_over_T", "nodes_beyond", "nodes"}``: the largest ``ν·u − d`` of the face mean and of any node (each node
+    with its own normal and clearance under a casing of revolution; m; negative: never reaches the clearance),
+    the node reaching farthest (0-based index and the mesh file's number), its position (mm) and clearance, when
+    (``t/T``), and how many of the face's nodes pass their clearance at some instant.
     """
     contact, model = reduced.contact, reduced.model
     if len(contact.nodes) < 2:
         return None
-    nodes, N = _normal_rows(reduced)
+    nodes = np.asarray(contact.nodes, dtype=np.int64)
+    d, _ = contact.node_clearances(model)  # each node's own clearance (a casing of revolution), else the gap
     times = np.linspace(0.0, orbit.T, samples, endpoint=False)
     x, _ = orbit.state(times)
     u = reduced.free_dofs(x)  # (n_free, samples)
-    normal = N @ u  # (nodes, samples)
+    excess = contact.node_normal_map(model) @ u - d[:, None]  # (nodes, samples): ν_k·u_k − d_k
     gap = float(contact.gap)
     mean = contact.w(model) @ u
-    k, j = np.unravel_index(int(np.argmax(normal)), normal.shape)
+    k, j = np.unravel_index(int(np.argmax(excess)), excess.shape)
     node = int(nodes[k])
-    return {"clearance_m": gap, "mean_max_m": float(mean.max() - gap), "node_max_m": float(normal[k, j] - gap),
+    return {"clearance_m": gap, "mean_max_m": float(mean.max() - gap), "node_max_m": float(excess[k, j]),
             "node": node, "node_id": int(model.mesh.node_ids[node]),
             "position_mm": (np.asarray(model.mesh.points[node], dtype=float) * 1e3).round(3).tolist(),
-            "t_over_T": float(times[j] / orbit.T), "nodes_beyond": int((normal.max(axis=1) > gap).sum()),
+            "node_clearance_m": float(d[k]),
+            "t_over_T": float(times[j] / orbit.T), "nodes_beyond": int((excess.max(axis=1) > 0).sum()),
             "nodes": int(nodes.size)}
 
 

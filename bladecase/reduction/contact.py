@@ -189,6 +189,11 @@ class Contact:
     #: The casing's stiffness (N/m) against the contact, in series with the blade's (``inf``: a rigid casing, the
     #: seed's model). Only the massless contact model takes a compliant casing (:meth:`with_casing`).
     casing: float = field(default=float("inf"), repr=False)
+    #: Per-node unit normals of a face on a casing of revolution (:meth:`on_casing`), in the order of ``nodes``;
+    #: empty: every node takes ``normal``.
+    normals: tuple[tuple[float, ...], ...] = field(default=(), repr=False)
+    #: Per-node clearances along those normals (m); ``gap`` is then their weighted mean (the constraint's).
+    clearances: tuple[float, ...] = field(default=(), repr=False)
 
     def __post_init__(self) -> None:
         node = self.node
@@ -218,6 +223,14 @@ class Contact:
         if not casing > 0:
             raise ValueError(f"casing stiffness must be a number > 0 in N/m (inf: a rigid casing), got {self.casing!r}")
         object.__setattr__(self, "casing", casing)
+        normals = tuple(_unit("normals", v) for v in self.normals)
+        clearances = tuple(float(x) for x in self.clearances)
+        if normals or clearances:
+            if len(normals) != len(nodes) or len(clearances) != len(nodes) or not np.all(np.isfinite(clearances)):
+                raise ValueError(f"a face on a casing needs one normal and one finite clearance per node of nodes "
+                                 f"({len(nodes)}), got {len(normals)} normals and {len(clearances)} clearances")
+        object.__setattr__(self, "normals", normals)
+        object.__setattr__(self, "clearances", clearances)
 
     def with_casing(self, stiffness: float) -> Contact:
         """This contact against a compliant casing of ``stiffness`` N/m (``inf``: rigid).
@@ -348,7 +361,11 @@ class Contact:
             scale = np.array([weight[k] for k in model.dofs.node[idx]])
         else:
             scale = 1.0 / max(len(self.nodes), 1)
-        w[idx] = nu[model.dofs.direction[idx]] * scale
+        if self.normals:  # each node's own casing normal
+            own = {k: _in_dim("normals", v, model.dim) for k, v in zip(self.nodes, self.normals, strict=True)}
+            w[idx] = np.array([own[k][c] for k, c in zip(model.dofs.node[idx], model.dofs.direction[idx])]) * scale
+        else:
+            w[idx] = nu[model.dofs.direction[idx]] * scale
         if not np.any(w):  # a free node always has all its directions free; guard anyway
             raise ValueError(f"the normal {tuple(nu)} has no component on the free dofs of node "
                              f"{_name(model, self.node)}")
@@ -375,7 +392,8 @@ class Contact:
     def _resolved(self, model: FEModel) -> Contact:
         """This contact with its normal made explicit for ``model``, after checking the node."""
         self.dofs(model)
-        return Contact(self.node, tuple(self.normal_for(model)), self.gap, self.nodes, self.weights, self.casing)
+        return Contact(self.node, tuple(self.normal_for(model)), self.gap, self.nodes, self.weights, self.casing,
+                       self.normals, self.clearances)
 
     @classmethod
     def face(cls, model: FEModel, group: str | Sequence[int] = "tip", normal: Sequence[float] | None = None,
@@ -419,6 +437,78 @@ class Contact:
         middle = int(nodes[np.argmin(np.linalg.norm(model.mesh.points[nodes] - centre, axis=1))])
         omega = tuple(float(x) for x in _area_weights(model, group, nodes)) if weights == "area" else ()
         return cls(middle, normal, gap, tuple(int(k) for k in nodes), omega)._resolved(model)
+
+    @classmethod
+    def on_casing(cls, model: FEModel, casing, group: str | Sequence[int] = "tip", weights: str = "area") -> Contact:
+        """The face contact of ``group`` under a casing of revolution (:class:`~bladecase.reduction.casing.Casing`):
+        each node with its own normal (the casing's, there) and its own clearance along it; the constraint is the
+        weighted mean of the nodes' normal displacements against the weighted mean clearance.
+
+        ``ValueError`` naming the node when a node of the face touches or crosses the casing at rest.
+
+        >>> from skfem import MeshTri
+        >>> from bladecase.fe import Mesh, assemble
+        >>> from bladecase.fe.rotation import RotationAxis
+        >>> from bladecase.reduction.casing import Casing
+        >>> t = MeshTri.init_tensor(np.linspace(-0.01, 0.01, 5), np.linspace(0.2, 0.3, 21))
+        >>> p = np.c_[t.p.T, np.zeros(t.p.shape[1])]
+        >>> strip = Mesh(p, {"triangle": t.t.T}, dim=2, groups={"root": np.flatnonzero(p[:, 1] == 0.2),
+        ...                                                     "tip": np.flatnonzero(p[:, 1] == 0.3)})
+        >>> model = assemble(strip, "steel", order=1, thickness=0.002)
+        >>> c = Contact.on_casing(model, Casing(RotationAxis((0, 0, 0), (0, 0, 1)), radius=0.3002))
+        >>> np.round(np.array(c.clearances) * 1e6, 2).tolist()    # µm: the corners are farther from the axis
+        [33.38, 158.34, 200.0, 158.34, 33.38]
+        >>> round(c.gap * 1e6, 2), np.round(c.normals[0], 4).tolist()   # area-weighted mean; a radial normal
+        (137.51, [-0.0333, 0.9994, 0.0])
+        """
+        face = cls.face(model, group, None, 1.0, weights)
+        points = np.zeros((len(face.nodes), 3))
+        points[:, : model.dim] = np.asarray(model.mesh.points, dtype=float)[list(face.nodes), : model.dim]
+        d, n = casing.clearances(points)
+        if (d <= 0).any():
+            k = int(np.argmin(d))
+            raise ValueError(f"contact node {model.mesh.node_id(face.nodes[k])} at {points[k].round(6).tolist()} "
+                             f"touches or crosses the casing at rest (clearance {d[k]:.4g} m): check the casing's "
+                             "radius, its axis, and the mesh's unit")
+        omega = np.array(face.weights) if face.weights else np.full(len(face.nodes), 1.0 / len(face.nodes))
+        gap = float(omega @ d)
+        mean = omega @ n
+        return cls(face.node, tuple((mean / np.linalg.norm(mean))[: model.dim].tolist()), gap, face.nodes,
+                   face.weights, face.casing, tuple(tuple(v) for v in n.tolist()), tuple(d.tolist()))
+
+    def node_clearances(self, model: FEModel) -> tuple[np.ndarray, np.ndarray]:
+        """``(d, ν)`` of every node of the contact (its ``nodes``, or the one ``node``): its clearance and unit
+        normal, ``(k,)`` and ``(k, dim)``."""
+        nodes = self.nodes or (self.node,)
+        if self.normals:
+            nu = np.array([_in_dim("normals", v, model.dim) for v in self.normals])
+            return np.array(self.clearances), nu
+        return np.full(len(nodes), self.gap), np.tile(self.normal_for(model), (len(nodes), 1))
+
+    def node_normal_map(self, model: FEModel):
+        """The sparse ``(k, n_dofs)`` map from free-dof vectors to the normal displacement ``ν_k·u_k`` of each node
+        of the contact (its ``nodes``, or the one ``node``), each with its own normal."""
+        import scipy.sparse as sp
+
+        nodes = self.nodes or (self.node,)
+        _, nu = self.node_clearances(model)
+        rows, cols, vals = [], [], []
+        for r, k in enumerate(nodes):
+            idx = np.flatnonzero(model.dofs.node == k)
+            rows += [r] * idx.size
+            cols += idx.tolist()
+            vals += nu[r][model.dofs.direction[idx]].tolist()
+        return sp.csr_array((vals, (rows, cols)), shape=(len(nodes), model.n_dofs))
+
+    def closed_by(self, model: FEModel, u: np.ndarray) -> Contact:
+        """This contact after its nodes moved by the free-dof displacement ``u`` (a static state, e.g. the
+        centrifugal one): the clearance ``gap − wᵀu`` and each node's ``d_k − ν_k·u_k`` (a node's may close;
+        ``ValueError`` when the constraint's own clearance does: the caller checks ``gap − wᵀu`` first)."""
+        import dataclasses
+
+        clearances = tuple((np.array(self.clearances) - self.node_normal_map(model) @ u).tolist()) \
+            if self.clearances else ()
+        return dataclasses.replace(self, gap=self.gap - float(self.w(model) @ u), clearances=clearances)
 
     def __repr__(self) -> str:
         where = f"face of {len(self.nodes)} nodes around node={self.node}" if self.nodes else f"node={self.node}"

@@ -33,6 +33,9 @@ def save_reduced(reduced: ReducedModel, path) -> None:
            "contact/nodes": np.array(c.nodes, dtype=np.int64), "contact/weights": np.array(c.weights, dtype=float)}
     if np.isfinite(c.casing):
         out["contact/casing"] = np.array(c.casing)
+    if c.normals:  # a face on a casing of revolution: each node's normal and clearance
+        out["contact/normals"] = np.array(c.normals, dtype=float)
+        out["contact/clearances"] = np.array(c.clearances, dtype=float)
     if getattr(s, "contact_model", "newton") == "massless":  # MasslessSystem: S and kc instead of K
         out.update({"contact_model": np.array("massless"), "Mr": s.M, "Sr": s.S, "kc": np.array(s.kc),
                     "closed_shape": reduced.closed_shape, "masses": reduced.masses})
@@ -89,9 +92,13 @@ def _reduced_from_arrays(data: dict, source: str) -> ReducedModel:
     weights = tuple(float(x) for x in npz_array(data, "contact/weights", source, 1)) if "contact/weights" in data \
         else ()
     casing = scalar("contact/casing") if "contact/casing" in data else float("inf")
+    normals = tuple(map(tuple, npz_array(data, "contact/normals", source, 2, finite=True).tolist())) \
+        if "contact/normals" in data else ()
+    clearances = tuple(npz_array(data, "contact/clearances", source, 1, finite=True).tolist()) \
+        if "contact/clearances" in data else ()
     try:
         contact = Contact(scalar("contact/node", "int"), tuple(normal) if normal.size else None,
-                          scalar("contact/gap"), nodes, weights, casing)
+                          scalar("contact/gap"), nodes, weights, casing, normals, clearances)
         contact.dofs(model)
         contact.normal_for(model)
     except ValueError as exc:

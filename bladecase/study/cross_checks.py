@@ -10,7 +10,7 @@ import math
 from ..fe import Material, PlateGeometry
 from ..fe.geometry import estimate_cells
 from .keys import StudyError, one_line
-from .sections import execution_checks, forcing_checks, rotation_checks
+from .sections import casing_checks, execution_checks, forcing_checks, rotation_checks
 from .values import LIMITS
 
 __all__ = ["MASSLESS_METHODS", "cross_checks"]
@@ -50,7 +50,7 @@ def _cell_checks(c: dict) -> None:
                      f"more than [limits] cells = {cap}: {fix}, or raise [limits] cells")
 
 
-def cross_checks(c: dict) -> None:
+def cross_checks(c: dict, model: bool = True) -> None:
     """Every check across keys and sections of a validated study ``c`` (its sections filled in)."""
     m = c["material"]
     given = [k for k in ("E", "nu", "rho") if m[k] is not None]
@@ -85,6 +85,7 @@ def cross_checks(c: dict) -> None:
     forcing_checks(c)
     execution_checks(c)
     rotation_checks(c)
+    casing_checks(c, model)
     o, s = c["output"], c["search"]
     for i, item in enumerate(o["orbits"]):
         if item["ipp"] not in s["ipp"]:

@@ -108,7 +108,8 @@ def operating_point(study: Study, model, contact, factor=None):
              "centrifugal closure %.4g mm)", info["speed_rpm"], omega, axis.direction.round(6).tolist(),
              axis.origin.tolist(), info["clearance_running_m"] * 1e3, info["clearance_cold_m"] * 1e3,
              info["closure_m"] * 1e3)
-    hot = dataclasses.replace(contact, gap=info["clearance_running_m"])
+    hot = contact.closed_by(model, state.displacement) if info["clearance_cold_m"] == contact.gap \
+        else dataclasses.replace(contact, gap=info["clearance_running_m"])  # clearance_at = "speed": as given
     return state.model, hot, state.factor, info
 
 
@@ -128,7 +129,7 @@ def _speed_point(omega: float, *, study: Study, model, contact, axis: RotationAx
     if d <= 0:
         point["note"] = "clearance closed: the blade rests on its casing"
         return point
-    hot = dataclasses.replace(contact, gap=d)
+    hot = contact.closed_by(model, state.displacement)  # the contact's clearance is the cold one here
     reduced = build_reduced(study, state.model, hot, factor=state.factor)
     families = search(study, reduced.system, label=f"{omega * 60 / (2 * math.pi):.6g} rpm")
     arcs = [a for f in families for a in f.arcs]

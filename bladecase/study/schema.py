@@ -32,6 +32,7 @@ from .cross_checks import MASSLESS_METHODS, cross_checks  # noqa: F401 (MASSLESS
 from .demo import NEWTON_DEMO, demo_study, demo_text  # noqa: F401 (re-exported: they lived here)
 from .keys import _BOOL, _INT, _LIST, _NUM, _STR, REQUIRED, Key, StudyError, one_line  # noqa: F401
 from .sections import (
+    CASING_KEYS,
     EXECUTION_KEYS,
     FORCING_KEYS,
     LIMIT_KEYS,
@@ -126,7 +127,8 @@ SCHEMA: dict[str, dict[str, Key]] = {
                            _int_between(1, LIMITS["frequencies"])),
     },
     "contact": {
-        "clearance": Key(_NUM, REQUIRED, "Clearance d between the contact node at rest and the casing (m).",
+        "clearance": Key(_NUM, None, "Clearance d between the contact node at rest and the casing (m); required "
+                         "unless a [casing] gives each node's.",
                          lambda v: "must be > 0 (metres)" if not v > 0 else _in_range("clearance")(v)),
         "group": Key(_STR, None, "Mesh group of the contact node: alone, a one-node group (default "
                      "'contact'); with 'farthest', the group searched (default 'tip'); with 'nearest', the group "
@@ -217,6 +219,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
                    None if v >= MIN_FPS else f"must be at least {MIN_FPS:g} frames per second"),
     },
     "rotation": ROTATION_KEYS,
+    "casing": CASING_KEYS,
     "execution": EXECUTION_KEYS,
     "limits": LIMIT_KEYS,
 }
@@ -447,7 +450,7 @@ def validate(raw: dict, source: str = "<string>", base: str | os.PathLike | None
                     raise StudyError(f"[{section}] {key}: required ({spec.doc})")
                 out[key] = list(spec.default) if isinstance(spec.default, list) else spec.default
         config[section] = out
-    cross_checks(config)
+    cross_checks(config, model=model)
     return Study(config=config, source=source, base=Path(base) if base is not None else Path.cwd())
 
 

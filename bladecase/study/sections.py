@@ -272,3 +272,54 @@ def rotation_checks(c: dict) -> None:
     if r["engine_orders"] and not r["speeds"]:
         raise StudyError(f"[rotation] engine_orders: drawn on the Campbell diagram, which needs speeds; got "
                          f"{r['engine_orders']} without speeds")
+
+
+def _radii(v) -> str | None:
+    ok = (len(v) == 2 and all(isinstance(p, list) and len(p) == 2 and all(
+        isinstance(x, (int, float)) and not isinstance(x, bool) and np.isfinite(x) for x in p) for p in v))
+    if not ok or v[0][0] == v[1][0] or min(v[0][1], v[1][1]) <= 0:
+        return "must be [[s1, R1], [s2, R2]]: two distinct axial stations (m along the axis) with radii > 0 (m)"
+    return None
+
+
+#: ``[casing]``: key → :class:`~bladecase.study.keys.Key` (a casing of revolution under a face contact).
+CASING_KEYS: dict[str, Key] = {
+    "radius": Key(_NUM, None, "A cylindrical casing's radius (m) about the axis.",
+                  lambda v: None if np.isfinite(v) and v > 0 else "must be a finite number > 0 (m)"),
+    "radii": Key(_LIST, None, "A conical casing: [[s1, R1], [s2, R2]], radii (m) at two axial stations (m along the "
+                 "axis from its origin), linear in between and beyond.", _radii),
+    "axis": Key((dict,), None, "The casing's axis, {origin = [x, y, z], direction = [dx, dy, dz]}; default: "
+                "[rotation] axis.", _axis),
+}
+
+
+def casing_checks(c: dict, model: bool = True) -> None:
+    """``[casing]``: one of radius/radii, an axis (its own or [rotation]'s), a face contact, no [contact] clearance
+    (each node's comes from the casing); without ``[casing]``, ``[contact] clearance`` is required."""
+    k = c.get("casing") or {}
+    given = k and (k.get("radius") is not None or k.get("radii") is not None)
+    ct = c["contact"]
+    if not given:
+        if k.get("axis") is not None:
+            raise StudyError("[casing] axis: a casing needs radius (a cylinder) or radii (a cone)")
+        if ct["clearance"] is None and model:
+            raise StudyError("[contact] clearance: required (m), or a [casing] with radius or radii from which each "
+                             "contact node's clearance is computed")
+        return
+    if k["radius"] is not None and k["radii"] is not None:
+        raise StudyError("[casing] radii: give radius (a cylinder) or radii (a cone), not both")
+    if k["axis"] is None:
+        r = c.get("rotation") or {}
+        if r.get("axis") is None:
+            raise StudyError("[casing] axis: required (or [rotation] axis): the casing is a surface of revolution "
+                             "about the engine axis")
+        k["axis"] = dict(r["axis"])
+    else:
+        axis = k["axis"]
+        k["axis"] = {"origin": list(axis.get("origin", [0.0, 0.0, 0.0])), "direction": list(axis["direction"])}
+    if ct["face"] is None and ct.get("nodes") is None:
+        raise StudyError("[casing]: each node of a contact face gets its clearance from the casing: set [contact] "
+                         "face (e.g. 'tip') or nodes")
+    if ct["clearance"] is not None:
+        raise StudyError(f"[contact] clearance: with a [casing], each node's clearance comes from the casing; remove "
+                         f"clearance = {ct['clearance']!r}")

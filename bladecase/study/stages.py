@@ -252,11 +252,26 @@ def build_contact(study: Study, model: FEModel) -> Contact:
     return contact if casing is None else contact.with_casing(casing)
 
 
+def _casing(study: Study):
+    """``[casing]`` as a :class:`~bladecase.reduction.casing.Casing` (``None`` without one)."""
+    k = study.config.get("casing") or {}
+    if k.get("radius") is None and k.get("radii") is None:
+        return None
+    from ..fe.rotation import RotationAxis
+    from ..reduction.casing import Casing
+
+    axis = RotationAxis(k["axis"]["origin"], k["axis"]["direction"])
+    return Casing(axis, radius=k["radius"], radii=None if k["radii"] is None else tuple(map(tuple, k["radii"])))
+
+
 def _picked_contact(study: Study, model: FEModel) -> Contact:
     c = study["contact"]
     normal, gap = c["normal"], c["clearance"]
     group = contact_group(study)
     try:
+        casing = _casing(study)
+        if casing is not None:  # each node its own clearance and normal from the casing of revolution
+            return Contact.on_casing(model, casing, group, weights=c["weights"] or "area")
         if c["face"] is not None or c.get("nodes") is not None:
             return Contact.face(model, group, normal, gap, weights=c["weights"] or "equal")
         if c["node"] is not None:  # a node number as in the mesh file
