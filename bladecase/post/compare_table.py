@@ -258,7 +258,10 @@ def _kept(models: list[dict], factor: float, compliance_rtol: float, fe_row: dic
 
 def _findings(models: list[dict], error: float) -> list[str]:
     if models and all(r.get("admissible_arcs") == 0 for r in models):
-        out = ["no model found an admissible arc: widen the search (periods, ipp) or check the contact point"]
+        # the massless contact model searches one contact phase per period: only the periods can be widened
+        massless = all(r.get("contact_model") == "massless" for r in models)
+        out = [f"no model found an admissible arc: widen the search ({'periods' if massless else 'periods, ipp'}) "
+               "or check the contact point"]
     else:
         out = [f"{r['model']} found no admissible arc" + (f" ({_count(r['families'], 'family')})"
                                                           if r.get("families") else "")

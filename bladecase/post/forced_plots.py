@@ -1,7 +1,8 @@
 """The forced response of a blade drawn over the nonsmooth modes of the same model (pyplot-free figures).
 
 :func:`forced_response_plot` draws, against the forcing frequency, the steady states of a forcing sweep
-(:mod:`bladecase.nsm.sweep`) coloured by their class "k impacts per p forcing periods", the non-periodic ones
+(:mod:`bladecase.nsm.sweep`) coloured by their class "k impacts per p forcing periods" ("k contact phases" for the
+massless contact model), the non-periodic ones
 and those without contact marked apart, over the admissible arcs of the nonsmooth modes (energy constant
 along each orbit) as curves.  The quantity is the energy (the maximum over the steady cycle of
 ``½vᵀMv + ½xᵀKx``, the backbones' own energy measure) or the contact-node displacement along the casing
@@ -15,7 +16,7 @@ from collections.abc import Sequence
 import numpy as np
 from matplotlib.figure import Figure
 
-from .plots import COLORS, _once, new_figure
+from .plots import COLORS, _once, is_massless, new_figure, per_period
 
 __all__ = ["CLASS_COLORS", "forced_response_plot"]
 
@@ -31,7 +32,8 @@ def _class_key(label: str) -> tuple[int, int]:
 
 
 def _backbone_arcs(ax, backbones: Sequence, labelled: set) -> list[float]:
-    """The admissible arcs of every branch as curves (one colour per ipp); returns their energies."""
+    """The admissible arcs of every branch as curves (one colour per number of impacts or contact phases per
+    period); returns their energies."""
     energies: list[float] = []
     for bb in backbones:
         c = COLORS[(bb.ipp - 1) % len(COLORS)]
@@ -43,8 +45,25 @@ def _backbone_arcs(ax, backbones: Sequence, labelled: set) -> list[float]:
                 continue
             energies.extend(E[sl][ok].tolist())
             ax.plot(f[sl][ok], E[sl][ok], "-" if ok.sum() > 1 else "o", color=c, lw=1.6, ms=4, alpha=0.85,
-                    label=_once(labelled, f"{bb.ipp}-ipp nonsmooth mode (admissible arcs)"))
+                    label=_once(labelled, _mode_label(bb)))
     return energies
+
+
+def _mode_label(bb) -> str:
+    """The legend of a branch's arcs: ``"1-ipp nonsmooth mode …"`` (Newton), ``"nonsmooth mode, 1 contact phase /
+    period …"`` (massless)."""
+    if is_massless(bb):
+        return f"nonsmooth mode, {per_period(bb.ipp, True)} (admissible arcs)"
+    return f"{bb.ipp}-ipp nonsmooth mode (admissible arcs)"
+
+
+def _class_words(k: str, p: str, massless: bool) -> str:
+    """The legend of a steady-state class ``k/p``: impacts (Newton) or contact phases (massless) per ``p`` forcing
+    periods."""
+    if k == "0":
+        return f"periodic, no contact{'' if p == '1' else f' ({p} periods)'}"
+    event = "contact phase" if massless else "impact"
+    return f"{k} {event}{'s' if k != '1' else ''} / {p} period{'s' if p != '1' else ''}"
 
 
 def forced_response_plot(
@@ -59,6 +78,7 @@ def forced_response_plot(
     engine_order: int | None = None,
     title: str | None = None,
     ax=None,
+    massless: bool | None = None,
 ) -> Figure:
     """Steady states of a forced sweep against the forcing frequency, over the nonsmooth-mode arcs.
 
@@ -78,6 +98,9 @@ def forced_response_plot(
         Clearance (m), drawn as a horizontal line for ``quantity="contact"``.
     engine_order : int, optional
         Adds the rotation speed ``60 f / EO`` (rpm) as a top axis.
+    massless : bool, optional
+        The states are of the massless contact model: their classes count contact phases, not impacts. Not set:
+        as the ``backbones`` (Newton's impacts without any).
 
     Examples
     --------
@@ -105,15 +128,15 @@ def forced_response_plot(
         ax = fig.add_subplot()
     else:
         fig = ax.figure
+    if massless is None:
+        massless = any(is_massless(bb) for bb in backbones)
     labelled: set = set()
     drawn_E = _backbone_arcs(ax, backbones, labelled) if quantity == "energy" else []
     up = np.array([s == "up" for s in sweep])
     lab = np.array(labels, dtype=object)
     classes = sorted({s for s in labels if "/" in s}, key=_class_key)
     for i, cls in enumerate(classes):
-        k, p = cls.split("/")
-        text = f"{k} impact{'s' if k != '1' else ''} / {p} period{'s' if p != '1' else ''}" if k != "0" else \
-            f"periodic, no contact{'' if p == '1' else f' ({p} periods)'}"
+        text = _class_words(*cls.split("/"), massless)
         for mask, marker in ((up, "^" if not up.all() else "o"), (~up, "v")):
             m = (lab == cls) & mask
             if m.any():

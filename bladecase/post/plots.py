@@ -14,8 +14,30 @@ from collections.abc import Sequence
 import numpy as np
 from matplotlib.figure import Figure
 
-#: Colours by number of impacts per period (cycled).
+#: Colours by number of impacts (massless model: contact phases) per period (cycled).
 COLORS = ("C0", "C1", "C2", "C3", "C4", "C5")
+
+
+def is_massless(item) -> bool:
+    """Whether ``item`` — a system, a branch, an orbit (or anything with a ``system``) — is of the massless contact
+    model (contact phases of finite duration), not Newton's (impacts)."""
+    if getattr(item, "contact_model", None) == "massless":
+        return True
+    if getattr(getattr(item, "system", None), "contact_model", None) == "massless":
+        return True
+    return any(getattr(o, "contact_model", None) == "massless" for o in (getattr(item, "orbits", None) or [])[:1])
+
+
+def per_period(k: int, massless: bool) -> str:
+    """How many contacts a period holds, in the contact model's words: impacts (``"1 ipp"``) for Newton's law,
+    contact phases for the massless model.
+
+    >>> per_period(1, False), per_period(1, True), per_period(2, True)
+    ('1 ipp', '1 contact phase / period', '2 contact phases / period')
+    """
+    if not massless:
+        return f"{k} ipp"
+    return f"{k} contact phase{'' if k == 1 else 's'} / period"
 
 
 class NotebookFigure(Figure):
@@ -67,7 +89,8 @@ def frequency_energy(
 
     ``backbones`` are :class:`bladecase.Backbone` (1 ipp) or
     :class:`bladecase.Family` (k ipp) objects, one colour per number of
-    impacts per period.  Admissible orbits are drawn as solid curves,
+    impacts per period (contact phases per period for the massless contact
+    model, and so labelled: :func:`per_period`).  Admissible orbits are drawn as solid curves,
     non-admissible ones as faint dots; the ends of the admissible intervals
     are dotted vertical lines, and the linear frequencies ``ω_j/2π`` in range
     dashed black ones.  Every kind of mark has a legend entry (labels are on
@@ -135,7 +158,8 @@ def frequency_energy(
             _stability_curves(ax, bb, f, E, adm, c, labelled)
         else:
             Ea = np.where(adm, E, np.nan)  # NaN breaks the curve between admissible arcs
-            ax.plot(f, Ea, "-", lw=1.8, color=c, label=_once(labelled, f"{bb.ipp} ipp (admissible)", adm.any()))
+            label = _once(labelled, f"{per_period(bb.ipp, is_massless(bb))} (admissible)", adm.any())
+            ax.plot(f, Ea, "-", lw=1.8, color=c, label=label)
         for iv in bb.intervals:
             for T, refined in ((iv.T_lo, iv.refined_lo), (iv.T_hi, iv.refined_hi)):
                 if refined:
@@ -176,7 +200,8 @@ def _narrow_arcs(ax, backbones, fmin: float, fmax: float, labelled: set) -> None
                 continue
             i = (arc.start + arc.stop) // 2
             ax.plot([f[i]], [E[i]], "o", ms=5, mfc="none", color=c,
-                    label=_once(labelled, f"{bb.ipp} ipp (admissible arc narrower than a pixel)"))
+                    label=_once(labelled, f"{per_period(bb.ipp, is_massless(bb))} (admissible arc narrower than a "
+                                             "pixel)"))
 
 
 def _stability_curves(ax, bb, f, E, adm, c, labelled: set) -> None:
@@ -187,7 +212,8 @@ def _stability_curves(ax, bb, f, E, adm, c, labelled: set) -> None:
     for mask, ls, word in ((stable, "-", "stable"), (unstable, "--", "unstable")):
         grown = mask | (np.r_[mask[1:], False] & adm) | (np.r_[False, mask[:-1]] & adm)
         ax.plot(f, np.where(grown, E, np.nan), ls, lw=1.8, color=c,
-                label=_once(labelled, f"{bb.ipp} ipp, admissible, {word} (Floquet)", mask.any()))
+                label=_once(labelled, f"{per_period(bb.ipp, is_massless(bb))}, admissible, {word} (Floquet)",
+                                   mask.any()))
 
 
 def _once(labelled: set, label: str, drawn: bool = True) -> str | None:

@@ -10,9 +10,56 @@ from .rotation_report import rotation_report
 NARROW_RTOL = 1e-3
 
 
+def massless_summary(summary: dict) -> bool:
+    """Whether a run's summary is of the massless contact model (contact phases, not impacts)."""
+    model = summary["contact"].get("model")
+    if model is not None:
+        return model == "massless"
+    return str(summary["reduction"].get("method", "")).startswith("massless")  # a summary without the key
+
+
+def orbit_words(k: int, massless: bool) -> str:
+    """An orbit named by its contacts per period, in the contact model's words.
+
+    >>> orbit_words(1, True), orbit_words(2, True), orbit_words(2, False)
+    ('orbit with one contact phase per period', 'orbit with 2 contact phases per period', '2-ipp orbit')
+    """
+    if not massless:
+        return f"{k}-ipp orbit"
+    return f"orbit with {'one contact phase' if k == 1 else f'{k} contact phases'} per period"
+
+
+def engineering_words(a: dict, massless: bool) -> str:
+    """What the blade and the casing see over an animated orbit (its ``summary.json`` entry), in a sentence:
+    tip displacement, contact force (Newton: impulses) and duration, the casing's give.
+
+    >>> text = engineering_words({"tip_amplitude_mm": 0.5, "tip_amplitude_node_id": 3, "tip_amplitude_t_over_T": 0.09,
+    ...                           "contact_force_n": 27.3, "contact_fraction": 0.181,
+    ...                           "casing_penetration_m": 2.73e-5}, True)
+    >>> print(*text.split("; "), sep="\\n")
+    tip displacement up to 0.5 mm (node 3, t/T = 0.090)
+    contact force up to 27.3 N, in contact 18.1 % of the period
+    the casing yields up to 27.3 µm (λ/k)
+    """
+    if "tip_amplitude_mm" not in a:
+        return "no engineering quantities in this summary"
+    words = [f"tip displacement up to {a['tip_amplitude_mm']:.4g} mm (node {a['tip_amplitude_node_id']}, "
+             f"t/T = {a['tip_amplitude_t_over_T']:.3f})"]
+    if massless:
+        words.append(f"contact force up to {a['contact_force_n']:.4g} N, in contact "
+                     f"{100 * a['contact_fraction']:.3g} % of the period")
+        if a.get("casing_penetration_m") is not None:
+            words.append(f"the casing yields up to {a['casing_penetration_m'] * 1e6:.4g} µm (λ/k)")
+    else:
+        words.append(f"impulses up to {a['contact_impulse_ns']:.4g} N·s per impact (Newton's law: instantaneous "
+                     "impacts, no contact force and no contact duration)")
+    return "; ".join(words)
+
+
 def report(summary: dict) -> str:
     """A human-readable Markdown report of a run's :data:`summary`."""
     m, c, r = summary["model"], summary["contact"], summary["reduction"]
+    massless = massless_summary(summary)
     lines = [f"# bladecase study `{summary['study']}`", "",
              f"Study file: `{summary['source']}` — bladecase {summary['bladecase_version']} — "
              f"total {summary['timings_s']['total']:.1f} s.", "",
@@ -26,11 +73,13 @@ def report(summary: dict) -> str:
              "- Linear frequencies (full FE model, Hz): " + ", ".join(f"{f:.2f}" for f in m["linear_frequencies_hz"]),
              *_plausibility_words(m),
              "", "## Contact", "",
-             (f"- Face of {len(c['face_nodes'])} nodes ({c.get('face_weights', 'equal')} weights; mean normal "
-              f"displacement), centre node {_node(c)}" if len(c.get("face_nodes", [])) > 1 else f"- Node {_node(c)}")
+             (f"- {_face_words(c)}, centre node {_node(c)}" if len(c.get("face_nodes", [])) > 1
+              else f"- Node {_node(c)}")
              + f" at ({', '.join(f'{x * 1e3:.5g}' for x in c['position'])}) mm, casing normal "
              f"({', '.join(f'{x:.4g}' for x in c['normal'])}), clearance {c['clearance_m'] * 1e3:.4g} mm.",
-             _casing_words(c.get("casing_stiffness_n_per_m")),
+             _model_words(massless),
+             _casing_words(c.get("casing_stiffness_n_per_m"), c),
+             *_static_words(c),
              *rotation_report(summary.get("rotation"), summary.get("campbell")),
              "", "## Reduced model", "",
              f"- {r['method']} (size {r['size']}): {r['reduced_dofs']} reduced dofs.", "",
@@ -49,18 +98,21 @@ def report(summary: dict) -> str:
     if summary.get("comparison"):
         lines += comparison_report(summary["comparison"])
     if summary.get("forcing"):
-        lines += forcing_report(summary["forcing"], summary["files"].get("forced_animations", []))
+        lines += forcing_report(summary["forcing"], summary["files"].get("forced_animations", []),
+                                massless=massless)
     s = summary["search"]
+    per = "contact phases per period" if massless else "impacts per period (ipp)"
     lines += ["", "## Nonsmooth modes", "",
-              f"Search: ipp {s['ipp']}, periods {s['periods']} × {s['period_unit']} "
+              f"Search: {per} {s['ipp']}, periods {s['periods']} × {s['period_unit']} "
               f"(= [{s['periods'][0] * s['period_unit_s']:.6g}, {s['periods'][1] * s['period_unit_s']:.6g}] s), "
               f"scan {s['scan']}.", ""]
     fams = summary["families"]
     with_arcs = [(i, f) for i, f in enumerate(fams) if f["admissible_arcs"]]
     lines.append(f"{len(fams)} families found, {len(with_arcs)} with admissible arcs "
                  f"(families without any are listed in `summary.json`).")
-    lines += ["", "| family | ipp | orbits | f range (Hz) | admissible arc f (Hz) | energy on arc (J) | "
-              "linearly stable (Floquet) |", "|---:|---:|---:|---|---|---|---|"]
+    lines += ["", f"| family | {'contact phases / period' if massless else 'ipp'} | orbits | f range (Hz) | "
+              "admissible arc f (Hz) | energy on arc (J) | linearly stable (Floquet) |",
+              "|---:|---:|---:|---|---|---|---|"]
     for i, f in with_arcs:
         for a in f["admissible_arcs"]:
             stable = a.get("stable_fraction")
@@ -68,21 +120,26 @@ def report(summary: dict) -> str:
                          f"{f['frequency_range_hz'][1]:.3f} | {a['f_lo']:.4f} – {a['f_hi']:.4f} | "
                          f"{a['energy_range_j'][0]:.3e} – {a['energy_range_j'][1]:.3e} | "
                          f"{'—' if stable is None else f'{stable:.0%} of its orbits'} |")
+    lines += _arc_engineering_table(with_arcs, massless)
     lines += [w for i, f in with_arcs if (w := _resonance_words(i, f))]
     widths = [(a["f_hi"] - a["f_lo"]) / a["f_hi"] for _, f in with_arcs for a in f["admissible_arcs"] if a["f_hi"] > 0]
     if widths and max(widths) < NARROW_RTOL:
         lines += ["", f"**Narrow:** the widest admissible arc spans {max(widths):.1e} of its frequency — in this model "
                   "the mode exists only next to where it grows from a linear mode (grazing); beyond, its orbits are "
-                  "not admissible (for the massless model the contact splits into several phases, "
-                  "docs/massless.md). Read its energies as those of a barely touching linear mode."]
+                  "not admissible" + (" (the contact splits into several phases, docs/massless.md)" if massless else "")
+                  + ". Read its energies as those of a barely touching linear mode."]
     files = summary["files"]
-    if summary.get("reference") and not files.get("animations"):
+    if summary.get("reference") and not files.get("animations") and not with_arcs:
+        lines += ["", "**No orbit animated:** no family has an admissible arc in the search range (widen [search] "
+                  "periods)."]
+    elif summary.get("reference") and not files.get("animations"):
         ref = summary["reference"]
         lines += ["", f"**No orbit animated:** no admissible orbit of the {r['method']} model that was tried survives "
                   f"in the reference model {ref['method']} ({ref['reduced_dofs']} dofs) — the families above are "
-                  "artefacts of the reduced model (see run.log). With Newton's impact law the orbits depend on the "
-                  "node's reduced mass; enlarging the model does not cure that: the massless contact model "
-                  "([contact] model = \"massless\", docs/massless.md) removes the impact law."]
+                  "artefacts of the reduced model (see run.log)." + ("" if massless else
+                  " With Newton's impact law the orbits depend on the node's reduced mass; enlarging the model does "
+                  "not cure that: the massless contact model ([contact] model = \"massless\", docs/massless.md) "
+                  "removes the impact law.")]
     lines += ["", "## Files", ""]
     if "frequency_energy_plot" in files:
         lines += [f"![frequency–energy]({files['frequency_energy_plot']})", ""]
@@ -94,7 +151,8 @@ def report(summary: dict) -> str:
                   if "contact_intervals" in a else
                   "impacts at t/T = " + ", ".join(f"{t / a['T']:.4f}" for t in a["impact_times"]))
         check = a["verification"]
-        lines.append(f"- family {a['family']}, {a['ipp']}-ipp orbit T = {a['T']:.8g} s (f = {a['frequency_hz']:.3f} "
+        lines.append(f"- family {a['family']}, {orbit_words(a['ipp'], massless)}, T = {a['T']:.8g} s "
+                     f"(f = {a['frequency_hz']:.3f} "
                      f"Hz, E = {a['energy_j']:.3e} J, "
                      f"{phases}, displacements × {a['scale']:.4g}; event-driven simulation returns to it to "
                      f"{check['return_error']:.1e}{'' if check['ok'] else ' — CHECK FAILED'}): {what}")
@@ -102,8 +160,13 @@ def report(summary: dict) -> str:
             lines.append(f"  - {_reference_words(a['reference_check'], a['ipp'])}")
         if "energy_words" in a:
             lines.append(f"  - {a['energy_words']}")
+        if "tip_amplitude_mm" in a:
+            text = engineering_words(a, massless)
+            lines.append(f"  - Tip and casing: {text}.")
         if "stability" in a:
-            lines.append(f"  - Stability (Floquet multipliers with saltation matrices): {a['stability']}.")
+            how = ("of the one-period map; the massless contact needs no saltation matrices" if massless
+                   else "with saltation matrices")
+            lines.append(f"  - Stability (Floquet multipliers {how}): {a['stability']}.")
         if a.get("tip_excursion"):
             x = a["tip_excursion"]
             lines.append(f"  - {'**Tip nodes beyond the clearance:** ' if x['nodes_beyond'] else 'Tip: '}"
@@ -149,11 +212,88 @@ def _plausibility_words(m: dict) -> list[str]:
     return [x for s in sentences if s for x in ("", f"**Warning — {s}.**")]
 
 
-def _casing_words(k: float | None) -> str:
+def _face_words(c: dict) -> str:
+    """``Face 'tip' of 26 nodes (area-weighted mean of their normal displacements)``."""
+    name = f" '{c['face']}'" if c.get("face") else ""
+    weights = "area-weighted" if c.get("face_weights") == "area" else "equal-weight"
+    return f"Face{name} of {len(c['face_nodes'])} nodes ({weights} mean of their normal displacements)"
+
+
+def _model_words(massless: bool) -> str:
+    if massless:
+        return ("- Contact model: massless — the contact dofs carry no inertia, and the casing pushes back with a "
+                "contact force λ over contact phases of finite duration (docs/massless.md).")
+    return ("- Contact model: Newton's impact law (restitution 1) — instantaneous impacts, each an impulse (N·s); "
+            "the contact has no duration and no force.")
+
+
+def _kc_words(c: dict) -> str:
+    kc = c.get("contact_stiffness_n_per_m")
+    if kc is None:
+        return "the contact's own stiffness"
+    return (f"the contact's own stiffness k_c = {kc:.4g} N/m (its dofs with the interior held, "
+            "1/(w_cᵀK_cc⁻¹w_c))")
+
+
+def _casing_words(k: float | None, c: dict | None = None) -> str:
+    c = c or {}
     if k is None:
+        if c.get("contact_stiffness_n_per_m") is not None:
+            return f"- Casing: rigid; the closed contact is as stiff as {_kc_words(c)}."
         return "- Casing: rigid (the clearance is closed by the contact alone)."
-    return (f"- Casing: compliant, {k:.4g} N/m in series with the contact's own stiffness — the contact moves λ/k "
-            "beyond the clearance while closed (docs/massless.md, \"A compliant casing\").")
+    series = c.get("series_stiffness_n_per_m")
+    return (f"- Casing: compliant, k = {k:.4g} N/m in series with {_kc_words(c)}"
+            + (f": the closed contact's stiffness is k_s = {series:.4g} N/m" if series is not None else "")
+            + "; the contact moves λ/k into the casing while closed (docs/massless.md, \"A compliant casing\").")
+
+
+def _static_words(c: dict) -> list[str]:
+    """The blade's static stiffness at the contact (the whole blade), against the casing's when compliant."""
+    ks = c.get("static_stiffness_n_per_m")
+    if ks is None:
+        return []
+    k = c.get("casing_stiffness_n_per_m")
+    versus = "" if k is None else f"; the casing's stiffness is {k / ks:.3g} × that"
+    return [f"- The blade's static stiffness at the contact: 1/(wᵀK⁻¹w) = {ks:.4g} N/m (the whole FE model, "
+            f"clamped at its root){versus}."]
+
+
+def _arc_engineering_table(with_arcs: list, massless: bool) -> list[str]:
+    """Tip displacement, contact force (Newton: impulses), contact duration and casing give over each admissible
+    arc, from the arc's ranges in the summary."""
+    rows = [(i, a) for i, f in with_arcs for a in f["admissible_arcs"] if "tip_amplitude_range_mm" in a]
+    if not rows:
+        return []
+    casing = massless and any("casing_penetration_range_m" in a for _, a in rows)
+    head = ["family", "admissible arc f (Hz)", "orbits used", "tip displacement (mm)"]
+    if massless:
+        head += ["peak contact force (N)", "in contact (% of the period)"] + (["casing penetration (µm)"] * casing)
+        what = ("the largest contact force λ, the share of the period in contact"
+                + (", how far the contact moves into the casing (λ/k)" if casing else ""))
+    else:
+        head += ["largest impulse (N·s)"]
+        what = "the largest impulse"
+    lines = ["", "Tip and casing over each admissible arc, lowest – highest over the orbits used (evenly spread over "
+             f"the arc, ends included), each expanded to the FE model: the largest tip displacement |u| over the "
+             f"period, {what}.", "", "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+
+    def span(a: dict, key: str, scale: float = 1.0, fmt: str = ".4g") -> str:
+        lo, hi = a.get(key) or (None, None)
+        return "—" if lo is None else f"{lo * scale:{fmt}} – {hi * scale:{fmt}}"
+
+    for i, a in rows:
+        cells = [str(i), f"{a['f_lo']:.4f} – {a['f_hi']:.4f}", str(a["engineering_orbits"]),
+                 span(a, "tip_amplitude_range_mm")]
+        if massless:
+            cells += [span(a, "contact_force_range_n"), span(a, "contact_fraction_range", 100, ".3g")]
+            cells += [span(a, "casing_penetration_range_m", 1e6)] * casing
+        else:
+            cells.append(span(a, "contact_impulse_range_ns"))
+        lines.append("| " + " | ".join(cells) + " |")
+    if not massless:
+        lines += ["", "Newton's law: impacts are instantaneous — an impulse per impact, no contact force and no "
+                  "contact duration."]
+    return lines
 
 
 def _resonance_words(index: int, fam: dict) -> str | None:
@@ -189,8 +329,12 @@ def _reference_words(check: dict, k: int) -> str:
             "it was asked for in [output] orbits.")
 
 
-def forcing_report(section: dict, animations: list[dict]) -> list[str]:
-    """The forced-response section of ``report.md``."""
+def forcing_report(section: dict, animations: list[dict], massless: bool | None = None) -> list[str]:
+    """The forced-response section of ``report.md`` (``massless``: the steady states count contact phases, not
+    impacts; not set: the section's ``contact_model``)."""
+    if massless is None:
+        massless = section.get("contact_model") == "massless"
+    events = "contact phases" if massless else "impacts"
     files = section["files"]
     lines = ["", "## Forced response", "",
              f"- Load: {section['load']}, amplitude {section['amplitude']:g} {section['amplitude_unit']}; damping: "
@@ -200,7 +344,7 @@ def forcing_report(section: dict, animations: list[dict]) -> list[str]:
         lines.append("- Steady states: " + ", ".join(f"`{v}`" for v in files.values()) + ".")
     for a in animations:
         shown = ", ".join(f"`{a[k]}`" for k in ("gif", "mp4", "pvd") if k in a)
-        lines.append(f"- Animated steady state {a['label']} (impacts/forcing periods) at {a['frequency_hz']:.6g} Hz "
+        lines.append(f"- Animated steady state {a['label']} ({events}/forcing periods) at {a['frequency_hz']:.6g} Hz "
                      f"({a['sweep']} sweep, re-simulation return error {a['return_error']:.1e}): "
                      f"{shown or 'no files'}.")
     return lines
@@ -210,7 +354,9 @@ def comparison_report(section: dict) -> list[str]:
     """The comparison section of ``report.md``: a table, the verdicts and the sentences in words."""
     rows = section["rows"]
     energy_cols = [k for k in rows[0] if k.startswith("energy_")]
-    head = ["model", "dofs", "modes matched / checked", "artefact modes", "impact mass kept",
+    # the impact mass is Newton's (the inertia an impact meets): a comparison of massless models has none
+    impact = any(r.get("impact_mass_kept") is not None for r in rows if r.get("method") != "fe")
+    head = ["model", "dofs", "modes matched / checked", "artefact modes", *["impact mass kept"] * impact,
             "static compliance kept", "families with arcs", *[c.replace("energy_", "E at ") for c in energy_cols],
             "convergence"]
     lines = ["", "## Model comparison", "",
@@ -221,7 +367,7 @@ def comparison_report(section: dict) -> list[str]:
         if r.get("method") == "fe":
             continue
         cells = [r["model"], str(r["dofs"]), f"{r.get('modes_matched')} / {r.get('modes_checked')}",
-                 r.get("artefact_modes") or "—", _num(r.get("impact_mass_kept"), "×"),
+                 r.get("artefact_modes") or "—", *[_num(r.get("impact_mass_kept"), "×")] * impact,
                  _num(r.get("static_compliance_kept"), "×"),
                  f"{r.get('families_with_arcs')} of {r.get('families')}",
                  *[_num(r.get(c), " J") for c in energy_cols], r.get("convergence") or "n/a"]

@@ -11,6 +11,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import weakref
 from pathlib import Path
 
 import numpy as np
@@ -104,7 +105,19 @@ def families_document(families: list[Branch], system: LinearSystem | MasslessSys
             raise ValueError(f"families_document: family {i} ({fam.k}-ipp) was computed on another system "
                              f"({fam.system!r}) than the one given ({system!r})")
     return {"system_dofs": system.n, "gap": system.gap, FINGERPRINT_KEY: fingerprint,
-            "families": [f.to_dict() for f in families]}
+            "families": [_with_stability(f if f.system is not None else f.bind(system)) for f in families]}
+
+
+def _with_stability(fam: Branch) -> dict:
+    """``fam.to_dict()`` with every orbit's ``stable``, ``stability`` (the verdict, or why there is none) and
+    ``multipliers`` (:func:`stability_records`)."""
+    out = fam.to_dict()
+    for rec, st in zip(out["orbits"], stability_records(fam)):
+        if st is None:  # a resonant scan period: no orbit
+            rec["stability"] = "no orbit (resonant period)"
+        else:
+            rec.update(st)
+    return out
 
 
 def load_families(path: str | os.PathLike, system: LinearSystem | MasslessSystem,
@@ -280,9 +293,16 @@ def _range(values: np.ndarray) -> list[float | None]:
     return [float(values.min()), float(values.max())] if values.size else [None, None]
 
 
-def family_summary(fam: Branch) -> dict:
-    """Period, frequency and energy ranges of a branch, and its admissible arcs."""
+def family_summary(fam: Branch, engineering=None) -> dict:
+    """Period, frequency and energy ranges of a branch, and its admissible arcs (each with the share of its orbits
+    that are linearly stable, :func:`stability_records`).
+
+    ``engineering``: a function of an orbit giving its engineering quantities
+    (:func:`bladecase.study.render.orbit_engineering` bound to the reduced model); each arc then gets their ranges
+    over its admissible orbits (:func:`_arc_engineering`).
+    """
     T, E = fam.T, fam.energy
+    records = stability_records(fam)
     out = {
         "ipp": fam.k,
         "orbits": len(fam.orbits),
@@ -294,7 +314,8 @@ def family_summary(fam: Branch) -> dict:
             {"T_lo": a.T_lo, "T_hi": a.T_hi, "f_lo": 1 / a.T_hi, "f_hi": 1 / a.T_lo,
              "energy_range_j": _range(E[a.start:a.stop + 1][fam.admissible[a.start:a.stop + 1]]),
              "refined_lo": bool(a.refined_lo), "refined_hi": bool(a.refined_hi),
-             "stable_fraction": _stable_fraction(fam.orbits[a.start:a.stop + 1])} for a in fam.arcs
+             "stable_fraction": _stable_fraction(records[a.start:a.stop + 1]),
+             **({} if engineering is None else _arc_engineering(fam, a, engineering))} for a in fam.arcs
         ],
     }
     out["resonance"] = _resonance(fam, E)
@@ -323,24 +344,113 @@ def _resonance(fam: Branch, E: np.ndarray) -> dict | None:
             "ratio": float(split.frequencies[j] / f)}
 
 
-#: Most orbits of an arc whose Floquet multipliers are computed for the summary (evenly sampled beyond).
+#: Systems of at most this many dofs get the Floquet verdict of every admissible orbit (modes file, summary).
+#: Larger ones — a ``2n × 2n`` monodromy per orbit, its eigenvalues costing ``~(2n)³`` — get it for
+#: :data:`STABILITY_SAMPLES` orbits per admissible arc, evenly spread, both ends included.
+STABILITY_DOFS = 100
+
+#: Orbits per admissible arc whose Floquet multipliers are computed on a system above :data:`STABILITY_DOFS` dofs.
 STABILITY_SAMPLES = 50
 
+#: Orbits per admissible arc (evenly spread, both ends included) whose engineering quantities give the summary's
+#: ranges: each is expanded to the FE model at a few hundred instants.
+ENGINEERING_SAMPLES = 16
 
-def _stable_fraction(orbits: list) -> float | None:
-    """Share of the arc's admissible orbits that are linearly stable (Floquet), ``None`` when none has a verdict."""
+#: Why an orbit has no Floquet verdict in the modes file: it is not a motion of the blade against the casing.
+NOT_ADMISSIBLE = "not computed: the orbit is not admissible (it crosses the casing, or the casing would pull)"
+
+#: Floquet records already computed, per orbit object (the modes file and the summary ask for the same orbits).
+_STABILITY: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def orbit_stability(orbit) -> dict:
+    """The Floquet verdict of one orbit (:func:`bladecase.nsm.floquet.floquet`, either contact model):
+    ``{"stable": bool, "stability": verdict in words, "multipliers": [[re, im], …]}``; with no verdict (e.g. a
+    grazing impact) ``stable`` is ``None`` and ``stability`` says why. Computed once per orbit object."""
     from ..nsm.floquet import floquet
 
-    pool = [o for o in orbits if o is not None and o.admissible]
-    if len(pool) > STABILITY_SAMPLES:
-        pool = [pool[i] for i in np.linspace(0, len(pool) - 1, STABILITY_SAMPLES).astype(int)]
-    verdicts = []
-    for o in pool:
-        try:
-            verdicts.append(floquet(o).stable)
-        except ValueError:  # grazing impact or no verdict: left out
-            continue
+    try:
+        return _STABILITY[orbit]
+    except (KeyError, TypeError):
+        pass
+    try:
+        fl = floquet(orbit)
+        out = {"stable": bool(fl.stable), "stability": fl.verdict,
+               "multipliers": [[float(z.real), float(z.imag)] for z in fl.multipliers]}
+    except ValueError as exc:
+        out = {"stable": None, "stability": f"no verdict ({exc})", "multipliers": None}
+    try:
+        _STABILITY[orbit] = out
+    except TypeError:  # an orbit record that takes no weak reference: not cached
+        pass
+    return out
+
+
+def _arc_picks(fam: Branch, arc, cap: int | None) -> list[int]:
+    """Indices of the admissible orbits of ``arc``; at most ``cap`` of them (evenly spread, both ends kept)."""
+    pool = [j for j in range(arc.start, arc.stop + 1) if fam.orbits[j] is not None and fam.orbits[j].admissible]
+    if cap is None or len(pool) <= cap:
+        return pool
+    return [pool[i] for i in np.unique(np.linspace(0, len(pool) - 1, cap).round().astype(int))]
+
+
+def _sampled(fam: Branch) -> bool:
+    """Whether the Floquet verdicts of ``fam`` are sampled (a system above :data:`STABILITY_DOFS` dofs)."""
+    return fam.system is not None and fam.system.n > STABILITY_DOFS
+
+
+def stability_records(fam: Branch) -> list[dict | None]:
+    """One Floquet record per point of ``fam`` (:func:`orbit_stability`; ``None`` at a resonant scan period).
+
+    Every admissible orbit on an admissible arc is analysed (on a system above :data:`STABILITY_DOFS` dofs,
+    :data:`STABILITY_SAMPLES` per arc); the others say why they have no verdict (``stable`` is ``None``, never
+    without a reason in ``stability``): not admissible (:data:`NOT_ADMISSIBLE`), or not sampled.
+    """
+    picked = {j for a in fam.arcs for j in _arc_picks(fam, a, STABILITY_SAMPLES if _sampled(fam) else None)}
+    out: list[dict | None] = []
+    for j, o in enumerate(fam.orbits):
+        if o is None:
+            out.append(None)
+        elif j in picked:
+            out.append(orbit_stability(o))
+        elif not o.admissible:
+            out.append({"stable": None, "stability": NOT_ADMISSIBLE, "multipliers": None})
+        elif _sampled(fam) and any(a.start <= j <= a.stop for a in fam.arcs):
+            out.append({"stable": None, "multipliers": None,
+                        "stability": f"not computed: on a system of {fam.system.n} dofs the multipliers are "
+                                     f"computed for {STABILITY_SAMPLES} orbits per admissible arc, evenly spread"})
+        else:
+            out.append({"stable": None, "stability": "not computed: admissible, but on no admissible arc",
+                        "multipliers": None})
+    return out
+
+
+def _stable_fraction(records: list[dict | None]) -> float | None:
+    """Share of the analysed orbits (records of :func:`stability_records`) that are linearly stable (Floquet),
+    ``None`` when none has a verdict."""
+    verdicts = [r["stable"] for r in records if r is not None and r["stable"] is not None]
     return float(np.mean(verdicts)) if verdicts else None
+
+
+def _arc_engineering(fam: Branch, arc, engineering) -> dict:
+    """Ranges ``[min, max]`` of the engineering quantities (``engineering(orbit)``, a dict of numbers or ``None``)
+    over the admissible orbits of ``arc`` — at most :data:`ENGINEERING_SAMPLES`, evenly spread, both ends included
+    (``engineering_orbits``: how many)."""
+    picks = _arc_picks(fam, arc, ENGINEERING_SAMPLES)
+    values = [engineering(fam.orbits[j]) for j in picks]
+    out: dict = {"engineering_orbits": len(picks)}
+    for key, ranged in ENGINEERING_RANGES.items():
+        nums = np.array([v[key] for v in values if isinstance(v.get(key), (int, float))], dtype=float)
+        if nums.size:
+            out[ranged] = _range(nums)
+    return out
+
+
+#: The engineering quantities of an orbit whose ranges over an arc the summary gives, and the ranges' keys (the
+#: unit stays last, as in ``energy_range_j``).
+ENGINEERING_RANGES = {"tip_amplitude_mm": "tip_amplitude_range_mm", "contact_force_n": "contact_force_range_n",
+                      "contact_impulse_ns": "contact_impulse_range_ns", "contact_fraction": "contact_fraction_range",
+                      "casing_penetration_m": "casing_penetration_range_m"}
 
 
 def reduced_summary(reduced: ReducedModel, reference_hz: np.ndarray, fe=None) -> dict:
@@ -384,12 +494,31 @@ def model_summary(mesh: Mesh, model: FEModel, f_fe: np.ndarray, source: str) -> 
     }
 
 
-def contact_summary(contact: Contact, model: FEModel) -> dict:
-    """Contact node, its position, the casing normal, the clearance and the casing's stiffness (None: rigid)."""
+def contact_summary(contact: Contact, model: FEModel, reduced: ReducedModel | None = None, fe=None,
+                    face: str | None = None) -> dict:
+    """Contact node, its position, the casing normal, the clearance and the casing's stiffness (None: rigid).
+
+    With ``reduced``: the contact model (``"newton"`` or ``"massless"``) and, for the massless one, the contact's
+    own stiffness ``k_c = 1/(w_cᵀK_cc⁻¹w_c)`` (the contact dofs with the interior held) and its value in series with
+    the casing (:func:`~bladecase.nsm.series_stiffness`); with ``fe`` (:func:`~bladecase.post.compare.fe_reference`)
+    the blade's static stiffness at the contact ``1/(wᵀK⁻¹w)`` (the whole blade); ``face``: the name of a face
+    contact's node group.
+    """
     ids = model.mesh.node_ids
-    return {"node": contact.node, "node_id": int(ids[contact.node]), "face_nodes": list(contact.nodes),
-            "face_node_ids": [int(ids[k]) for k in contact.nodes],
-            "casing_stiffness_n_per_m": None if np.isinf(contact.casing) else contact.casing,
-            "face_weights": "area" if contact.weights else "equal",
-            "position": model.mesh.points[contact.node].tolist(),
-            "normal": contact.normal_for(model).tolist(), "clearance_m": contact.gap}
+    out = {"node": contact.node, "node_id": int(ids[contact.node]), "face_nodes": list(contact.nodes),
+           "face_node_ids": [int(ids[k]) for k in contact.nodes],
+           "casing_stiffness_n_per_m": None if np.isinf(contact.casing) else contact.casing,
+           "face_weights": "area" if contact.weights else "equal",
+           "position": model.mesh.points[contact.node].tolist(),
+           "normal": contact.normal_for(model).tolist(), "clearance_m": contact.gap}
+    if face is not None and contact.nodes:
+        out["face"] = face
+    if reduced is not None:
+        system = reduced.system
+        out["model"] = getattr(system, "contact_model", "newton")
+        if isinstance(system, MasslessSystem):
+            out["contact_stiffness_n_per_m"] = float(system.kc_structure)
+            out["series_stiffness_n_per_m"] = float(system.kc)
+    if fe is not None and fe.static_compliance > 0:
+        out["static_stiffness_n_per_m"] = 1.0 / float(fe.static_compliance)
+    return out

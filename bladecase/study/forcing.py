@@ -50,11 +50,14 @@ DEFAULTS = {"rayleigh": None, "ratio": None, "load": "nodal", "node": None, "gro
             "amplitude": None, "engine_order": None, "frequencies": [0.8, 1.2], "frequency_unit": "f1",
             "points": 41, "periods": 300, "direction": "up", "restitution": 1.0, "max_p": 4, "animate": 1}
 
-#: Columns of ``forced.csv`` (and of the section's ``points``), with their units.
+#: Columns of ``forced.csv`` (and of the section's ``points``), with their units. The header is the names alone:
+#: a quantity with a unit carries it as the name's suffix (``frequency_hz``, ``period_s``), as ``comparison.csv``
+#: and ``summary.json`` do. ``k``: impacts (massless model: contact phases) per ``p`` forcing periods;
+#: ``resimulated_contacts``: those the re-simulation of one cycle finds.
 COLUMNS = (("sweep", ""), ("frequency_hz", "Hz"), ("period_s", "s"), ("speed_rpm", "rpm"), ("label", ""),
            ("k", ""), ("p", ""), ("periodic", ""), ("energy_j", "J"), ("mean_energy_j", "J"),
            ("contact_max_m", "m"), ("contact_amplitude_m", "m"), ("residual", ""), ("return_error", ""),
-           ("resimulated_impacts", ""))
+           ("resimulated_contacts", ""))
 
 
 def _settings(forcing: dict) -> dict:
@@ -309,7 +312,7 @@ def _row(direction: str, pt: SweepPoint, orbit: ForcedOrbit | None, eo) -> dict:
             "periodic": bool(pt.periodic), "energy_j": float(pt.energy), "mean_energy_j": float(pt.mean_energy),
             "contact_max_m": hi, "contact_amplitude_m": 0.5 * (hi - lo), "residual": float(pt.residual),
             "return_error": orbit.return_error if orbit is not None else np.nan,
-            "resimulated_impacts": orbit.k if orbit is not None else None}
+            "resimulated_contacts": orbit.k if orbit is not None else None}
 
 
 def _sweep(direction: str, system, periods, run: dict) -> tuple[str, list[SweepPoint]]:
@@ -381,14 +384,15 @@ def forced_response(reduced: ReducedModel, families: list, forcing: dict, *, fol
             orbits.append(orbit)
     columns = {name: [r[name] for r in rows] for name, _ in COLUMNS}
     unit = "Pa" if s["load"] == "pressure" else "N"
-    section = {"load": load_words, "amplitude": float(s["amplitude"]), "amplitude_unit": unit,
+    section = {"contact_model": "massless" if massless else "newton",
+               "load": load_words, "amplitude": float(s["amplitude"]), "amplitude_unit": unit,
                "damping": _damping_words(s), "engine_order": s["engine_order"], "direction": s["direction"],
                "periods_per_point": int(s["periods"]), "points": columns,
                "classes": _classes(columns["label"]), "files": {}}
     section["peak"] = _peak(columns, families)
     section["words"] = _words(section, eo, "contact phases" if massless else "impacts")
     if folder is not None:
-        section["files"].update(_write(folder, columns, families, figures, title, reduced.system.gap, eo))
+        section["files"].update(_write(folder, columns, families, figures, title, reduced.system.gap, eo, massless))
     log.info("forced response: %s", section["words"])
     section["orbits"] = orbits
     return section
@@ -465,18 +469,25 @@ def _words(section: dict, eo, events: str = "impacts") -> str:
     if bb is None:
         return text + " has no nonsmooth-mode arc to compare with."
     off = f"energy {abs(bb['energy_offset']) * 100:.3g} % {'above' if bb['energy_offset'] > 0 else 'below'}"
+    mode = (f"nonsmooth mode ({_phases(bb['ipp'])})" if events == "contact phases"
+            else f"{bb['ipp']}-ipp nonsmooth mode")
     if bb["on_arc"]:
-        return text + f" lies on the {bb['ipp']}-ipp nonsmooth mode's arc ({off})."
-    return text + (f" lies outside the nonsmooth-mode arcs: the nearest, {bb['ipp']}-ipp over "
+        return text + f" lies on an admissible arc of the {mode} ({off})."
+    return text + (f" lies outside the nonsmooth-mode arcs: the nearest, the {mode} over "
                    f"{bb['arc_hz'][0]:.5g}–{bb['arc_hz'][1]:.5g} Hz, is {bb['frequency_offset'] * 100:.3g} % away in "
                    f"frequency ({off} at its end).")
 
 
-def _write(folder, c: dict, families: list, figures: bool, title: str, gap: float, eo) -> dict:
+def _phases(k: int) -> str:
+    return "one contact phase per period" if k == 1 else f"{k} contact phases per period"
+
+
+def _write(folder, c: dict, families: list, figures: bool, title: str, gap: float, eo,
+           massless: bool = False) -> dict:
     from pathlib import Path
 
     folder = Path(folder)
-    header = ",".join(f"{name} ({unit})" if unit else name for name, unit in COLUMNS)
+    header = ",".join(name for name, _ in COLUMNS)  # the unit is the name's suffix (COLUMNS)
     lines = [header]
     for i in range(len(c["label"])):
         lines.append(",".join("" if c[name][i] is None else
@@ -487,7 +498,7 @@ def _write(folder, c: dict, families: list, figures: bool, title: str, gap: floa
     if figures:
         fig = forced_response_plot(c["frequency_hz"], c["energy_j"], c["label"], sweep=c["sweep"],
                                    backbones=[f for f in families if f.arcs], gap=gap,
-                                   engine_order=None if eo is None else eo.engine_order,
+                                   engine_order=None if eo is None else eo.engine_order, massless=massless,
                                    title=f"{title}: forced response over the nonsmooth modes" if title else None)
         save_figure(fig, folder / "forced_response.png")
         files["figure"] = "forced_response.png"

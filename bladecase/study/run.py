@@ -9,6 +9,7 @@ plain tqdm, absent with ``progress=False``.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import os
 import shutil
 import time
@@ -30,10 +31,19 @@ from .executor import Executor, make_executor
 from .forcing import forced_response, forced_scene
 from .publish import RUN_RESULTS, check_inputs, output_folder, publish, release, staged_names, staging_dir
 from .reference import reference_model
-from .render import render_all
+from .render import orbit_engineering, render_all
 from .rotation import campbell_stage, operating_point
 from .schema import Study, load_study
-from .stages import build_contact, build_mesh, build_model, build_reduced, check_plausibility, period_unit, search
+from .stages import (
+    build_contact,
+    build_mesh,
+    build_model,
+    build_reduced,
+    check_plausibility,
+    contact_group,
+    period_unit,
+    search,
+)
 
 
 @dataclass
@@ -198,10 +208,11 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
             t0 = time.perf_counter()
             compares.append(build_reduced(study, model, contact, c["method"], c.get("size"), factor=factor))
             build_s.append(time.perf_counter() - t0)
-        log.info("contact: node %d at %s mm, normal %s, clearance %g mm", mesh.node_id(contact.node),
+        log.info("contact: %s at %s mm, normal %s, clearance %g mm", _contact_words(study, contact, mesh),
                  np.round(mesh.points[contact.node] * 1e3, 4).tolist(), np.round(contact.normal_for(model), 6).tolist(),
                  contact.gap * 1e3)
         log.info("reduced model: %s", reduced)
+        log.info("contact stiffness: %s", _stiffness_words(reduced, fe))
         t0 = time.perf_counter()
         reference = reference_model(model, contact, reduced, factor) if o["reference"] else None
         build_s.append(time.perf_counter() - t0)
@@ -261,7 +272,7 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         "study": study.name, "source": study.source, "bladecase_version": __version__,
         "model": model_summary(mesh, model, f_fe, "gmsh (parametric [geometry])" if study.parametric
                                else str(study.mesh_path())),
-        "contact": contact_summary(contact, model),
+        "contact": contact_summary(contact, model, reduced, fe, face=contact_group(study) if contact.nodes else None),
         "rotation": rotation,
         "campbell": campbell,
         "reduction": reduced_summary(reduced, f_fe, fe),
@@ -269,12 +280,35 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         "compare": [dict(reduced_summary(r, f_fe), families=[family_summary(f) for f in fams])
                     for r, fams in zip(compares, compare_families)],
         "search": {**study["search"], "period_unit_s": unit},
-        "families": [family_summary(f) for f in families],
+        "families": [family_summary(f, functools.partial(orbit_engineering, reduced)) for f in families],
         "forcing": forcing,
         "comparison": None if comparison is None else {k: comparison[k] for k in ("rows", "diagnostics", "figures")},
         "files": files,
     }
     return summary, families, {m.name: m for m in models}
+
+
+def _contact_words(study: Study, contact, mesh) -> str:
+    """The contact as the log names it: ``node 6``, or for a face ``face 'tip' of 26 nodes (area-weighted mean of
+    their normal displacements), centre node 6``."""
+    if not contact.nodes:
+        return f"node {mesh.node_id(contact.node)}"
+    weights = "area-weighted" if contact.weights else "equal-weight"
+    return (f"face '{contact_group(study)}' of {len(contact.nodes)} nodes ({weights} mean of their normal "
+            f"displacements), centre node {mesh.node_id(contact.node)}")
+
+
+def _stiffness_words(reduced, fe) -> str:
+    """The contact's own stiffness ``k_c`` and its series value with the casing (massless model), and the blade's
+    static stiffness at the contact ``1/(wᵀK⁻¹w)`` (the whole FE model)."""
+    s = reduced.system
+    blade = f"the blade's static stiffness at the contact 1/(wᵀK⁻¹w) = {1 / fe.static_compliance:.4g} N/m"
+    if getattr(s, "contact_model", "newton") != "massless":
+        return f"{blade} (Newton's impact law: rigid casing)"
+    own = f"k_c = {s.kc_structure:.4g} N/m (the contact dofs with the interior held, 1/(w_cᵀK_cc⁻¹w_c))"
+    if np.isinf(s.casing):
+        return f"{own}, rigid casing; {blade}"
+    return f"{own}; casing {s.casing:.4g} N/m in series: k_s = {s.kc:.4g} N/m; {blade}"
 
 
 def _campbell(study: Study, model, contact, executor: Executor, progress: bool, staging: Path, files: dict) -> dict:
