@@ -10,6 +10,9 @@ $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e ".[test,video]"
+	@# optional CHOLMOD from cvxopt's wheel (pip alone): faster, leaner sparse factorisation; SuperLU without it
+	$(BIN)/python -m pip install --quiet --only-binary=cvxopt -e ".[cvxopt]" \
+	    || echo "optional cvxopt (CHOLMOD) not installed: no wheel for this platform, SuperLU used"
 	@# optional CHOLMOD (faster sparse factorisation): only where SuiteSparse's headers are installed
 	@if [ -f /usr/include/suitesparse/cholmod.h ]; then \
 	    $(BIN)/python -m pip install --quiet "scikit-sparse<0.5" \

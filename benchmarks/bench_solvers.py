@@ -1,24 +1,30 @@
 """Sparse SPD factorisation of the blade's K: SuperLU against the other backends, and the eigen-solvers on it.
 
-For each blade size (``bench_fe_pipeline.py``'s: 5 490 / 26 316 / 110 424 P2 dofs) the stiffness ``K`` and mass
-``M`` are assembled once and saved; then, for each backend, a fresh process (its own peak memory) loads them
-and times (``time.perf_counter``):
+For each blade size (``bench_fe_pipeline.py``'s 5 490 / 26 316 / 110 424 P2 dofs and 61 704 between) the
+stiffness ``K`` and mass ``M`` are assembled once and saved; then, for each installed backend
+(``bladecase.linalg.available_backends()``: ``superlu``, ``cvxopt``, ``cholmod``), a fresh process (its own peak
+memory) loads them and times (``time.perf_counter``):
 
 * the factorisation ``bladecase.linalg.spd_factor(K)`` alone, the peak resident memory it adds (Linux
-  ``VmHWM`` reset just before, minus ``VmRSS`` before) and the memory its factor keeps;
-* one solve, and one solve of a block of 20 right-hand sides;
+  ``VmHWM`` reset just before, minus ``VmRSS`` before), the memory its factor keeps, and the process's peak
+  (``ru_maxrss``) right after it;
+* one solve, and one solve of a block of 20 right-hand sides, and the largest difference of that block's
+  solution from SuperLU's, relative to its largest entry;
 * with ``--eigen``, 20 lowest modes reusing the factor: ARPACK shift-invert (``lowest_modes(method="arpack")``),
   the block shift-invert Lanczos (``method="block"``) and, with ``--lobpcg``, scipy's LOBPCG preconditioned by
   the factor (block 30, tol 1e-9, at most 40 iterations) — each with its largest relative frequency difference
   from ARPACK's and its largest relative residual ``‖Kφ - λMφ‖ / ‖Kφ‖``.
 
-Single-threaded BLAS (``OPENBLAS_NUM_THREADS=1`` is set for the children unless already set).  Exit status 0.
+``--repeat N`` runs every backend N times, interleaved (SuperLU, the others, SuperLU, …), and reports the
+medians (and the range of the factorisation times); each other backend is then compared with SuperLU: the
+ratio of each figure, SuperLU / backend (above 1: the backend is faster or leaner).  Single-threaded BLAS
+(``OPENBLAS_NUM_THREADS=1`` is set for the children unless already set).  Exit status 0.
 
 Run::
 
     cd /work/main && OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_solvers.py
-        [--skip-110k] [--sizes 0.0055,0.0025,0.0014] [--backends superlu,cholmod] [--eigen] [--lobpcg]
-        [--json FILE]
+        [--skip-110k] [--sizes 0.0055,0.0025,0.00175,0.0014] [--backends superlu,cvxopt,cholmod] [--repeat 3]
+        [--eigen] [--lobpcg] [--json FILE]
 """
 
 from __future__ import annotations
@@ -27,6 +33,7 @@ import argparse
 import json
 import os
 import resource
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -35,8 +42,11 @@ from pathlib import Path
 
 from bench_core import machine
 
-SIZES = (0.0055, 0.0025, 0.0014)
+SIZES = (0.0055, 0.0025, 0.00175, 0.0014)
 COUNT = 20
+#: Figures compared with SuperLU's (medians over the repeats), and their labels.
+COMPARED = {"factor_seconds": "factor", "factor_peak_MiB": "factor peak memory", "factor_maxrss_MiB": "ru_maxrss",
+            "solve_seconds": "1 solve", "block_solve_seconds": "20-rhs solve"}
 
 
 def peak_mib() -> float:
@@ -95,8 +105,12 @@ def _eigen(K, M, factor, method: str) -> tuple[float, object, object]:
     return time.perf_counter() - t0, lam, phi
 
 
-def run_one(path: str, methods: list[str]) -> dict:
-    """Factorise the saved ``K`` (backend from ``$BLADECASE_FACTOR``), solve, and run the eigen-solvers."""
+def run_one(path: str, methods: list[str], reference: str | None = None) -> dict:
+    """Factorise the saved ``K`` (backend from ``$BLADECASE_FACTOR``), solve, and run the eigen-solvers.
+
+    ``reference``: a ``.npy`` file with SuperLU's solution of the 20 right-hand sides (written by the SuperLU
+    run if missing, compared with otherwise).
+    """
     import warnings
 
     import numpy as np
@@ -114,7 +128,8 @@ def run_one(path: str, methods: list[str]) -> dict:
     hwm = _status_mib("VmHWM")
     out = {"dofs": n, "backend": factor.backend, "factor_seconds": seconds,
            "factor_peak_MiB": hwm - before if None not in (hwm, before) else float("nan"),
-           "factor_kept_MiB": _status_mib("VmRSS") - before if before is not None else float("nan")}
+           "factor_kept_MiB": _status_mib("VmRSS") - before if before is not None else float("nan"),
+           "factor_maxrss_MiB": peak_mib()}
     B = np.random.default_rng(0).standard_normal((n, COUNT))
     t0 = time.perf_counter()
     factor.solve(B[:, 0])
@@ -123,6 +138,12 @@ def run_one(path: str, methods: list[str]) -> dict:
     X = factor.solve(B)
     out["block_solve_seconds"] = time.perf_counter() - t0
     out["solve_residual"] = float(np.abs(K @ X - B).max())
+    if reference is not None:
+        if factor.backend == "superlu" and not Path(reference).exists():
+            np.save(reference, X)
+        elif Path(reference).exists():
+            R = np.load(reference)
+            out["max_rel_diff_vs_superlu"] = float(np.abs(X - R).max() / np.abs(R).max())
     ref = None
     for method in methods:
         with warnings.catch_warnings():
@@ -137,11 +158,12 @@ def run_one(path: str, methods: list[str]) -> dict:
     return out
 
 
-def child(path: Path, backend: str, methods: list[str]) -> dict:
+def child(path: Path, backend: str, methods: list[str], reference: Path | None = None) -> dict:
     env = dict(os.environ, BLADECASE_FACTOR=backend)
     env.setdefault("OPENBLAS_NUM_THREADS", "1")
+    ref = str(reference) if reference is not None else None
     code = (f"import json, sys; sys.path.insert(0, {str(Path(__file__).parent)!r}); import bench_solvers as b; "
-            f"print('RESULT' + json.dumps(b.run_one({str(path)!r}, {methods!r})))")
+            f"print('RESULT' + json.dumps(b.run_one({str(path)!r}, {methods!r}, {ref!r})))")
     proc = subprocess.run([sys.executable, "-W", "ignore", "-c", code], env=env, capture_output=True, text=True)
     rows = [r for r in proc.stdout.splitlines() if r.startswith("RESULT")]
     if proc.returncode or not rows:
@@ -149,19 +171,49 @@ def child(path: Path, backend: str, methods: list[str]) -> dict:
     return json.loads(rows[-1][len("RESULT"):])
 
 
+def median_run(runs: list[dict], methods: list[str]) -> dict:
+    """The medians of the figures of ``runs`` (one backend, one size); ``factor_range`` their min and max."""
+    ok = [r for r in runs if "error" not in r]
+    if not ok:
+        return runs[-1]
+    out = dict(ok[0], runs=len(ok), factor_range=[min(r["factor_seconds"] for r in ok),
+                                                   max(r["factor_seconds"] for r in ok)])
+    for key, value in ok[0].items():
+        if isinstance(value, float):
+            out[key] = statistics.median(r[key] for r in ok if key in r)
+    for m in methods:
+        out[m] = {k: statistics.median(r[m][k] for r in ok) for k in ok[0][m]}
+    return out
+
+
 def report(r: dict, methods: list[str]) -> None:
     if "error" in r:
         print(f"  {r['backend']:<8} error: {r['error']}")
         return
-    print(f"  {r['backend']:<8} factor {r['factor_seconds']:7.2f} s  +{r['factor_peak_MiB']:5.0f} MiB peak "
-          f"(+{r['factor_kept_MiB']:.0f} kept)   solve "
+    spread = (f" ({r['factor_range'][0]:.2f}-{r['factor_range'][1]:.2f}, median of {r['runs']})"
+              if r.get("runs", 1) > 1 else "")
+    diff = f"   vs SuperLU {r['max_rel_diff_vs_superlu']:.1e}" if "max_rel_diff_vs_superlu" in r else ""
+    print(f"  {r['backend']:<8} factor {r['factor_seconds']:7.2f} s{spread}  +{r['factor_peak_MiB']:5.0f} MiB peak "
+          f"(+{r['factor_kept_MiB']:.0f} kept, ru_maxrss {r['factor_maxrss_MiB']:.0f})   solve "
           f"{r['solve_seconds']:.3f} s   20-block solve {r['block_solve_seconds']:.3f} s   "
-          f"peak {r['peak_MiB']:.0f} MiB")
+          f"peak {r['peak_MiB']:.0f} MiB{diff}")
     for m in methods:
         e = r[m]
         print(f"  {'':<8} 20 modes {m:<7} {e['seconds']:7.2f} s   factor + modes "
               f"{r['factor_seconds'] + e['seconds']:7.2f} s   freq diff vs {methods[0]} "
               f"{e['max_rel_freq_diff_vs_first']:.1e}   residual {e['max_rel_residual']:.1e}")
+
+
+def report_ratios(results: dict[str, dict]) -> None:
+    """Each backend's figures against SuperLU's: SuperLU / backend (> 1: faster or leaner)."""
+    base = results.get("superlu")
+    if base is None or "error" in base:
+        return
+    for backend, r in results.items():
+        if backend == "superlu" or "error" in r:
+            continue
+        ratios = "   ".join(f"{label} {base[key] / r[key]:.1f}x" for key, label in COMPARED.items())
+        print(f"  {backend:<8} vs SuperLU (SuperLU / {backend}): {ratios}")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -170,6 +222,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--sizes", default=",".join(map(str, SIZES)), help="mesh sizes in m, comma-separated")
     parser.add_argument("--skip-110k", action="store_true", help="leave out the 1.4 mm (110k-dof) blade")
     parser.add_argument("--backends", default=None, help="comma-separated (default: every available backend)")
+    parser.add_argument("--repeat", type=int, default=1, help="runs of each backend, interleaved (medians shown)")
     parser.add_argument("--eigen", action="store_true", help="also 20 modes by ARPACK and by block Lanczos")
     parser.add_argument("--lobpcg", action="store_true", help="with --eigen, also LOBPCG")
     parser.add_argument("--json", metavar="FILE", type=Path, help="also write the figures to FILE (JSON)")
@@ -180,17 +233,25 @@ def main(argv: list[str] | None = None) -> int:
     sizes = [float(s) for s in args.sizes.split(",") if not (args.skip_110k and float(s) <= 0.0014)]
     backends = args.backends.split(",") if args.backends else sorted(available_backends(), key="superlu".__ne__)
     methods = (["arpack", "block"] + (["lobpcg"] if args.lobpcg else [])) if args.eigen else []
-    print(f"bladecase sparse factorisation benchmark: {', '.join(backends)} on the blade's K (issue 14)")
-    info = {"machine": machine(), "runs": []}
+    print(f"bladecase sparse factorisation benchmark: {', '.join(backends)} on the blade's K")
+    info = {"machine": machine(), "runs": [], "medians": []}
     with tempfile.TemporaryDirectory() as tmp:
         for size in sizes:
             n, path = save_model(size, Path(tmp))
+            reference = Path(tmp) / f"X_{size:g}.npy"
             print(f"\nblade mesh size {size:g} m: {n} dofs")
-            for backend in backends:
-                r = child(path, backend, methods)
-                r["size"] = size
-                info["runs"].append(r)
+            runs: dict[str, list[dict]] = {b: [] for b in backends}
+            for _ in range(max(args.repeat, 1)):
+                for backend in backends:
+                    r = child(path, backend, methods, reference)
+                    r["size"] = size
+                    info["runs"].append(r)
+                    runs[backend].append(r)
+            results = {b: median_run(rs, methods) for b, rs in runs.items()}
+            for r in results.values():
                 report(r, methods)
+                info["medians"].append(r)
+            report_ratios(results)
             path.unlink()
     if args.json:
         args.json.parent.mkdir(parents=True, exist_ok=True)

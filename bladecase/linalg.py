@@ -8,20 +8,23 @@ or a dense eigen-solution for small problems asking for many modes).  Every site
 :data:`DENSE_LIMIT`.
 
 Backend: :func:`factor_backend` is the ONE place that chooses how sparse matrices are factorised, at run
-time: ``"cholmod"`` (supernodal Cholesky of SuiteSparse through the optional ``scikit-sparse``, ``<0.5`` on
-Debian's SuiteSparse 5) where it imports, else ``"superlu"``; the environment variable ``BLADECASE_FACTOR``
-(``superlu`` or ``cholmod``) forces one.  SuperLU: scipy's SuperLU in symmetric mode without pivoting
+time, the first that imports of: ``"cholmod"`` (supernodal Cholesky of SuiteSparse through the optional
+``scikit-sparse``, ``<0.5`` on Debian's SuiteSparse 5, built where SuiteSparse's headers are installed),
+``"cvxopt"`` (the same CHOLMOD from cvxopt's wheels, which ``make`` installs with pip alone:
+:mod:`bladecase.linalg_backends`), ``"superlu"``; the environment variable ``BLADECASE_FACTOR`` (``superlu``,
+``cvxopt`` or ``cholmod``) forces one.  SuperLU: scipy's SuperLU in symmetric mode without pivoting
 (minimum degree on ``A + Aᵀ``, ``diag_pivot_thresh = 0``), which for an SPD matrix is an LDLᵀ,
 ``Pᵀ A P = L D Lᵀ``, ``A`` positive definite iff every pivot of ``D`` is > 0 and no off-diagonal pivot was
-taken.  CHOLMOD: ``Pᵀ A P = L Lᵀ``, 3 to 6 times faster and 4 times leaner on the 110k-dof blade; it fails on
-a matrix that is not positive definite (the message then comes from SuperLU's diagnosis) and, having no
-pivoting, leaves indefinite matrices (:func:`symmetric_factor`) to SuperLU.  A backend is one ``factor``
-function in :data:`_SPARSE_BACKENDS` (plus an import probe in :data:`_PROBES`); callers keep using
-:class:`SPDFactor` (``solve``, ``operator``, ``ldlt``).
+taken.  CHOLMOD (either): ``Pᵀ A P = L Lᵀ``, 3 to 6 times faster and 3 to 5 times leaner on the 110k-dof blade;
+it fails on a matrix that is not positive definite (``NotPositiveDefinite``: the message then comes from
+SuperLU's diagnosis) and, having no pivoting, leaves indefinite matrices (:func:`symmetric_factor`) to SuperLU.
+A backend is one ``factor`` function in :data:`_SPARSE_BACKENDS` (plus an import probe in :data:`_PROBES`);
+callers keep using :class:`SPDFactor` (``solve``, ``operator``, ``ldlt``).
 
 Eigen-solver: :func:`lowest_modes` uses ARPACK's shift-invert Lanczos, or the block shift-invert Lanczos of
 :mod:`bladecase.linalg_block` when the factor solves blocks of right-hand sides much faster than one at a time
-(CHOLMOD) and ``K`` has at least :data:`BLOCK_MIN_DOFS` rows (110k dofs, 20 modes: 2.7 s vs 3.7 to 7.5 s).
+(scikit-sparse's CHOLMOD; not cvxopt's, which solves column by column) and ``K`` has at least
+:data:`BLOCK_MIN_DOFS` rows (110k dofs, 20 modes: 2.7 s vs 3.7 to 7.5 s).
 
 Reuse: a factor can be computed once and passed on (``factor=``) to :func:`lowest_modes`,
 :func:`bladecase.fe.natural_frequencies` and :func:`bladecase.reduction.reduce`;
@@ -48,6 +51,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .checks import integer
+from .linalg_backends import NotPositiveDefinite, cvxopt_cholesky, import_cvxopt
 from .linalg_block import BLOCK_SIZE, block_lanczos
 
 __all__ = [
@@ -60,7 +64,7 @@ __all__ = [
 #: for); a dense ``n × n`` float matrix is 72 MB at 3000 dofs.
 DENSE_LIMIT = 3000
 
-#: Environment variable that forces the sparse factorisation backend (``superlu``, ``cholmod``).
+#: Environment variable that forces the sparse factorisation backend (``superlu``, ``cvxopt``, ``cholmod``).
 BACKEND_ENV = "BLADECASE_FACTOR"
 
 #: Smallest ``K`` for which :func:`lowest_modes` (``method="auto"``) uses the block Lanczos with a factor that
@@ -106,15 +110,20 @@ def _import_cholmod():
 
 
 #: Import probes of the optional backends: ``name -> () -> module`` (raises ``ImportError`` if missing).
-_PROBES: dict[str, Callable] = {"cholmod": _import_cholmod}
+_PROBES: dict[str, Callable] = {"cholmod": _import_cholmod, "cvxopt": import_cvxopt}
+
+#: How to install each optional backend (in the error of a forced backend that is missing).
+_INSTALL = {"cholmod": "install scikit-sparse<0.5 with SuiteSparse (apt install libsuitesparse-dev)",
+            "cvxopt": "pip install cvxopt (make installs its wheel)"}
 
 #: Preference order of :func:`factor_backend` (the first available wins); SuperLU is always available.
-_PREFERENCE = ("cholmod", "superlu")
+_PREFERENCE = ("cholmod", "cvxopt", "superlu")
 
 #: Backends that pivot, hence factor indefinite matrices (:func:`symmetric_factor`); the others use SuperLU.
 _PIVOTING = frozenset({"superlu"})
 
-#: Backends whose block solves are much cheaper per right-hand side than single solves (block eigen-solver).
+#: Backends whose block solves are much cheaper per right-hand side than single solves (block eigen-solver);
+#: not cvxopt, which solves column by column (20 modes at 110k dofs: block 8.6 s, ARPACK 4.3 s).
 _BLOCK_SOLVES = frozenset({"cholmod"})
 
 
@@ -140,15 +149,16 @@ def available_backends() -> list[str]:
 def factor_backend() -> str:
     """The sparse factorisation backend: the one place where it is chosen.
 
-    ``$BLADECASE_FACTOR`` (:data:`BACKEND_ENV`) if set (``"superlu"`` or ``"cholmod"``), else the first of
-    :func:`available_backends`: ``"cholmod"`` where ``sksparse.cholmod`` imports, else ``"superlu"``.
+    ``$BLADECASE_FACTOR`` (:data:`BACKEND_ENV`) if set (``"superlu"``, ``"cvxopt"`` or ``"cholmod"``), else the
+    first of :func:`available_backends`: ``"cholmod"`` where ``sksparse.cholmod`` imports, else ``"cvxopt"``
+    where ``cvxopt.cholmod`` imports, else ``"superlu"``.
 
     Raises
     ------
     ValueError
         ``$BLADECASE_FACTOR`` names no backend, or one that is not installed (the message says why).
 
-    >>> factor_backend() in ("cholmod", "superlu")
+    >>> factor_backend() in ("cholmod", "cvxopt", "superlu")
     True
     """
     forced = os.environ.get(BACKEND_ENV, "").strip().lower()
@@ -159,9 +169,8 @@ def factor_backend() -> str:
                          f"{', '.join(repr(k) for k in _PREFERENCE)} (or unset it to choose automatically)")
     why = _missing(forced) if forced in _PROBES else None
     if why is not None:
-        raise ValueError(f"{BACKEND_ENV} = {forced!r} but that backend is not installed ({why}): install "
-                         f"scikit-sparse<0.5 with SuiteSparse (apt install libsuitesparse-dev), or unset "
-                         f"{BACKEND_ENV} to use {available_backends()[0]!r}")
+        raise ValueError(f"{BACKEND_ENV} = {forced!r} but that backend is not installed ({why}): "
+                         f"{_INSTALL[forced]}, or unset {BACKEND_ENV} to use {available_backends()[0]!r}")
     return forced
 
 
@@ -180,10 +189,11 @@ class Factor:
     kind : str
         ``"sparse"`` or ``"dense"``.
     backend : str
-        ``"superlu"`` (sparse, :func:`factor_backend`), ``"cholesky"`` or ``"lu"`` (dense, scipy).
+        ``"superlu"``, ``"cvxopt"`` or ``"cholmod"`` (sparse, :func:`factor_backend`), ``"cholesky"`` or ``"lu"``
+        (dense, scipy).
     fill : int
         Entries stored by the factors (``nnz(L) + nnz(U)`` for SuperLU, ``nnz(L)`` for CHOLMOD — counted on a
-        copy when first read —, ``n²`` dense): the memory it takes.
+        copy, or for cvxopt a second factorisation, when first read —, ``n²`` dense): the memory it takes.
     """
 
     def __init__(self, name: str, n: int, kind: str, backend: str, solve: Callable, source=None, parts=None,
@@ -279,7 +289,7 @@ def _superlu(A: sp.csc_array, name: str, hint: str, definite: bool):
 def _cholmod(A: sp.csc_array, name: str, hint: str, definite: bool):
     """CHOLMOD's supernodal Cholesky ``Pᵀ A P = L Lᵀ``: ``(solve, ldlt, fill)``; SPD matrices only.
 
-    A matrix that is not positive definite is diagnosed by SuperLU (the same messages as that backend).
+    A matrix that is not positive definite raises :class:`NotPositiveDefinite` (:func:`spd_factor` diagnoses).
     :meth:`SPDFactor.ldlt` turns the factor into CHOLMOD's simplicial LDLᵀ in place (solves stay right).
     """
     if not definite:
@@ -288,8 +298,7 @@ def _cholmod(A: sp.csc_array, name: str, hint: str, definite: bool):
     try:
         f = cholmod.cholesky(A, mode="supernodal")  # LLᵀ: simplicial would be an LDLᵀ, not checking definiteness
     except cholmod.CholmodNotPositiveDefiniteError:
-        _superlu(A, name, hint, True)  # raises the exact diagnosis (pivot, singular, pivoting)
-        raise _fail(name, "is not positive definite: CHOLMOD's Cholesky factorisation met a pivot <= 0", hint) from None
+        raise NotPositiveDefinite("CHOLMOD's Cholesky factorisation met a pivot <= 0") from None
 
     def ldlt():
         L, D = f.L_D()  # A[p][:, p] = L D Lᵀ
@@ -303,7 +312,7 @@ def _cholmod(A: sp.csc_array, name: str, hint: str, definite: bool):
 
 #: Sparse backends by name: ``factor(A_csc, name, hint, definite) -> (solve, ldlt, fill)`` (``fill`` an int
 #: or a function that counts it when asked).
-_SPARSE_BACKENDS = {"superlu": _superlu, "cholmod": _cholmod}
+_SPARSE_BACKENDS = {"superlu": _superlu, "cvxopt": cvxopt_cholesky, "cholmod": _cholmod}
 
 
 def _square(A, name: str) -> int:
@@ -324,8 +333,8 @@ def _finite(A, name: str) -> None:
 def spd_factor(A, name: str = "A", *, hint: str = "") -> SPDFactor:
     """Factor a symmetric positive definite matrix (scipy sparse or dense); the symmetry is not checked.
 
-    Sparse: the backend of :func:`factor_backend` (SuperLU LDLᵀ, see the module docstring).  Dense:
-    Cholesky.  A sparse matrix is never made dense.
+    Sparse: the backend of :func:`factor_backend` (CHOLMOD's Cholesky or SuperLU's LDLᵀ, see the module
+    docstring).  Dense: Cholesky.  A sparse matrix is never made dense.
 
     Parameters
     ----------
@@ -365,8 +374,12 @@ def spd_factor(A, name: str = "A", *, hint: str = "") -> SPDFactor:
     if np.any(~(diag > 0)):
         i = int(np.flatnonzero(~(diag > 0))[0])
         raise _fail(name, f"is not positive definite: diagonal entry {name}[{i},{i}] = {diag[i]:.6g} <= 0", hint)
-    backend = factor_backend()
-    solve, ldlt, fill = _SPARSE_BACKENDS[backend](sp.csc_array(A, dtype=float), name, hint, True)
+    backend, A_csc = factor_backend(), sp.csc_array(A, dtype=float)
+    try:
+        solve, ldlt, fill = _SPARSE_BACKENDS[backend](A_csc, name, hint, True)
+    except NotPositiveDefinite as exc:  # a Cholesky-only backend: SuperLU says why (pivot, singular, pivoting)
+        _superlu(A_csc, name, hint, True)
+        raise _fail(name, f"is not positive definite: {exc}", hint) from None
     return SPDFactor(name, n, "sparse", backend, solve, A, ldlt, fill)
 
 
