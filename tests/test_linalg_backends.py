@@ -152,16 +152,23 @@ def test_cholmod_leaves_indefinite_factorisations_to_superlu(cholmod):
     _indefinite_goes_to_superlu(laplacian(6) - 1.5 * sp.eye_array(36), 1e-12)  # indefinite, non-singular
 
 
-def test_cholmod_factor_gives_the_modes_with_either_eigen_solver(cholmod):
+def _laplacian_modes(methods) -> tuple:
+    """The 5 lowest modes of the 20 × 20 grid Laplacian by each of ``methods`` with the backend's own factor, against
+    the closed form ``4 sin²(iπ/42) + 4 sin²(jπ/42)``; ``(K, M, factor, exact)`` for more checks."""
     K = laplacian(20)
     M = sp.eye_array(400, format="csr")
     f = spd_factor(K, "K")
     k = np.arange(1, 4)
     exact = np.sort((4 * np.sin(k[:, None] * np.pi / 42) ** 2 + 4 * np.sin(k[None, :] * np.pi / 42) ** 2).ravel())
-    for method in ("arpack", "block"):
+    for method in methods:
         lam, phi = lowest_modes(K, M, 5, factor=f, method=method)
         np.testing.assert_allclose(lam, exact[:5], rtol=1e-10, atol=0)
         np.testing.assert_allclose(phi.T @ phi, np.eye(5), atol=1e-10)
+    return K, M, f, exact
+
+
+def test_cholmod_factor_gives_the_modes_with_either_eigen_solver(cholmod):
+    _laplacian_modes(("arpack", "block"))
 
 
 # --------------------------------------------------------------------------- cvxopt's CHOLMOD (where installed)
@@ -250,15 +257,7 @@ def test_cvxopt_ignores_and_keeps_the_users_cholmod_options(cvxopt_forced):
 
 
 def test_cvxopt_factor_gives_the_modes_with_either_eigen_solver_and_auto_takes_arpack(cvxopt_forced):
-    K = laplacian(20)
-    M = sp.eye_array(400, format="csr")
-    f = spd_factor(K, "K")
-    k = np.arange(1, 4)
-    exact = np.sort((4 * np.sin(k[:, None] * np.pi / 42) ** 2 + 4 * np.sin(k[None, :] * np.pi / 42) ** 2).ravel())
-    for method in ("arpack", "block", "auto"):
-        lam, phi = lowest_modes(K, M, 5, factor=f, method=method)
-        np.testing.assert_allclose(lam, exact[:5], rtol=1e-10, atol=0)
-        np.testing.assert_allclose(phi.T @ phi, np.eye(5), atol=1e-10)
+    K, M, f, exact = _laplacian_modes(("arpack", "block", "auto"))
     lam, _ = lowest_modes(K, M, 5)  # factorised here, by the forced backend
     np.testing.assert_allclose(lam, exact[:5], rtol=1e-10, atol=0)
     solve = f.solve
