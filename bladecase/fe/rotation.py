@@ -151,6 +151,7 @@ class _Operators:
         Ms = _scalar_mass(basis, model.mass, model.order)
         Ms = sp.diags_array(Ms) if not sp.issparse(Ms) else Ms
         Ms = sp.csr_array(Ms) * (model.material.rho * self.depth)
+        self.Ms = Ms  # ρ ∫ φ_a φ_b (scalar, all dofs): M⊥, f₁ and the Coriolis matrix are made from it
         P = axis.projector(dim)
         positions = np.zeros((basis.N, 3))
         positions[:, :dim] = basis.doflocs.T
@@ -335,13 +336,9 @@ def coriolis_matrix(model: FEModel, axis: RotationAxis, speed: float) -> sp.csr_
     effect with it (a quadratic eigenproblem, e.g. on a modal basis)."""
     omega = to_rad_s(speed)
     ops = _operators(model, axis)
-    from .assembly import _scalar_mass
-
-    Ms = _scalar_mass(ops.basis, model.mass, model.order)
-    Ms = sp.csr_array(sp.diags_array(Ms) if not sp.issparse(Ms) else Ms) * (model.material.rho * ops.depth)
     a = axis.direction
     skew = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])[: ops.dim, : ops.dim]
-    G = sp.csr_array(sp.kron(Ms, 2.0 * omega * skew, format="csr"))
+    G = sp.csr_array(sp.kron(ops.Ms, 2.0 * omega * skew, format="csr"))
     return sp.csr_array(G[ops.free][:, ops.free])
 
 
