@@ -28,7 +28,10 @@ from ..linalg import lowest_modes
 from .model import FEModel
 from .rotation import RotationAxis, spin
 
-__all__ = ["Campbell", "campbell", "crossings", "from_modes", "mac", "track"]
+__all__ = ["EXTRA_MODES", "Campbell", "campbell", "crossings", "from_modes", "mac", "modes_at_speed", "track"]
+
+#: Candidate modes computed beyond those tracked, so that a mode entering from above is followed by its shape.
+EXTRA_MODES = 4
 
 #: A link between two speeds whose MAC is below this is reported as uncertain (the speeds are too far apart).
 MAC_WARN = 0.8
@@ -133,7 +136,7 @@ class Campbell:
 
 
 def campbell(model: FEModel, speeds, axis: RotationAxis | None = None, count: int = 6, engine_orders=(),
-             extra: int = 4, progress: bool = False) -> Campbell:
+             extra: int = EXTRA_MODES, progress: bool = False) -> Campbell:
     """The Campbell diagram of ``model`` at ``speeds`` (rad/s, sorted here): the ``count`` lowest modes at the
     first speed, followed by shape through ``count + extra`` candidates at every speed.
 
@@ -164,14 +167,21 @@ def campbell(model: FEModel, speeds, axis: RotationAxis | None = None, count: in
 
     shapes, values, displacements = [], [], []
     for w in progress_bar(speeds, "Campbell", enabled=progress, unit="speed"):
-        state = spin(model, float(w), axis)
-        lam, phi = lowest_modes(state.model.K, state.model.M, n, factor=state.factor)
+        state, phi, f = modes_at_speed(model, float(w), axis, n)
         shapes.append(phi)
-        values.append(np.sqrt(np.maximum(lam, 0.0)) / (2 * math.pi))
+        values.append(f)
         displacements.append(state.displacement)
     out = from_modes(speeds, shapes, values, model.M, count, engine_orders)
     out.running_displacement = displacements
     return out
+
+
+def modes_at_speed(model: FEModel, speed: float, axis: RotationAxis | None, count: int, static: str = "linear"):
+    """``(state, Φ, f)``: the model spun at ``speed`` (:func:`~bladecase.fe.rotation.spin`), its ``count`` lowest
+    mode shapes (free dofs × count) and frequencies (Hz) about that state — one speed of a Campbell diagram."""
+    state = spin(model, speed, axis, static=static)
+    lam, phi = lowest_modes(state.model.K, state.model.M, count, factor=state.factor)
+    return state, phi, np.sqrt(np.maximum(lam, 0.0)) / (2 * math.pi)
 
 
 def from_modes(speeds, shapes: list[np.ndarray], frequencies: list[np.ndarray], M, count: int,

@@ -24,15 +24,11 @@ import math
 import numpy as np
 
 from .. import log
-from ..fe.campbell import Campbell, from_modes
+from ..fe.campbell import EXTRA_MODES, Campbell, from_modes, modes_at_speed
 from ..fe.rotation import RotationAxis, SpinState, spin, to_rad_s
-from ..linalg import lowest_modes
 from .schema import Study, StudyError
 
 __all__ = ["band_risks", "campbell_stage", "operating_point", "rotation_axis", "running_clearance", "speeds"]
-
-#: Candidate modes computed beyond the ``modes`` tracked (modes entering from above are followed by shape).
-EXTRA_MODES = 4
 
 
 def _section(study: Study) -> dict | None:
@@ -118,10 +114,9 @@ def _speed_point(omega: float, *, study: Study, model, contact, axis: RotationAx
     """One speed of the Campbell diagram (module level: an executor ships it to its workers)."""
     from .stages import build_reduced, period_unit, search
 
-    state = spin(model, float(omega), axis, static=study["rotation"].get("static", "auto"))
     n = min(count + EXTRA_MODES, model.n_dofs - 1)
-    lam, phi = lowest_modes(state.model.K, state.model.M, n, factor=state.factor)
-    point = {"shapes": phi, "frequencies_hz": np.sqrt(np.maximum(lam, 0.0)) / (2 * math.pi),
+    state, phi, f = modes_at_speed(model, float(omega), axis, n, static=study["rotation"].get("static", "auto"))
+    point = {"shapes": phi, "frequencies_hz": f,
              "clearance": running_clearance(study, model, contact, state, cold=True), "band_hz": None, "note": None}
     d = point["clearance"]["clearance_running_m"]
     if not bands:
