@@ -381,8 +381,8 @@ def recover(out: Path, locked: bool = False) -> bool:
                              "remove it and run again")
         journal = read_signed(marker)
         staging = out / journal["staging"] if journal and _valid_journal(journal) else None
-        if staging is not None and not os.path.lexists(staging) and read_signed(out / MANIFEST) is not None \
-                and read_signed(out / MANIFEST).get("run") == journal["staging"]:
+        done = read_signed(out / MANIFEST) if staging is not None and not os.path.lexists(staging) else None
+        if done is not None and done.get("run") == journal["staging"]:
             marker.unlink()  # killed after its last step but one: the publication is complete
             return True
         if staging is None or not stamped(staging):
