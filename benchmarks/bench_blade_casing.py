@@ -5,7 +5,7 @@ The massless contact on the area-weighted tip face (the demo's) in series with a
 size`` and ``tip_size`` scaled by 1.4, 1, 0.7 — and 0.5, 0.35 with ``--fine``) and each reduced size (massless
 method, 8, 16, 32, 64): the first open frequency f₁, the grazing energy ``E_g = ½ω₁²(d/b₁)²`` and, at the periods
 ``T/T₁`` of ``--ratios``, the energy of the backbone's orbit: the smoothest one-phase orbit of that period
-(``smoothest`` of every orbit ``orbits_at_period`` finds, bladecase.nsm.massless_orbits; admissible ones first),
+(``smoothest`` of every orbit ``orbits_at_period`` finds, bladecase.nsm.massless.orbits; admissible ones first),
 so that a narrow internal-resonance tongue elsewhere on the branch does not hide it; whether it is admissible
 (proved), and its contact fraction of the period. Then the relative changes between the two largest sizes (per
 mesh) and between the two finest meshes (largest size), of admissible orbits only, with the observed order
@@ -30,7 +30,7 @@ from scipy.linalg import LinAlgWarning
 import bladecase as bc
 from bladecase.fe import stiffness_factor
 from bladecase.nsm import series_stiffness
-from bladecase.nsm.massless_orbits import orbits_at_period, smoothest
+from bladecase.nsm.massless.orbits import orbits_at_period, smoothest
 from bladecase.post.compare_plots import observed_order as observed_order_of
 from bladecase.study import demo_study, stages
 

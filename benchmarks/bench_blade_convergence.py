@@ -35,7 +35,7 @@ from scipy.optimize import brentq
 
 import bladecase as bc
 from bladecase.nsm import MASSLESS_DENSE_LIMIT
-from bladecase.nsm.massless_orbits import SymmetricOrbit, closing_residual, orbit_at_period
+from bladecase.nsm.massless.orbits import SymmetricOrbit, closing_residual, orbit_at_period
 from bladecase.post.compare import ModelResult, contact_spectrum
 from bladecase.post.compare_table import convergence_verdict
 from bladecase.study import demo_study, stages
@@ -73,7 +73,7 @@ def grazing_energy(system) -> float:
 
 def orbits_at(branch, T: float) -> list:
     """The branch's orbits of period ``T``: ``Branch.orbit_at`` (Newton) or, massless,
-    ``bladecase.nsm.massless_orbits.orbit_at_period`` from the interpolated contact half-time of each pair of
+    ``bladecase.nsm.massless.orbits.orbit_at_period`` from the interpolated contact half-time of each pair of
     neighbours that brackets ``T``."""
     system = branch.system
     if getattr(system, "contact_model", "newton") != "massless":

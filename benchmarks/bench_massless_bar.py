@@ -1,7 +1,7 @@
 """Convergence study of the 1-D bar's first nonsmooth mode: massless vs Newton contact, against the continuum.
 
-Bar L = 1, EA = 1, ρA = 1, gap d = 0.5, fixed at x = 0 (bladecase.nsm.bar). The continuum's one-contact-phase
-mode (d'Alembert, bladecase.nsm.bar.bar_continuum_energy) has E = d²/(2(T-3)²) for 3 < T < 4. Printed:
+Bar L = 1, EA = 1, ρA = 1, gap d = 0.5, fixed at x = 0 (bladecase.nsm.massless.bar). The continuum's one-contact-phase
+mode (d'Alembert, bladecase.nsm.massless.bar.bar_continuum_energy) has E = d²/(2(T-3)²) for 3 < T < 4. Printed:
 
 1. the admissible one-phase symmetric orbits of the massless bar at T = 3.35, 3.45, 3.55 for n = 50…400
    (pointwise values at fixed T: do they converge?);
@@ -24,9 +24,9 @@ import time
 import numpy as np
 
 import bladecase as bc
-from bladecase.nsm.bar import bar, bar_continuum_band_energy, bar_continuum_energy, bar_continuum_field
-from bladecase.nsm.massless import simulate_massless
-from bladecase.nsm.massless_orbits import follow_from_grazing, orbits_at_period, smoothest
+from bladecase.nsm.massless.bar import bar, bar_continuum_band_energy, bar_continuum_energy, bar_continuum_field
+from bladecase.nsm.massless.model import simulate_massless
+from bladecase.nsm.massless.orbits import follow_from_grazing, orbits_at_period, smoothest
 
 D = 0.5
 QUICK = "--quick" in sys.argv

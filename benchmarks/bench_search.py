@@ -128,7 +128,7 @@ def off_families(system, mids: list, families) -> int:
     an earlier run) lie on none of ``families`` (re-solved from the family's curve at their period,
     :func:`bladecase.nsm.modes.on_curve`): admissible orbits the search no longer lists."""
     from bladecase.nsm.modes import on_curve
-    from bladecase.nsm.orbits import make_orbit
+    from bladecase.nsm.newton.orbits import make_orbit
 
     if not mids:
         return 0

@@ -28,7 +28,8 @@ import numpy as np  # noqa: E402
 
 import bladecase  # noqa: E402
 from bladecase.io import save_figure  # noqa: E402
-from bladecase.nsm.forced import Damping, simulate_forced  # noqa: E402
+from bladecase.nsm.damping import Damping  # noqa: E402
+from bladecase.nsm.newton.forced import simulate_forced  # noqa: E402
 
 _HERE = str(pathlib.Path(__file__).resolve().parent)
 if _HERE not in sys.path:  # for the sibling scripts, also when the script is loaded by path (tests)

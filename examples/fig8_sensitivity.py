@@ -19,7 +19,7 @@ own first linear period), as a fraction of the window, against ``n``:
 * Massless contact model, ``n = 4…200``: the last mass is massless, its mass ``1/n`` moved to the three masses
   before it keeping the total mass and the centre of mass (:func:`massless_chain`; ``n = 2, 3`` have too few
   neighbours to keep both), the contact condensed (theory §8). Its one-contact-phase mode is followed from
-  grazing at its open-phase period ``T₁`` (:func:`bladecase.nsm.massless_branches.massless_modes`); the
+  grazing at its open-phase period ``T₁`` (:func:`bladecase.nsm.massless.branches.massless_modes`); the
   measure is the part of the window covered by the admissible arc that starts at grazing (end refined to 1e-9 T).
 
 Run: ``python examples/fig8_sensitivity.py [--out DIR] [--low]`` (``--low``: a few ``n`` only; the full scan
@@ -39,8 +39,8 @@ import numpy as np  # noqa: E402
 
 import bladecase  # noqa: E402
 from bladecase.io import save_figure  # noqa: E402
-from bladecase.nsm.massless import MasslessSystem, condense, redistribute_mass  # noqa: E402
-from bladecase.nsm.massless_branches import massless_modes  # noqa: E402
+from bladecase.nsm.massless.branches import massless_modes  # noqa: E402
+from bladecase.nsm.massless.model import MasslessSystem, condense, redistribute_mass  # noqa: E402
 
 _HERE = str(pathlib.Path(__file__).resolve().parent)
 if _HERE not in sys.path:  # for examples/_paper.py, also when the script is loaded by path (tests)

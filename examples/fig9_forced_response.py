@@ -36,7 +36,7 @@ import numpy as np  # noqa: E402
 
 import bladecase  # noqa: E402
 from bladecase.io import save_figure  # noqa: E402
-from bladecase.nsm.forced import Damping  # noqa: E402
+from bladecase.nsm.damping import Damping  # noqa: E402
 from bladecase.nsm.sweep import SweepPoint, forced_sweep  # noqa: E402
 
 _HERE = str(pathlib.Path(__file__).resolve().parent)

@@ -5,7 +5,7 @@ import pytest
 
 from bladecase.nsm import bar, chain, orbit_1ipp, orbits_kipp
 from bladecase.nsm.energy import ModalSplit, describe_split, modal_energy_split
-from bladecase.nsm.massless_branches import massless_mode
+from bladecase.nsm.massless.branches import massless_mode
 
 
 def test_newton_split_is_the_flight_invariant_modal_energy():

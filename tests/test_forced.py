@@ -1,4 +1,4 @@
-"""Forced, damped event-driven simulation and the forcing-period sweep (bladecase.nsm.forced, .sweep).
+"""Forced, damped event-driven simulation and the forcing-period sweep (bladecase.nsm.newton.forced, .sweep).
 
 * the exact flight against scipy's solve_ivp (1e-9 relative) for under-, critically and over-damped modes,
   exactly and nearly resonant forcing of undamped modes, Rayleigh damping and a non-diagonal mass matrix;
@@ -19,7 +19,8 @@ from scipy.integrate import solve_ivp
 
 import bladecase as bc
 from bladecase.nsm.damped_signals import DampedModes, DampedSignal
-from bladecase.nsm.forced import Damping, ForcedFlight, simulate_forced
+from bladecase.nsm.damping import Damping
+from bladecase.nsm.newton.forced import ForcedFlight, simulate_forced
 from bladecase.nsm.sweep import forced_point, forced_sweep
 from bladecase.study.executor import SerialExecutor
 

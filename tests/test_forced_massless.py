@@ -1,11 +1,11 @@
-"""Forced, damped simulation of the massless contact model (bladecase.nsm.forced_massless, issue 13)."""
+"""Forced, damped simulation of the massless contact model (bladecase.nsm.massless.forced, issue 13)."""
 
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
 from bladecase.nsm import Damping, bar, condense, simulate_massless
-from bladecase.nsm.forced_massless import (
+from bladecase.nsm.massless.forced import (
     ExpSignal,
     MasslessForcedFlight,
     _ModalPhase,

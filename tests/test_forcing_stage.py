@@ -10,7 +10,7 @@ import pytest
 from _studies import PLATE, ROOT, absolute
 
 from bladecase.nsm import chain
-from bladecase.nsm.forced import Damping
+from bladecase.nsm.damping import Damping
 from bladecase.nsm.sweep import forced_point
 from bladecase.post.forced_plots import forced_response_plot
 from bladecase.post.outputs import FORMATS

@@ -455,7 +455,7 @@ def test_an_eigen_solution_out_of_proportion_is_refused_or_announced(caplog):
 
 def test_simulate_bounds_the_memory_of_its_stored_impacts():
     """Each impact keeps its state (4 n floats); the default cap keeps them within 1 GB and says so."""
-    from bladecase.nsm.simulation import STATE_MEMORY_BYTES, default_max_impacts
+    from bladecase.nsm.newton.simulation import STATE_MEMORY_BYTES, default_max_impacts
 
     assert default_max_impacts(200) * 32 * 200 <= STATE_MEMORY_BYTES < (default_max_impacts(200) + 1) * 32 * 200
     assert default_max_impacts(1) == 1_000_000

@@ -265,7 +265,7 @@ def test_nonsmooth_mode_system_type():
 
 def test_the_default_resolution_keeps_the_grid_bounded():
     """k = 8 with the default resolution of a stiff system: the grid is cut to MAX_GRID_CELLS cells, not 6e7."""
-    from bladecase.nsm import kipp
+    from bladecase.nsm.newton import kipp
 
     assert kipp._largest_resolution(8) == 28 and math.comb(27, 7) <= kipp.MAX_GRID_CELLS < math.comb(28, 7)
     assert kipp._largest_resolution(3) == kipp.MAX_RESOLUTION
@@ -295,8 +295,8 @@ def test_massless_mode_arguments(call, words):
 
 
 def test_massless_orbit_helpers_arguments():
-    from bladecase.nsm.massless_follow import follow_mode
-    from bladecase.nsm.massless_orbits import follow_from_grazing, orbit_at_period, orbits_at_period
+    from bladecase.nsm.massless.follow import follow_mode
+    from bladecase.nsm.massless.orbits import follow_from_grazing, orbit_at_period, orbits_at_period
 
     with pytest.raises(ValueError, match="T must be a finite number > 0, got 'a'"):
         orbits_at_period(MASSLESS, "a")

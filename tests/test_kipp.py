@@ -883,8 +883,8 @@ def test_generic_driver_follows_another_residual():
     the bilinear oscillator (mass on k₁ = 1, massless contact point on k₂ = 3, gap 1), whose periodic
     orbits obey a closed-form period–energy relation."""
     from bladecase.nsm import Curve, trace
-    from bladecase.nsm.massless import condense
-    from bladecase.nsm.massless_orbits import SymmetricOrbit, closing_residual, orbit_at_period
+    from bladecase.nsm.massless.model import condense
+    from bladecase.nsm.massless.orbits import SymmetricOrbit, closing_residual, orbit_at_period
 
     s = condense(np.diag([1.0, 0.0]), np.array([[4.0, -3.0], [-3.0, 3.0]]), np.array([0.0, 1.0]), gap=1.0)
 

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from bladecase.nsm.bar import bar, bar_continuum_energy, bar_continuum_field
-from bladecase.nsm.massless import condense, redistribute_mass, simulate_massless
-from bladecase.nsm.massless_orbits import follow_from_grazing
+from bladecase.nsm.massless.bar import bar, bar_continuum_energy, bar_continuum_field
+from bladecase.nsm.massless.model import condense, redistribute_mass, simulate_massless
+from bladecase.nsm.massless.orbits import follow_from_grazing
 
 
 def bilinear(m=1.0, k1=1.0, k2=3.0, d=1.0):
@@ -161,8 +161,8 @@ def test_band_limited_energy_of_the_bar_mode_converges_to_the_continuum():
     """The measure that converges (docs/massless.md): at T = 3.45, the smoothest one-phase orbit's energy in the
     lowest 10 modes approaches the continuum's with an observed order >= 1.5 and is within 1 % at n = 200, while
     the total energy stays > 10 % off (mesh-scale modes)."""
-    from bladecase.nsm.bar import bar_continuum_band_energy
-    from bladecase.nsm.massless_orbits import orbits_at_period, smoothest
+    from bladecase.nsm.massless.bar import bar_continuum_band_energy
+    from bladecase.nsm.massless.orbits import orbits_at_period, smoothest
 
     T, d, K = 3.45, 0.5, 10
     ref = bar_continuum_band_energy(T, d, K)

@@ -18,7 +18,7 @@ from test_massless_fe import strip
 
 import bladecase as bc
 from bladecase.nsm import condense, series_stiffness, simulate_massless
-from bladecase.nsm.massless_orbits import follow_from_grazing, orbits_at_period, smoothest
+from bladecase.nsm.massless.orbits import follow_from_grazing, orbits_at_period, smoothest
 from bladecase.reduction import load_reduced, save_reduced
 from bladecase.study.schema import StudyError, validate
 

@@ -1,5 +1,5 @@
-"""Orbits of the massless model with several contact phases per period (bladecase/nsm/massless_phases.py) and the
-mode followed through changes of its phase pattern (bladecase/nsm/massless_follow.py)."""
+"""Orbits of the massless model with several contact phases per period (bladecase/nsm/massless/phases.py) and the
+mode followed through changes of its phase pattern (bladecase/nsm/massless/follow.py)."""
 
 import pickle
 
@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 from bladecase.nsm import Branch, bar
-from bladecase.nsm.massless import simulate_massless
-from bladecase.nsm.massless_branches import massless_mode
-from bladecase.nsm.massless_orbits import closing_residual
-from bladecase.nsm.massless_phases import PhasedOrbit, solve_half, split_at
+from bladecase.nsm.massless.branches import massless_mode
+from bladecase.nsm.massless.model import simulate_massless
+from bladecase.nsm.massless.orbits import closing_residual
+from bladecase.nsm.massless.phases import PhasedOrbit, solve_half, split_at
 
 
 @pytest.fixture(scope="module")

@@ -14,8 +14,8 @@ import pytest
 
 import bladecase as bc
 from bladecase.nsm import continuation, modes
-from bladecase.nsm.arc_ends import _bisect_end, bisect_ends
-from bladecase.nsm.families import (
+from bladecase.nsm.newton.arc_ends import _bisect_end, bisect_ends
+from bladecase.nsm.newton.families import (
     ARC_RTOL,
     KippCurve,
     KippCurves,
@@ -24,8 +24,8 @@ from bladecase.nsm.families import (
     polished_orbits,
     trace_families,
 )
-from bladecase.nsm.kipp import canonical_rotation
-from bladecase.nsm.modal import (
+from bladecase.nsm.newton.kipp import canonical_rotation
+from bladecase.nsm.newton.modal import (
     ModalKernel,
     impact_kernels,
     impulses_for,
@@ -34,7 +34,7 @@ from bladecase.nsm.modal import (
     solve_times,
     solve_times_stack,
 )
-from bladecase.nsm.orbits import REPEAT_RTOL, make_orbit, make_orbits
+from bladecase.nsm.newton.orbits import REPEAT_RTOL, make_orbit, make_orbits
 from bladecase.nsm.signals import TrigSum, certified_max, certified_max_stack, sincos
 
 
@@ -345,7 +345,7 @@ def test_start_index_near_many_is_near_of_each(k):
     index's order; none missed at the edges of the sorted first-impact ranges."""
     from types import SimpleNamespace
 
-    from bladecase.nsm.coverage import _StartIndex
+    from bladecase.nsm.newton.coverage import _StartIndex
 
     rng = np.random.default_rng(7 + k)
     T = 10.0

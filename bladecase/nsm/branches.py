@@ -1,7 +1,7 @@
 """Branches of periodic orbits — the nonsmooth modes — and how they are found.
 
 One type, :class:`Branch`, holds a sequence of k-ipp orbits with its admissible :class:`Arc` s, whether it came
-from a scan of periods (:func:`bladecase.nsm.scan.backbone`, 1 impact per period: one orbit per requested
+from a scan of periods (:func:`bladecase.nsm.newton.scan.backbone`, 1 impact per period: one orbit per requested
 period, ``None`` at resonant ones) or from continuation along the solution curve (:func:`nonsmooth_mode`, any
 ``k``; the curve is followed through turning points in ``T`` by :mod:`bladecase.nsm.continuation`).
 ``Family``, ``Backbone`` and ``Interval`` are the former names of :class:`Branch` and :class:`Arc`.
@@ -15,10 +15,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .families import ARC_RTOL, MERGE_RTOL
-from .kipp import check_k
-from .modal import ModalKernel, check_period, solve_times
-from .orbits import PeriodicOrbit, make_orbit
+from .newton.families import ARC_RTOL, MERGE_RTOL
+from .newton.kipp import check_k
+from .newton.modal import ModalKernel, check_period, solve_times
+from .newton.orbits import PeriodicOrbit, make_orbit
 from .system import LinearSystem
 
 __all__ = ["ARC_RTOL", "MERGE_RTOL", "Arc", "Backbone", "Branch", "Family", "Interval"]  # nonsmooth_mode: .modes
@@ -91,7 +91,7 @@ class Branch:
 
     Examples
     --------
-    A scan of 1-ipp orbits of the two-mass chain (one orbit per period; :func:`~bladecase.nsm.scan.backbone`):
+    A scan of 1-ipp orbits of the two-mass chain (one orbit per period; :func:`~bladecase.nsm.newton.scan.backbone`):
 
     >>> from bladecase.nsm import backbone, chain
     >>> system = chain(2, k=1.0, m=0.5, gap=1.0)
@@ -234,7 +234,7 @@ class Branch:
         """
         system = self._bound()
         if getattr(system, "contact_model", "newton") == "massless":
-            from .massless_branches import massless_orbit_at
+            from .massless.branches import massless_orbit_at
 
             return massless_orbit_at(system, self.orbits, float(T))
         out = []
@@ -436,10 +436,10 @@ def _interval_arc(iv: dict, periods: list[float], orbits: list) -> Arc:
 def _orbit_from_dict(system, rec: dict):
     """An orbit record of either contact model (``contact_model`` key; Newton when absent)."""
     if rec.get("contact_model") == "massless":
-        from .massless_orbits import SymmetricOrbit
+        from .massless.orbits import SymmetricOrbit
 
         if "durations" in rec:
-            from .massless_phases import PhasedOrbit
+            from .massless.phases import PhasedOrbit
 
             return PhasedOrbit.from_dict(system, rec)
 

@@ -3,7 +3,7 @@
 A :class:`Curve` is ``R: ℝⁿ → ℝᵐ`` whose zero set is (locally) a curve — rank ``n - 1`` Jacobian; redundant
 equations (``m >= n``) are allowed — given as callables: the residual, its EXACT Jacobian, and optional
 predicates (``valid`` points, forbidden ``crossing`` between two points).  The driver knows nothing else:
-the k-ipp families (:mod:`bladecase.nsm.families`: impact times and period) and, e.g., the shooting equations of
+the k-ipp families (:mod:`bladecase.nsm.newton.families`: impact times and period) and, e.g., the shooting equations of
 a piecewise-linear contact model (switching instants and period) plug in the same way.
 
 * :func:`tangent` — the unit null vector of the Jacobian (SVD), oriented along a previous one;

@@ -57,7 +57,7 @@ def _newton(orbit) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _massless(orbit) -> tuple[np.ndarray, np.ndarray]:
-    from .massless_phases import PhasedOrbit
+    from .massless.phases import PhasedOrbit
 
     s = orbit._bound()
     o = s.open

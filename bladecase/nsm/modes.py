@@ -1,13 +1,13 @@
 """Finding the nonsmooth modes of a system: :func:`nonsmooth_mode`, for either contact model.
 
 Newton contact: every k-ipp family started from the orbits found at ``scan`` periods
-(:func:`~bladecase.nsm.kipp.orbits_kipp`) and followed by continuation (:mod:`~bladecase.nsm.families`);
-``k = 1`` is a scan (:func:`~bladecase.nsm.scan.backbone`). Massless contact: the branches grown from the
-open-phase modes at grazing (:mod:`~bladecase.nsm.massless_branches`). All are :class:`~bladecase.nsm.Branch` es.
+(:func:`~bladecase.nsm.newton.kipp.orbits_kipp`) and followed by continuation (:mod:`~bladecase.nsm.newton.families`);
+``k = 1`` is a scan (:func:`~bladecase.nsm.newton.scan.backbone`). Massless contact: the branches grown from the
+open-phase modes at grazing (:mod:`~bladecase.nsm.massless.branches`). All are :class:`~bladecase.nsm.Branch` es.
 
 The k-ipp search, in this module: the families of many starts traced together in start order, a start skipped
 when an earlier family passes it — each crossing of a family with a scan period solved once and the starts
-matched by lookup (:func:`starts_passed`, :mod:`~bladecase.nsm.coverage`) — and, by geometry
+matched by lookup (:func:`starts_passed`, :mod:`~bladecase.nsm.newton.coverage`) — and, by geometry
 (:func:`on_curve`), each stretch of a branch listed once (:func:`distinct_runs`; a family lying on another is
 dropped).  The starts themselves are not certified (only the families' orbits are).
 """
@@ -17,8 +17,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..progress import progress_bar, progress_counter
+from .arcs import check_period_range
 from .branches import Arc, Branch
-from .coverage import (  # noqa: F401 (PASS_GATE, passes, phase_distance(s), starts_passed: lived here)
+from .massless.model import MasslessSystem
+from .newton.coverage import (  # noqa: F401 (PASS_GATE, passes, phase_distance(s), starts_passed: lived here)
     PASS_GATE,
     _passed,
     _resolve,
@@ -28,11 +30,10 @@ from .coverage import (  # noqa: F401 (PASS_GATE, passes, phase_distance(s), sta
     phase_distances,
     starts_passed,
 )
-from .families import FamilyTracer, complete_families
-from .kipp import canonical_rotation, check_period_range, check_resolution, check_search_k, orbits_kipp
-from .massless import MasslessSystem
-from .modal import solve_times_stack
-from .orbits import REPEAT_RTOL, PeriodicOrbit
+from .newton.families import FamilyTracer, complete_families
+from .newton.kipp import canonical_rotation, check_resolution, check_search_k, orbits_kipp
+from .newton.modal import solve_times_stack
+from .newton.orbits import REPEAT_RTOL, PeriodicOrbit
 from .system import LinearSystem
 
 __all__ = ["MASSLESS_MIN_POINTS", "nonsmooth_mode"]
@@ -73,7 +74,7 @@ def nonsmooth_mode(
         A Newton-contact system, or a massless-contact one (:class:`~bladecase.nsm.MasslessSystem`, from
         :func:`~bladecase.nsm.bar` or a massless reduced model): then ``k = 1`` (one contact phase per
         period) and each branch grows from an open-phase linear mode at grazing
-        (:mod:`~bladecase.nsm.massless_branches`).
+        (:mod:`~bladecase.nsm.massless.branches`).
     k : int
         Impacts (contact phases) per period (>= 1).
     T_range : (T_min, T_max)
@@ -137,11 +138,11 @@ def nonsmooth_mode(
         if k != 1:
             raise ValueError(f"the massless contact model has modes with one contact phase per period (k = 1) "
                              f"so far; got k = {k}")
-        from .massless_branches import massless_modes
+        from .massless.branches import massless_modes
 
         return massless_modes(system, (T_lo, T_hi), max_points=max(max_points, MASSLESS_MIN_POINTS), refine=refine)
     if k == 1:
-        from .scan import backbone
+        from .newton.scan import backbone
 
         return [backbone(system, np.linspace(T_lo, T_hi, max(scan, 200))).compact()]
     starts = []
@@ -165,10 +166,10 @@ def _follow_starts(system: LinearSystem, k: int, starts: list[tuple[float, Perio
     """The family of every start not passed by the family of an earlier start, in the order of the starts,
     each branch listed once.
 
-    Up to ``TRACE_WINDOW`` families are traced at once (:class:`~bladecase.nsm.families.FamilyTracer`); they
+    Up to ``TRACE_WINDOW`` families are traced at once (:class:`~bladecase.nsm.newton.families.FamilyTracer`); they
     are taken in the order of their starts: the first unresolved start whose family is traced is kept and
     marks the later starts its curve passes (:func:`starts_passed`), whose traces, if begun, are dropped: the
-    same families as following the starts one by one (:func:`~bladecase.nsm.coverage._resolve`).  Then, by
+    same families as following the starts one by one (:func:`~bladecase.nsm.newton.coverage._resolve`).  Then, by
     geometry: a stretch a family's curve traces a second time is left out (the family is cut there,
     :func:`distinct_runs`), and a family whose orbits all lie on another family (one passing its start) is
     dropped (:func:`on_curve`).
@@ -316,7 +317,7 @@ def on_curve(curve: list[PeriodicOrbit], orbits: list[PeriodicOrbit], allowed: n
     An orbit is one when a segment of ``curve`` (``allowed[i, j]``: may orbit ``i`` be matched on segment
     ``j``) brackets its period with interpolated (canonically rotated) impact times near its own (within
     ``SAME_GATE·T`` plus the segment's length) and, re-solved at its period from there
-    (:func:`~bladecase.nsm.modal.solve_times`), gives its impact times to ``SAME_RTOL·T``: the same orbit,
+    (:func:`~bladecase.nsm.newton.modal.solve_times`), gives its impact times to ``SAME_RTOL·T``: the same orbit,
     whatever the points the two families were sampled at.
 
     >>> from bladecase.nsm import chain, nonsmooth_mode

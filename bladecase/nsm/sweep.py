@@ -1,7 +1,7 @@
 """Forcing-period sweep of the forced, damped impact oscillator (seed paper Sec. 2.5, Figs. 9–10).
 
 For each forcing period ``T = 2π/Ω`` the system is integrated over ``n_periods`` periods
-(:func:`~bladecase.nsm.forced.simulate_forced`, exact flights, certified contact search) and the end of
+(:func:`~bladecase.nsm.newton.forced.simulate_forced`, exact flights, certified contact search) and the end of
 the run is classified by :func:`forced_point`:
 
 * **periodic steady state** — the stroboscopic map (the state sampled once per forcing period) returns
@@ -25,8 +25,8 @@ mechanical energy ``E(t) = ½vᵀMv + ½xᵀKx`` (kinetic + strain; the damping 
 included), sampled at 64 points per shortest period and refined around the largest sample;
 ``mean_energy`` is its time average over the cycle.
 
-**Massless contact model** (:class:`~bladecase.nsm.massless.MasslessSystem`): the runs are
-:func:`~bladecase.nsm.forced_massless.simulate_forced_massless`; "impacts" are then the contact phases (their
+**Massless contact model** (:class:`~bladecase.nsm.massless.model.MasslessSystem`): the runs are
+:func:`~bladecase.nsm.massless.forced.simulate_forced_massless`; "impacts" are then the contact phases (their
 closing switches: ``k`` contact phases per ``p`` forcing periods), ``impulses`` the momentum ``∫λ dt`` each
 phase transmits, the energy ``½vᵀMv + ½xᵀSx + ½k_c max(0, y - d)²`` and the return norm ``xᵀSx + vᵀMv``.
 
@@ -47,9 +47,10 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from ..progress import progress_bar
-from .forced import Damping, ForcedTrajectory, _real, simulate_forced
-from .forced_massless import MasslessForcedTrajectory, simulate_forced_massless
-from .massless import MasslessSystem
+from .damping import Damping, _real
+from .massless.forced import MasslessForcedTrajectory, simulate_forced_massless
+from .massless.model import MasslessSystem
+from .newton.forced import ForcedTrajectory, simulate_forced
 from .system import LinearSystem
 
 __all__ = ["SWEEP_TOL", "SweepPoint", "forced_point", "forced_sweep", "rate_max", "settles_linear"]
@@ -216,8 +217,8 @@ def forced_point(system: LinearSystem | MasslessSystem, T: float, *, damping: Da
     """Integrate ``n_periods`` forcing periods from ``(x0, v0)`` (default: rest) and classify the end.
 
     A pure function of its arguments (a study executor may map it over periods).  A
-    :class:`~bladecase.nsm.massless.MasslessSystem` is run by
-    :func:`~bladecase.nsm.forced_massless.simulate_forced_massless` (``contact_load``: its ``g``; module
+    :class:`~bladecase.nsm.massless.model.MasslessSystem` is run by
+    :func:`~bladecase.nsm.massless.forced.simulate_forced_massless` (``contact_load``: its ``g``; module
     docstring: contact phases are counted instead of impacts).
 
     The paper's 2-dof chain forced at ``T = 4.5`` settles on one impact per forcing period; its energy peaks
@@ -286,8 +287,8 @@ def forced_sweep(system: LinearSystem | MasslessSystem, periods, damping: Dampin
     periods : sequence of float
         Forcing periods ``T = 2π/Ω`` (any order; visited in the sweep direction).
     damping, amplitude, load, restitution, contact_load
-        As :func:`~bladecase.nsm.forced.simulate_forced` (``amplitude`` is ``F₀``; ``restitution``: Newton's
-        model only) and :func:`~bladecase.nsm.forced_massless.simulate_forced_massless` (``contact_load``).
+        As :func:`~bladecase.nsm.newton.forced.simulate_forced` (``amplitude`` is ``F₀``; ``restitution``: Newton's
+        model only) and :func:`~bladecase.nsm.massless.forced.simulate_forced_massless` (``contact_load``).
     n_periods : int
         Forcing periods integrated at each ``T`` (the paper: 500).
     direction : {"up", "down"}

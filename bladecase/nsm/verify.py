@@ -1,7 +1,7 @@
 """The independent check of a periodic orbit: the event-driven simulator, started from the orbit's
 post-impact state, must come back to it after one period with the same number of impacts.
 
-The orbit's equations (:mod:`~bladecase.nsm.modal`) and the simulator (:mod:`~bladecase.nsm.simulation`)
+The orbit's equations (:mod:`~bladecase.nsm.newton.modal`) and the simulator (:mod:`~bladecase.nsm.newton.simulation`)
 share no code path but the system's matrices, so agreement is evidence that the orbit exists in the
 system it was computed for — and only in that system (checking a reduced model's orbit in a richer
 model is a separate question).
@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .orbits import PeriodicOrbit
-from .simulation import simulate
+from .newton.orbits import PeriodicOrbit
+from .newton.simulation import simulate
 
 #: Relative tolerance of the independent check of an animated orbit: the
 #: event-driven simulator started from its post-impact state at ``t = 0`` must
@@ -53,8 +53,8 @@ def verify(orbit: PeriodicOrbit) -> dict:
 
 def _verify_massless(orbit) -> dict:
     """The massless model's check: from the orbit's state at mid-contact, one period of
-    :func:`~bladecase.nsm.massless.simulate_massless` must come back with one opening and one closing."""
-    from .massless import simulate_massless
+    :func:`~bladecase.nsm.massless.model.simulate_massless` must come back with one opening and one closing."""
+    from .massless.model import simulate_massless
 
     T = orbit.T
     x0, v0 = (z[:, 0] for z in orbit.state(np.array([orbit.beta])))  # mid-contact: no switch at t = 0

@@ -1,7 +1,7 @@
 """Stage 2 — the reduction layer: contact, orthogonal-symmetry basis, Lanczos chain, reduced models.
 
 Data in: an :class:`~bladecase.fe.FEModel` and a :class:`Contact`. Data out: a :class:`ReducedModel`
-whose ``.system`` is the :class:`~bladecase.nsm.orbits.LinearSystem` the solver takes, and which expands
+whose ``.system`` is the :class:`~bladecase.nsm.system.LinearSystem` the solver takes, and which expands
 reduced states back to the mesh.
 
 Modules: :mod:`~bladecase.reduction.contact` (:class:`Contact`), :mod:`~bladecase.reduction.symmetry`

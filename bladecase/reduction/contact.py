@@ -237,7 +237,7 @@ class Contact:
 
         The casing — its local flexibility, its abradable coating — acts as a spring between the contact and the
         rigid casing at ``gap``: with the massless contact model the closed phase's stiffness is the contact's in
-        series with the casing's (:func:`bladecase.nsm.massless.series_stiffness`), and the contact moves
+        series with the casing's (:func:`bladecase.nsm.massless.model.series_stiffness`), and the contact moves
         ``λ / stiffness`` beyond the gap. Newton's impact law needs a rigid casing.
 
         >>> Contact(3, (0.0, 1.0), 1e-4).with_casing(2e6)

@@ -1,7 +1,7 @@
 """Load vectors on a finite-element model and their projection onto a reduced model.
 
 A load is a vector ``f`` on the FREE dofs of an :class:`~bladecase.fe.FEModel` (the order of ``model.K``):
-the external force is ``F₀ f cos(Ωt)`` in the forced simulation (:func:`bladecase.nsm.forced.simulate_forced`).
+the external force is ``F₀ f cos(Ωt)`` in the forced simulation (:func:`bladecase.nsm.newton.forced.simulate_forced`).
 
 * :func:`nodal_load` — a force of given total ``amplitude`` (N) along a direction, shared equally by one node
   or a set of nodes (a list, or a mesh group);

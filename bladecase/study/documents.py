@@ -202,8 +202,8 @@ def _newton_problems(system: LinearSystem, orbits: list) -> list[str | None]:
     """Why each of ``orbits`` (Newton contact, one family) is not an admissible orbit of ``system`` (``None``:
     it is)."""
     from ..nsm import ModalKernel, check_period
-    from ..nsm.modal import check_times
-    from ..nsm.orbits import make_orbits
+    from ..nsm.newton.modal import check_times
+    from ..nsm.newton.orbits import make_orbits
 
     out: list[str | None] = [None] * len(orbits)
     ok = []
@@ -249,8 +249,8 @@ def _newton_problems(system: LinearSystem, orbits: list) -> list[str | None]:
 
 def _massless_problem(system: MasslessSystem, orbit) -> str | None:
     """Why ``orbit`` (massless contact) is not an admissible orbit of ``system`` (``None``: it is)."""
-    from ..nsm.massless_orbits import SymmetricOrbit, closing_residual
-    from ..nsm.massless_phases import PhasedOrbit, solve_half
+    from ..nsm.massless.orbits import SymmetricOrbit, closing_residual
+    from ..nsm.massless.phases import PhasedOrbit, solve_half
 
     try:
         if isinstance(orbit, SymmetricOrbit):

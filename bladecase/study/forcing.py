@@ -15,7 +15,7 @@ Engine order ``EO`` (:class:`bladecase.reduction.loads.EngineOrderLoad`): a sing
 ``frequency_unit = "rpm"`` the range is given in rotation speeds, and the CSV and figure show both.
 
 Either contact model: with ``[contact] model = "massless"`` the sweeps run
-:func:`bladecase.nsm.forced_massless.simulate_forced_massless` (``k`` then counts contact phases, ``restitution``
+:func:`bladecase.nsm.massless.forced.simulate_forced_massless` (``k`` then counts contact phases, ``restitution``
 must stay 1), and a load on the massless contact dofs enters exactly through its static contact displacement
 ``g = w_cᵀK_cc⁻¹f_c`` (:func:`contact_load`).
 """
@@ -32,8 +32,9 @@ from scipy.optimize import minimize_scalar
 from .. import log
 from ..io import save_figure, write_text
 from ..nsm import MasslessSystem
-from ..nsm.forced import Damping, ForcedTrajectory, simulate_forced
-from ..nsm.forced_massless import MasslessForcedTrajectory, simulate_forced_massless
+from ..nsm.damping import Damping
+from ..nsm.massless.forced import MasslessForcedTrajectory, simulate_forced_massless
+from ..nsm.newton.forced import ForcedTrajectory, simulate_forced
 from ..nsm.sweep import ENERGY_SAMPLES, SweepPoint, forced_sweep, rate_max
 from ..post.forced_plots import forced_response_plot
 from ..reduction import ReducedModel

@@ -57,7 +57,7 @@ def check_in_reference(orbit, reduced: ReducedModel, reference: ReducedModel) ->
     "contacts": impacts or contact phases in the period (the orbit has ``orbit.k``), "survives": bool}``.
     """
     from ..nsm import simulate
-    from ..nsm.massless import simulate_massless
+    from ..nsm.massless.model import simulate_massless
 
     massless = getattr(orbit, "contact_model", "newton") == "massless"
     t0 = orbit.mid_open_time if massless else 0.5 * float(np.diff(np.r_[0.0, orbit.impact_times]).min())

@@ -406,7 +406,7 @@ def _check_start_grid(system, k: int, T: float, scan: int, resolution: int | Non
         return
     from math import comb
 
-    from ..nsm.kipp import default_resolution
+    from ..nsm.newton.kipp import default_resolution
 
     res = resolution or default_resolution(T, float(system.spectrum.contact_modes[0].max()))
     cells = comb(res - 1, k - 1) * scan

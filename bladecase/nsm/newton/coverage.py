@@ -106,8 +106,8 @@ def _crossings(problem: KippCurve, zs, index: _StartIndex, wanted: np.ndarray) -
 
 def _solve_crossings(problem: KippCurve, crossings: list[tuple]) -> list:
     """The fixed-period solutions from the crossings (``None`` where none converges): for ``k = 2`` all of them
-    at once (:func:`~bladecase.nsm.modal.solve_times_stack`: the scalar equation ``s(t₁) = 0``), else one
-    :func:`~bladecase.nsm.modal.solve_times` each."""
+    at once (:func:`~bladecase.nsm.newton.modal.solve_times_stack`: the scalar equation ``s(t₁) = 0``), else one
+    :func:`~bladecase.nsm.newton.modal.solve_times` each."""
     if problem.k == 2 and crossings:
         return solve_times_stack(problem.system, np.array([c[0] for c in crossings]),
                                  np.array([c[1] for c in crossings]), problem.d)

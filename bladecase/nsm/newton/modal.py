@@ -27,9 +27,9 @@ from functools import cache, cached_property
 
 import numpy as np
 
-from .continuation import lstsq_stack
-from .signals import sincos_half
-from .system import LinearSystem
+from ..continuation import lstsq_stack
+from ..signals import sincos_half
+from ..system import LinearSystem
 
 #: ``T`` is resonant when ``|ω_j T - 2πm| <= RESONANCE_RTOL · ω_j T`` for an
 #: integer ``m >= 1`` and a mode with ``b_j ≠ 0``: within the accuracy of the

@@ -2,13 +2,13 @@
 
 ``M x'' + C x' + K x = F₀ cos(Ωt) f`` with the unilateral constraint ``wᵀx <= d`` and Moreau's form of
 Newton's law (restitution ``e``).  Damping is modal: Rayleigh ``C = αK + βM`` (the paper uses ``C = αK``)
-or modal damping ratios ``ζ_j`` (:class:`Damping`); the load vector ``f`` defaults to a unit force on every
-dof — the paper's "force acting on every mass" of the spring–mass chain.
+or modal damping ratios ``ζ_j`` (:class:`~bladecase.nsm.damping.Damping`); the load vector ``f`` defaults to a
+unit force on every dof — the paper's "force acting on every mass" of the spring–mass chain.
 
 The free flight stays EXACT between events: closed form per mode in every regime (under-, critically and
 over-damped; near-resonant and exactly resonant forcing of an undamped mode) in
 :mod:`bladecase.nsm.damped_signals`, whose contact signal carries a certified curvature bound, so the
-unchanged event loop :func:`bladecase.nsm.simulation.integrate` finds every first contact (no grazing
+unchanged event loop :func:`bladecase.nsm.newton.simulation.integrate` finds every first contact (no grazing
 contact missed) and refines it to machine precision.  :class:`ForcedFlight` is the propagator plugged into
 that loop; :func:`simulate_forced` is the entry point.  Pre-impact states are recorded as well
 (``v⁻ = v⁺ + Λ M⁻¹w``, positions continuous).
@@ -26,121 +26,13 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from .damped_signals import DampedModes, DampedSignal
+from ..damped_signals import DampedModes, DampedSignal
+from ..damping import QUAD_NODES, Damping, EnergyBalance, _real, forcing_inputs
+from ..system import LinearSystem
 from .flight import ModalFlight, NewtonImpact
 from .simulation import Trajectory, _check_state, integrate
-from .system import LinearSystem
 
-__all__ = ["Damping", "EnergyBalance", "ForcedFlight", "ForcedTrajectory", "simulate_forced"]
-
-#: Gauss–Legendre nodes per quadrature panel of :meth:`ForcedTrajectory.energy_balance` (panels of at most
-#: half the shortest period: the integrands are entire functions, the error is at round-off level).
-QUAD_NODES = 20
-
-
-def _finite_nonneg(name: str, value) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a finite number >= 0, got {value!r}") from None
-    if not np.isfinite(v) or v < 0:
-        raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
-    return v
-
-
-@dataclass(frozen=True)
-class Damping:
-    """Modal damping: Rayleigh ``C = αK + βM`` or modal damping ratios ``ζ_j`` (not both).
-
-    In M-normalised modal coordinates ``ΦᵀCΦ = diag(2σ_j)``, ``σ_j = ζ_j ω_j`` with
-    ``ζ_j = (α ω_j + β/ω_j)/2`` for Rayleigh damping.
-
-    >>> import numpy as np
-    >>> Damping(alpha=0.01).ratios(np.array([1.0, 4.0])).tolist()      # C = αK: ζ_j = αω_j/2
-    [0.005, 0.02]
-    >>> Damping(zeta=[0.02, 0.05]).rates(np.array([1.0, 4.0])).tolist()
-    [0.02, 0.2]
-    """
-
-    alpha: float = 0.0
-    beta: float = 0.0
-    zeta: tuple[float, ...] | float | None = None
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "alpha", _finite_nonneg("alpha", self.alpha))
-        object.__setattr__(self, "beta", _finite_nonneg("beta", self.beta))
-        if self.zeta is not None:
-            try:
-                if isinstance(self.zeta, (str, bytes)):
-                    raise TypeError
-                z = np.atleast_1d(np.asarray(self.zeta, dtype=float))
-            except (TypeError, ValueError):
-                z = np.array([np.nan])  # refused below
-            if z.ndim != 1 or z.size == 0 or not np.all(np.isfinite(z)) or np.any(z < 0):
-                raise ValueError(f"zeta must be a damping ratio >= 0 or a sequence of them, got {self.zeta!r}")
-            if self.alpha or self.beta:
-                raise ValueError("give either Rayleigh coefficients (alpha, beta) or modal ratios zeta, not both")
-            object.__setattr__(self, "zeta", float(z[0]) if np.ndim(self.zeta) == 0 else tuple(z.tolist()))
-
-    def ratios(self, omega: np.ndarray) -> np.ndarray:
-        """Damping ratios ``ζ_j`` of the modes of angular frequencies ``omega``."""
-        omega = np.asarray(omega, dtype=float)
-        if self.zeta is None:
-            return 0.5 * (self.alpha * omega + self.beta / omega)
-        z = np.asarray(self.zeta, dtype=float)
-        if z.ndim == 1 and z.size != omega.size:
-            raise ValueError(f"zeta has {z.size} ratios but the system has {omega.size} modes")
-        return np.broadcast_to(z, omega.shape).astype(float)
-
-    def rates(self, omega: np.ndarray) -> np.ndarray:
-        """Decay rates ``σ_j = ζ_j ω_j``."""
-        return self.ratios(omega) * np.asarray(omega, dtype=float)
-
-    def matrix(self, system: LinearSystem) -> np.ndarray:
-        """The dense damping matrix ``C`` (``αK + βM``, or ``MΦ diag(2ζω) ΦᵀM`` for modal ratios)."""
-        M = system.M.toarray() if hasattr(system.M, "toarray") else np.asarray(system.M)
-        K = system.K.toarray() if hasattr(system.K, "toarray") else np.asarray(system.K)
-        if self.zeta is None:
-            return self.alpha * K + self.beta * M
-        sp = system.spectrum
-        MP = M @ sp.phi
-        return MP @ np.diag(2 * self.rates(sp.omega)) @ MP.T
-
-
-def _real(name: str, value, what: str = "finite number") -> float:
-    """``float(value)`` of a number (not a bool, not a string), else ``ValueError`` naming ``name``."""
-    try:
-        if isinstance(value, (bool, np.bool_, str, bytes)):
-            raise TypeError
-        return float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a {what}, got {value!r}") from None
-
-
-def forcing_inputs(n: int, period, amplitude: float, damping, load):
-    """Checked ``(period, Ω, damping, load)`` of a forced flight of ``n`` dofs (``load=None``: every dof)."""
-    if period is None:
-        if amplitude != 0:
-            raise ValueError("a forcing period is needed when the amplitude is not 0")
-        Omega = 0.0
-    else:
-        period = _real("period", period, "finite number > 0")
-        if not np.isfinite(period) or period <= 0:
-            raise ValueError(f"period must be finite and > 0, got {period!r}")
-        Omega = 2 * np.pi / period
-    damping = Damping() if damping is None else damping
-    if not isinstance(damping, Damping):
-        raise ValueError(f"damping must be a Damping (e.g. Damping(alpha=0.005)) or None, got {damping!r}")
-    try:
-        if isinstance(load, (str, bytes)):
-            raise TypeError
-        f = np.ones(n) if load is None else np.asarray(load, dtype=float).reshape(-1)
-    except (TypeError, ValueError):
-        raise ValueError(f"load must be a finite vector of {n} entries (or None: a unit force on every dof), got "
-                         f"{load!r}") from None
-    if f.shape != (n,) or not np.all(np.isfinite(f)):
-        raise ValueError(f"load must be a finite vector of {n} entries, got shape {f.shape}")
-    return period, Omega, damping, f
+__all__ = ["ForcedFlight", "ForcedTrajectory", "simulate_forced"]
 
 
 class ForcedFlight(ModalFlight):
@@ -198,25 +90,9 @@ class ForcedFlight(ModalFlight):
         return np.cos(self.Omega * np.asarray(t)) * np.sum(F * p, axis=0), np.sum(2 * s * p * p, axis=0)
 
 
-@dataclass(frozen=True)
-class EnergyBalance:
-    """Energy budget of a forced run: ``final - initial = work - dissipated - impact_loss`` (``residual``
-    is the difference, round-off for an exact simulation)."""
-
-    initial: float
-    final: float
-    work: float
-    dissipated: float
-    impact_loss: float
-
-    @property
-    def residual(self) -> float:
-        return self.final - self.initial - self.work + self.dissipated + self.impact_loss
-
-
 @dataclass(frozen=True, eq=False)
 class ForcedTrajectory(Trajectory):
-    """Result of :func:`simulate_forced`: a :class:`~bladecase.nsm.simulation.Trajectory` (post-impact
+    """Result of :func:`simulate_forced`: a :class:`~bladecase.nsm.newton.simulation.Trajectory` (post-impact
     states ``x``, ``v``, impact times, impulses, ``state(t)``) plus the pre-impact states.
 
     Attributes
@@ -282,7 +158,7 @@ class ForcedTrajectory(Trajectory):
 
 
 def _states(n: int, x0, v0) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`~bladecase.nsm.simulation._check_state`, with a value that is not numbers named."""
+    """:func:`~bladecase.nsm.newton.simulation._check_state`, with a value that is not numbers named."""
     for name, a in (("x0", x0), ("v0", v0)):
         try:
             if a is None or isinstance(a, (str, bytes)):
@@ -326,7 +202,7 @@ def simulate_forced(
         Newton coefficient ``e`` in ``(0, 1]``.
     max_impacts : int or None
         Safety stop (``complete = False``); default: the stored states fit in 1 GB
-        (:func:`bladecase.nsm.simulation.default_max_impacts`).
+        (:func:`bladecase.nsm.newton.simulation.default_max_impacts`).
 
     Returns
     -------

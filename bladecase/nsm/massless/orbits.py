@@ -22,9 +22,9 @@ from functools import cached_property
 import numpy as np
 import scipy.linalg as sla
 
-from .massless import BoundOrbit, MasslessSystem
-from .signals import TrigSum, certified_max
-from .system import LinearSystem
+from ..signals import TrigSum, certified_max
+from ..system import LinearSystem
+from .model import BoundOrbit, MasslessSystem
 
 #: Relative tolerance (of the clearance) of the admissibility proofs.
 ADMISSIBILITY_RTOL = 1e-9
@@ -91,7 +91,7 @@ class SymmetricOrbit(BoundOrbit):
     @cached_property
     def impulses(self) -> np.ndarray:
         """``[∫λ dt]`` over the closed phase (exact: ``λ = k_c (y - d)`` is a trigonometric sum)."""
-        from .massless_phases import PhasedOrbit
+        from .phases import PhasedOrbit
 
         return PhasedOrbit(self._bound(), "open", [self.alpha, self.beta], self.a).impulses
 
@@ -129,7 +129,7 @@ class SymmetricOrbit(BoundOrbit):
 
     def monodromy(self) -> np.ndarray:
         """``(2n, 2n)`` monodromy of ``(x, v)`` over one period (see :meth:`PhasedOrbit.monodromy`)."""
-        from .massless_phases import PhasedOrbit
+        from .phases import PhasedOrbit
 
         return PhasedOrbit(self._bound(), "open", [self.alpha, self.beta], self.a).monodromy()
 

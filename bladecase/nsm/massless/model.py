@@ -43,8 +43,8 @@ from functools import cached_property
 import numpy as np
 import scipy.linalg as sla
 
-from .signals import TrigSum, first_upcrossing
-from .system import INACTIVE_RTOL, Spectrum
+from ..signals import TrigSum, first_upcrossing
+from ..system import INACTIVE_RTOL, Spectrum
 
 #: Largest interior size handled (dense eigenproblems of both phases).
 MASSLESS_DENSE_LIMIT = 4000

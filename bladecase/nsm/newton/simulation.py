@@ -1,8 +1,8 @@
 """Event-driven simulation: the independent truth for every periodic orbit.
 
-The loop (:func:`integrate`) takes two swappable pieces (:mod:`bladecase.nsm.flight`): a flight propagator
-(today the exact undamped modal flight, :class:`~bladecase.nsm.flight.ModalFlight`) and an impact law (today
-Moreau's form of Newton's law, :class:`~bladecase.nsm.flight.NewtonImpact`).  The next impact is the FIRST
+The loop (:func:`integrate`) takes two swappable pieces (:mod:`bladecase.nsm.newton.flight`): a flight propagator
+(today the exact undamped modal flight, :class:`~bladecase.nsm.newton.flight.ModalFlight`) and an impact law (today
+Moreau's form of Newton's law, :class:`~bladecase.nsm.newton.flight.NewtonImpact`).  The next impact is the FIRST
 root of the propagator's contact signal ``wᵀx(t) - d`` after the current time, found by
 :func:`bladecase.nsm.signals.first_upcrossing`, which proves every skipped interval free of contact (no grazing
 contact missed) from the signal's certified curvature bound, and refines the root to machine precision.
@@ -17,10 +17,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..checks import integer
+from ...checks import integer
+from ..signals import first_upcrossing
+from ..system import LinearSystem
 from .flight import CONTACT_RTOL, FlightPropagator, ImpactLaw, ModalFlight, NewtonImpact
-from .signals import first_upcrossing
-from .system import LinearSystem
 
 __all__ = ["CONTACT_RTOL", "STATE_MEMORY_BYTES", "Trajectory", "default_max_impacts", "integrate", "simulate"]
 
@@ -227,8 +227,8 @@ def simulate(
 ) -> Trajectory:
     """Integrate the impacting system from ``(x0, v0)`` at ``t = 0`` to ``t_end``.
 
-    Exact undamped modal flight (:class:`~bladecase.nsm.flight.ModalFlight`) and Newton's impact law in
-    Moreau's form (:class:`~bladecase.nsm.flight.NewtonImpact`); :func:`integrate` takes other pieces.
+    Exact undamped modal flight (:class:`~bladecase.nsm.newton.flight.ModalFlight`) and Newton's impact law in
+    Moreau's form (:class:`~bladecase.nsm.newton.flight.NewtonImpact`); :func:`integrate` takes other pieces.
 
     Parameters
     ----------

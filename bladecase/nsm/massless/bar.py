@@ -23,8 +23,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .massless import MasslessSystem, condense, redistribute_mass
-from .system import LinearSystem, chain
+from ..system import LinearSystem, chain
+from .model import MasslessSystem, condense, redistribute_mass
 
 CONTACT_MODELS = ("newton", "massless")
 
@@ -43,7 +43,7 @@ def bar(n: int, gap: float, length: float = 1.0, EA: float = 1.0, rhoA: float = 
     Lumped (row-sum) mass. ``contact="newton"``: the seed's model, a spring–mass chain whose end node (mass
     ``ρA h/2``) impacts (:class:`~bladecase.nsm.LinearSystem`). ``contact="massless"``: the end node's mass is moved
     to the two nodes before it (total mass and centre of mass kept: ``+ρA h`` at ``L - h``, ``-ρA h/2`` at
-    ``L - 2h``), and the model is condensed (:class:`~bladecase.nsm.massless.MasslessSystem`); ``casing``: the
+    ``L - 2h``), and the model is condensed (:class:`~bladecase.nsm.massless.model.MasslessSystem`); ``casing``: the
     stiffness of a compliant casing in series with the end (``inf``: rigid; the massless model only).
     """
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 3:

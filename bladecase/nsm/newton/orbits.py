@@ -1,8 +1,8 @@
 """Periodic orbits with impacts: the record, its construction and certification, and the 1-ipp orbit.
 
 An orbit with impacts at ``0 < t₁ < … < t_k = T`` and impulses ``Λ_i`` is ``x(t) = -Σ_i Λ_i G((t - t_i) mod T)``
-(theory §3–4; ``G`` in :mod:`bladecase.nsm.modal`).  One impact per period (k = 1) gives ``Λ = -d / g(0)``,
-``g = wᵀG``.  Orbits with k >= 2 impacts are found by :func:`bladecase.nsm.kipp.orbits_kipp`.
+(theory §3–4; ``G`` in :mod:`bladecase.nsm.newton.modal`).  One impact per period (k = 1) gives ``Λ = -d / g(0)``,
+``g = wᵀG``.  Orbits with k >= 2 impacts are found by :func:`bladecase.nsm.newton.kipp.orbits_kipp`.
 
 A :class:`PeriodicOrbit` is a small record (period, impact times, impulses, energy, certified admissibility)
 bound to its system; it pickles without the system (:meth:`PeriodicOrbit.bind` re-attaches one).
@@ -16,9 +16,9 @@ from functools import cached_property
 
 import numpy as np
 
+from ..signals import POINTS_PER_PERIOD, TrigSum, certified_max, certified_max_stack, sincos
+from ..system import LinearSystem
 from .modal import RESONANCE_RTOL, ModalKernel, check_period, impact_matrices
-from .signals import POINTS_PER_PERIOD, TrigSum, certified_max, certified_max_stack, sincos
-from .system import LinearSystem
 
 __all__ = [
     "ADMISSIBILITY_RTOL", "REPEAT_RTOL", "RESONANCE_RTOL", "PeriodicOrbit", "check_newton_system", "check_period",
@@ -27,7 +27,7 @@ __all__ = [
 
 
 def __getattr__(name: str):
-    # ``orbits_kipp`` lived here before the k-ipp search moved to :mod:`bladecase.nsm.kipp` (which imports
+    # ``orbits_kipp`` lived here before the k-ipp search moved to :mod:`bladecase.nsm.newton.kipp` (which imports
     # this module): still importable from here, resolved on first use.
     if name in ("orbits_kipp", "canonical_rotation"):
         from . import kipp

@@ -1,6 +1,6 @@
 """Every periodic orbit with k impacts per period at one period ``T`` (theory §4).
 
-The orbits solve ``Π(t)Λ = 0``, ``Σ(t)Λ = d·1`` for ``0 < t₁ < … < t_k = T`` (:mod:`bladecase.nsm.modal`).
+The orbits solve ``Π(t)Λ = 0``, ``Σ(t)Λ = d·1`` for ``0 < t₁ < … < t_k = T`` (:mod:`bladecase.nsm.newton.modal`).
 k = 2 reduces to the scalar ``s(t₁) = 0`` (the paper's Eq. 15), whose sign changes are all found with certified
 root exclusion; k >= 3 is a multistart (Newton from every cell of a grid of ordered impact times,
 Levenberg–Marquardt from the most promising cells and from repeated lower-order patterns).
@@ -13,13 +13,13 @@ from math import comb
 
 import numpy as np
 
-from .continuation import lstsq_stack
+from ..continuation import lstsq_stack
+from ..signals import TrigSum, all_roots
+from ..system import LinearSystem
 from .modal import ModalKernel, _newton_stack, check_period, impact_kernels, impulses_for, solve_times
 from .orbits import REPEAT_RTOL, PeriodicOrbit, check_newton_system, make_orbit, orbit_1ipp
-from .signals import TrigSum, all_roots
-from .system import LinearSystem
 
-__all__ = ["MAX_GRID_CELLS", "MAX_K", "canonical_rotation", "check_k", "check_newton_system", "check_period_range",
+__all__ = ["MAX_GRID_CELLS", "MAX_K", "canonical_rotation", "check_k", "check_newton_system",
            "check_resolution", "check_search_k", "orbits_kipp"]
 
 #: Largest ``k`` the k-ipp search takes (its start grid grows combinatorially with ``k``; as the CLI's ``--ipp``
@@ -53,26 +53,6 @@ def check_search_k(k, name: str = "k") -> int:
     if isinstance(k, (bool, np.bool_)) or not isinstance(k, (int, np.integer)) or not 1 <= k <= MAX_K:
         raise ValueError(f"{name} (impacts per period) must be an integer with 1 <= {name} <= {MAX_K}, got {k!r}")
     return int(k)
-
-
-def check_period_range(name: str, value) -> tuple[float, float]:
-    """``(start, stop)`` of a period range: two finite numbers with ``0 < start < stop`` (``ValueError`` naming
-    ``name`` otherwise).
-
-    >>> check_period_range("T_range", (4.1, 3.2))
-    Traceback (most recent call last):
-    ...
-    ValueError: T_range must be (start, stop) with 0 < start < stop, got (4.1, 3.2)
-    """
-    try:
-        lo, hi = (float(x) for x in value)
-        if isinstance(value, (str, bytes)) or any(isinstance(x, (bool, np.bool_)) for x in value):
-            raise TypeError
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be (start, stop): two periods with 0 < start < stop, got {value!r}") from None
-    if not (np.isfinite(lo) and np.isfinite(hi)) or not 0 < lo < hi:
-        raise ValueError(f"{name} must be (start, stop) with 0 < start < stop, got {value!r}")
-    return lo, hi
 
 
 def check_resolution(resolution, k: int) -> int | None:

@@ -4,16 +4,18 @@ Where a k-ipp family stops being admissible between two of its computed orbits, 
 found by bisection along the curve (:func:`_bisect_end` does one end): the midpoint is
 solved at the mean period by Newton from the interpolated impact times, else by the arclength corrector
 orthogonal to the chord, a midpoint leaving the bracket stops the bisection, and the midpoint's orbit is
-certified (:func:`~bladecase.nsm.orbits.make_orbits`: the same proof as :func:`~bladecase.nsm.orbits.make_orbit`).
+certified (:func:`~bladecase.nsm.newton.orbits.make_orbits`: the same proof as
+:func:`~bladecase.nsm.newton.orbits.make_orbit`).
 :func:`bisect_ends` runs every bracket of a search in lockstep: per bisection step, one vectorised fixed-period
-Newton solve (:func:`~bladecase.nsm.modal.solve_times_stack`) and one vectorised certification for all of them.
+Newton solve (:func:`~bladecase.nsm.newton.modal.solve_times_stack`) and one vectorised certification for all of
+them.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from . import continuation
+from .. import continuation
 from .modal import ModalKernel, check_period, impact_kernels, solve_stack, solve_times, solve_times_stack
 from .orbits import PeriodicOrbit, make_orbit, make_orbits
 
@@ -24,14 +26,14 @@ MAX_STEPS = 80
 
 
 def bisect_ends(ends: list[tuple], rtol: float) -> list[tuple[float, bool]]:
-    """For each ``(problem, z_in, z_out)`` — a :class:`~bladecase.nsm.families.KippCurve` (one system and ``k``
+    """For each ``(problem, z_in, z_out)`` — a :class:`~bladecase.nsm.newton.families.KippCurve` (one system and ``k``
     for all) and two of its points, ``z_in`` admissible, ``z_out`` not — the period where admissibility is lost
     between them and whether the bracket was narrowed to ``rtol`` (relative, in ``T``): the result of
     :func:`_bisect_end` for each, all bisected together.
 
     >>> import numpy as np
     >>> from bladecase.nsm import chain, orbits_kipp
-    >>> from bladecase.nsm.families import KippCurve, trace_families, polished_orbits
+    >>> from bladecase.nsm.newton.families import KippCurve, trace_families, polished_orbits
     >>> system = chain(2, k=1.0, m=0.5, gap=1.0)
     >>> start = [o for o in orbits_kipp(system, 13.5, 2) if o.repeats == 1][1]
     >>> (problem, zs), = trace_families(system, 2, [start], (13.2, 13.75), 0.01, 400)

@@ -4,13 +4,13 @@ A k-ipp orbit is a zero of ``[ΠΛ ; ΣΛ - d·1]`` (theory §4): ``2k`` equatio
 ``(t₁…t_{k-1}, T, Λ)``, one of them redundant (``ΛᵀΠΛ ≡ 0``), so the solutions form curves — the nonsmooth
 modes.  :class:`KippCurve` eliminates the impulses (``Λ = d Σ⁻¹ 1``) and gives the remaining impact-law
 condition ``Π n``, ``n = Σ⁻¹1/|Σ⁻¹1|``, with its exact Jacobian (derivatives of the modal kernel in the impact
-times and in ``T``, :meth:`bladecase.nsm.modal.ModalKernel.dT`); :mod:`bladecase.nsm.continuation` follows it.
+times and in ``T``, :meth:`bladecase.nsm.newton.modal.ModalKernel.dT`); :mod:`bladecase.nsm.continuation` follows it.
 :class:`KippCurves` evaluates many such curves at once, so that :class:`FamilyTracer` and :func:`trace_families`
 follow many families together (the same algorithm on each, its numerical work vectorised over the families).
 :func:`follow_family` and :func:`complete_families` give the families' certified orbits
 (:func:`polished_orbits`: the fixed-period Newton polish and the certification vectorised,
-:func:`~bladecase.nsm.orbits.make_orbits`) and admissible arcs, whose ends are refined by bisection along the
-curve (all ends of a batch of families together, :func:`~bladecase.nsm.arc_ends.bisect_ends`).
+:func:`~bladecase.nsm.newton.orbits.make_orbits`) and admissible arcs, whose ends are refined by bisection along the
+curve (all ends of a batch of families together, :func:`~bladecase.nsm.newton.arc_ends.bisect_ends`).
 """
 
 from __future__ import annotations
@@ -20,7 +20,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import continuation
+from .. import continuation
+from ..arcs import admissible_arcs
+from ..system import LinearSystem
 from .arc_ends import _bisect_end, bisect_ends
 from .modal import (
     ModalKernel,
@@ -32,7 +34,6 @@ from .modal import (
     solve_times_stack,
 )
 from .orbits import PeriodicOrbit, make_orbit, make_orbits
-from .system import LinearSystem
 
 #: Relative precision in ``T`` of the refined ends of admissible arcs.
 ARC_RTOL = 1e-9
@@ -432,33 +433,3 @@ def _arcs(problem: KippCurve, zs, orbits, refine: bool) -> list[tuple]:
     """``(start, stop, T_lo, T_hi, refined_lo, refined_hi)`` of every maximal admissible run of ``orbits``."""
     return admissible_arcs(orbits, lambda i, out: _bisect_end(problem, zs[i], zs[out], orbits[out], ARC_RTOL)
                            if refine else None)
-
-
-def admissible_arcs(orbits, refine_end) -> list[tuple]:
-    """``(start, stop, T_lo, T_hi, refined_lo, refined_hi)`` of every maximal admissible run of ``orbits`` (a curve).
-
-    ``refine_end(i, out)``: the period where admissibility is lost between the run's end point ``i`` and its
-    non-admissible neighbour ``out``, and whether that was found — ``(T, True)`` — or ``None`` not to refine.
-    Along a curve ``T`` need not be monotone: the refined flags go with whichever end gives ``T_lo``/``T_hi``.
-    """
-    adm = np.array([o.admissible for o in orbits], dtype=bool)
-    arcs = []
-    i = 0
-    while i < adm.size:
-        if not adm[i]:
-            i += 1
-            continue
-        j = i
-        while j + 1 < adm.size and adm[j + 1]:
-            j += 1
-        (T_a, ref_a), (T_b, ref_b) = (orbits[i].T, False), (orbits[j].T, False)
-        if i > 0:
-            T_a, ref_a = refine_end(i, i - 1) or (T_a, False)
-        if j + 1 < adm.size:
-            T_b, ref_b = refine_end(j, j + 1) or (T_b, False)
-        Ts = [o.T for o in orbits[i:j + 1]] + [T_a, T_b]
-        lo, hi = min(Ts), max(Ts)
-        arcs.append((i, j, float(lo), float(hi), bool((lo == T_a and ref_a) or (lo == T_b and ref_b)),
-                     bool((hi == T_a and ref_a) or (hi == T_b and ref_b))))
-        i = j + 1
-    return arcs

@@ -12,10 +12,10 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from ..progress import progress_bar
-from .branches import Arc, Backbone, Branch, Interval
+from ...progress import progress_bar
+from ..branches import Arc, Backbone, Branch, Interval
+from ..system import LinearSystem
 from .orbits import PeriodicOrbit, check_newton_system, orbit_1ipp
-from .system import LinearSystem
 
 __all__ = ["BISECTION_RTOL", "Backbone", "Interval", "backbone"]  # Backbone, Interval: former names
 

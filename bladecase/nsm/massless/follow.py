@@ -4,15 +4,15 @@ A mode grows from an open-phase linear mode at grazing with one short contact ph
 can be lost in two ways only: ``λ`` reaches 0 inside a closed phase (the contact opens briefly: the phase splits
 in three) or ``ŵᵀx`` reaches ``d`` inside an open phase (a new contact phase).  At that boundary orbit the
 orbit with the extra phases has a phase of zero duration, and beyond it that phase grows: the mode goes on as a
-symmetric orbit with more phases (:func:`~bladecase.nsm.massless_phases.split_guess` gives the split; the new
+symmetric orbit with more phases (:func:`~bladecase.nsm.massless.phases.split_guess` gives the split; the new
 orbit is solved at the period of the first non-admissible point).  The reverse — a phase shrinking to nothing —
 merges its neighbours.  Each stretch with a fixed phase pattern is followed by pseudo-arclength continuation of
-:func:`~bladecase.nsm.massless_phases.solve_half` (exact Jacobian, dimensionless durations ``τ ω``), so folds in
+:func:`~bladecase.nsm.massless.phases.solve_half` (exact Jacobian, dimensionless durations ``τ ω``), so folds in
 ``T`` are passed on the same branch; switches between stretches happen only at proved admissibility
 boundaries (bisection along the curve to :data:`EDGE_RTOL` in ``T``).
 
 The result is the physically continued mode: a list of admissible orbits (each switch contributes its boundary
-orbit), which :func:`~bladecase.nsm.massless_branches.massless_modes` turns into a :class:`~bladecase.nsm.Branch`.
+orbit), which :func:`~bladecase.nsm.massless.branches.massless_modes` turns into a :class:`~bladecase.nsm.Branch`.
 """
 
 from __future__ import annotations
@@ -20,10 +20,10 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
-from .. import log
-from .continuation import Curve, bisect, follow, tangent
-from .massless import MasslessSystem
-from .massless_phases import PHASES, PhasedOrbit, solve_half, split_at, violation
+from ... import log
+from ..continuation import Curve, bisect, follow, tangent
+from .model import MasslessSystem
+from .phases import PHASES, PhasedOrbit, solve_half, split_at, violation
 
 #: Relative precision (of ``T``) of the boundary orbits where the phase pattern changes.
 EDGE_RTOL = 1e-9
@@ -101,8 +101,8 @@ def follow_mode(system: MasslessSystem, start: PhasedOrbit, T_range: tuple[float
                 max_points: int = 4000, ds: float = 2e-3, ds_max: float = 0.05) -> list[PhasedOrbit]:
     """Admissible orbits of the mode through ``start`` (admissible), following it in the direction where half
     phase ``grow`` lengthens, across changes of its phase pattern, while ``T`` stays in ``T_range``."""
-    from .kipp import check_period_range
-    from .massless_orbits import check_massless_system
+    from ..arcs import check_period_range
+    from .orbits import check_massless_system
 
     check_massless_system(system, "follow_mode")
     if not isinstance(start, PhasedOrbit):

@@ -5,7 +5,7 @@ phase.  Its half orbit starts at the middle of phase 0 (``first``: open or close
 ``x = x_eq + Φ a`` in that phase's modal coordinates, runs phases ``0, 1, …, m`` alternately open and closed for
 durations ``τ_0 … τ_m`` (phase 0 and phase ``m`` by half), and ends with ``v = 0`` in the middle of phase ``m``.
 So ``T = 2 Σ τ`` and the orbit has ``m`` contact phases per period (``m = 1``: the one-phase orbits of
-:mod:`bladecase.nsm.massless_orbits`, ``τ = (α, β)``).
+:mod:`bladecase.nsm.massless.orbits`, ``τ = (α, β)``).
 
 The state at every switch is affine in ``a``: ``v_end = V(τ) a + v₀(τ) = 0`` is a linear system for ``a``, and the
 ``m`` switch conditions ``ŵᵀx = d`` leave ``m`` equations ``r(τ) = 0`` in ``m + 1`` durations: a curve, followed
@@ -19,7 +19,7 @@ is continuous across switches, so the monodromy matrix is the product of the pha
 matrices are the identity).
 
 >>> import numpy as np
->>> from bladecase.nsm.massless import condense
+>>> from bladecase.nsm.massless.model import condense
 >>> s = condense(np.diag([1.0, 0.0]), np.array([[4.0, -3.0], [-3.0, 3.0]]), np.array([0.0, 1.0]), gap=1.0)
 >>> a, r, J = solve_half(s, "open", np.array([2.0, 0.5]), gradient=True)   # not yet periodic: r ≠ 0
 >>> round(float(r[0]), 6), J.shape
@@ -34,8 +34,8 @@ from functools import cached_property
 import numpy as np
 import scipy.linalg as sla
 
-from .massless import BoundOrbit, MasslessSystem, Phase
-from .signals import TrigSum, certified_max
+from ..signals import TrigSum, certified_max
+from .model import BoundOrbit, MasslessSystem, Phase
 
 __all__ = ["PHASES", "PhasedOrbit", "solve_half", "split_at", "violation"]
 

@@ -1,12 +1,12 @@
 """Forced, damped event-driven simulation of the massless contact model (theory §8, issue 13).
 
-The interior dofs of a :class:`~bladecase.nsm.massless.MasslessSystem` obey
+The interior dofs of a :class:`~bladecase.nsm.massless.model.MasslessSystem` obey
 
     M x'' + C x' + S x + ŵ λ = F₀ cos(Ωt) f,      λ = k_c max(0, y - d),      y = ŵᵀx + g F₀ cos(Ωt),
 
 **Damping.** ``C`` acts on the interior only, the contact spring ``k_c`` is NOT damped: Rayleigh on the
 open-phase matrices, ``C = αS + βM``, or modal ratios ``ζ_j`` of the open-phase modes
-(:class:`~bladecase.nsm.forced.Damping`, ``ΦᵀCΦ = diag(2ζ_jω_j)``).  The same ``C`` acts in both phases, so
+(:class:`~bladecase.nsm.damping.Damping`, ``ΦᵀCΦ = diag(2ζ_jω_j)``).  The same ``C`` acts in both phases, so
 ``λ`` stays continuous and both switches happen at ``y = d`` (closing when ``y`` rises through ``d``,
 opening when ``λ`` falls to 0).  The closed phase (stiffness ``S + k_cŵŵᵀ``) then has NON-proportional
 damping, except when ``C`` is undamped or mass-proportional.
@@ -51,10 +51,10 @@ from functools import cached_property
 
 import numpy as np
 
-from .damped_signals import DampedModes, DampedSignal
-from .forced import QUAD_NODES, Damping, EnergyBalance, forcing_inputs
-from .massless import MasslessSystem, _leave_surface
-from .signals import POINTS_PER_PERIOD, first_upcrossing
+from ..damped_signals import DampedModes, DampedSignal
+from ..damping import QUAD_NODES, Damping, EnergyBalance, forcing_inputs
+from ..signals import POINTS_PER_PERIOD, first_upcrossing
+from .model import MasslessSystem, _leave_surface
 
 __all__ = ["ExpSignal", "MasslessForcedFlight", "MasslessForcedTrajectory", "simulate_forced_massless"]
 

@@ -2,7 +2,7 @@
 
 Each branch grows from an open-phase linear mode at grazing (contact time ``2β → 0``, ``T → 2π/ω_j``) and is
 followed by pseudo-arclength continuation of the closing residual in ``(α, β)`` with its exact gradient
-(:func:`~bladecase.nsm.massless_orbits.follow_from_grazing`), through folds in ``T`` on the same branch. Its
+(:func:`~bladecase.nsm.massless.orbits.follow_from_grazing`), through folds in ``T`` on the same branch. Its
 admissible arcs are the maximal runs of certified admissible orbits; their ends are refined by bisection along
 the curve. The branch is the same type as the Newton modes': plots, reports, files and animations take it as is.
 """
@@ -11,11 +11,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import log
-from .families import admissible_arcs
-from .kipp import check_period_range
-from .massless import MasslessSystem
-from .massless_orbits import (
+from ... import log
+from ..arcs import admissible_arcs, check_period_range
+from .model import MasslessSystem
+from .orbits import (
     SymmetricOrbit,
     _correct,
     check_massless_system,
@@ -35,7 +34,7 @@ def massless_modes(system: MasslessSystem, T_range: tuple[float, float], max_poi
 
     Branches are ordered by mode; a branch that never enters the range is left out.
     """
-    from .branches import Arc, Branch
+    from ..branches import Arc, Branch
 
     check_massless_system(system, "massless_modes")
     T_lo, T_hi = check_period_range("T_range", T_range)
@@ -126,8 +125,8 @@ def massless_orbit_at(system: MasslessSystem, orbits: list[SymmetricOrbit], T: f
 
 def massless_mode(system: MasslessSystem, T_range: tuple[float, float], mode: int = 0, max_points: int = 4000):
     """The nonsmooth mode grown from open-phase mode ``mode`` at grazing, followed through changes of its number
-    of contact phases (:func:`~bladecase.nsm.massless_follow.follow_mode`): a :class:`~bladecase.nsm.Branch` of
-    admissible :class:`~bladecase.nsm.massless_phases.PhasedOrbit` s (``orbit.k`` contact phases each), ordered
+    of contact phases (:func:`~bladecase.nsm.massless.follow.follow_mode`): a :class:`~bladecase.nsm.Branch` of
+    admissible :class:`~bladecase.nsm.massless.phases.PhasedOrbit` s (``orbit.k`` contact phases each), ordered
     along the curve from grazing, or ``None`` when nothing admissible lies in ``T_range``.
 
     Where the one-phase orbit loses admissibility (``λ`` turning negative inside the contact, or the open phase
@@ -139,9 +138,9 @@ def massless_mode(system: MasslessSystem, T_range: tuple[float, float], mode: in
     >>> sorted({o.k for o in branch.orbits})[:2], bool(branch.admissible.all())
     ([1, 2], True)
     """
-    from .branches import Arc, Branch
-    from .massless_follow import follow_mode
-    from .massless_phases import PhasedOrbit
+    from ..branches import Arc, Branch
+    from .follow import follow_mode
+    from .phases import PhasedOrbit
 
     check_massless_system(system, "massless_mode")
     T_lo, T_hi = check_period_range("T_range", T_range)

@@ -1,6 +1,6 @@
 """The pieces of the event-driven simulator: a flight propagator and an impact law.
 
-The event loop (:func:`bladecase.nsm.simulation.integrate`) knows only these two interfaces:
+The event loop (:func:`bladecase.nsm.newton.simulation.integrate`) knows only these two interfaces:
 
 * a **flight propagator** maps a state to its coordinates (``encode``/``decode``), advances it in closed form
   (``advance``), and gives the contact signal ``wᵀx(τ) - d`` of the flight starting from a state as an object
@@ -27,8 +27,8 @@ from typing import Protocol
 
 import numpy as np
 
-from .signals import TrigSum
-from .system import LinearSystem
+from ..signals import TrigSum
+from ..system import LinearSystem
 
 #: Relative tolerance (of ``gap``) within which a state counts as "at the obstacle"
 #: (raised to the round-off of ``wᵀx`` for large amplitudes).

@@ -1,0 +1,71 @@
+"""The massless contact model (theory §8): contact dofs without inertia, Signorini without an impact law.
+
+A :class:`MasslessSystem` (the interior after condensing the massless contact dofs, a unilateral spring ``k_c``)
+has contact phases of finite duration instead of impacts. One module per step:
+
+- :mod:`~bladecase.nsm.massless.model` — :class:`MasslessSystem`, :func:`condense`, :func:`redistribute_mass`,
+  :func:`series_stiffness` (a compliant casing in series), the contact phases and the event-driven simulator
+  (:func:`simulate_massless`);
+- :mod:`~bladecase.nsm.massless.orbits` — symmetric orbits with one contact phase per period
+  (:class:`SymmetricOrbit`, :func:`orbits_at_period`, :func:`follow_from_grazing`);
+- :mod:`~bladecase.nsm.massless.phases` — orbits with any number of contact phases (:class:`PhasedOrbit`);
+- :mod:`~bladecase.nsm.massless.follow` — a mode followed through changes of its phase pattern
+  (:func:`follow_mode`);
+- :mod:`~bladecase.nsm.massless.branches` — the modes as :class:`~bladecase.nsm.branches.Branch` es
+  (:func:`massless_modes`, :func:`massless_mode`);
+- :mod:`~bladecase.nsm.massless.forced` — forced and damped simulation (:func:`simulate_forced_massless`;
+  damping and the energy balance are shared: :mod:`bladecase.nsm.damping`);
+- :mod:`~bladecase.nsm.massless.bar` — the 1-D benchmark bar (either contact model) and its continuum solution
+  (:func:`bar`, :func:`bar_continuum_energy`).
+
+What both contact models share lives in :mod:`bladecase.nsm` (systems, signals, continuation, branches, the
+period range and admissible arcs of :mod:`bladecase.nsm.arcs`, damping); :func:`~bladecase.nsm.nonsmooth_mode`
+(:mod:`bladecase.nsm.modes`) dispatches to this package or to :mod:`bladecase.nsm.newton`.  (The name ``bar`` of
+this package is the function; the module is ``bladecase.nsm.massless.bar`` in ``from … import``.)
+"""
+
+from .bar import CONTACT_MODELS, bar, bar_continuum_band_energy, bar_continuum_energy, bar_continuum_field
+from .branches import ARC_RTOL, massless_mode, massless_modes, massless_orbit_at
+from .follow import EDGE_RTOL, MAX_HALF_PHASES, VANISH_RTOL, follow_mode, solve_at_period
+from .forced import ExpSignal, MasslessForcedFlight, MasslessForcedTrajectory, simulate_forced_massless
+from .model import (
+    MASSLESS_DENSE_LIMIT,
+    BoundOrbit,
+    MasslessSystem,
+    MasslessTrajectory,
+    Phase,
+    condense,
+    redistribute_mass,
+    series_stiffness,
+    simulate_massless,
+)
+from .orbits import (
+    ADMISSIBILITY_RTOL,
+    SymmetricOrbit,
+    check_massless_system,
+    closing_residual,
+    follow_from_grazing,
+    orbit_at_period,
+    orbits_at_period,
+    smoothest,
+)
+from .phases import PHASES, PhasedOrbit, solve_half, split_at, violation
+
+__all__ = [
+    # bar
+    "CONTACT_MODELS", "bar", "bar_continuum_band_energy", "bar_continuum_energy", "bar_continuum_field",
+    # branches
+    "ARC_RTOL", "massless_mode", "massless_modes", "massless_orbit_at",
+    # follow
+    "EDGE_RTOL", "MAX_HALF_PHASES", "VANISH_RTOL", "follow_mode", "solve_at_period",
+    # forced
+    "ExpSignal", "MasslessForcedFlight", "MasslessForcedTrajectory", "simulate_forced_massless",
+    # model
+    "MASSLESS_DENSE_LIMIT", "BoundOrbit", "MasslessSystem", "MasslessTrajectory", "Phase", "condense",
+    "redistribute_mass", "series_stiffness", "simulate_massless",
+    # orbits
+    "ADMISSIBILITY_RTOL", "SymmetricOrbit", "check_massless_system", "closing_residual", "follow_from_grazing",
+    "orbit_at_period", "orbits_at_period", "smoothest",
+    # phases
+    "PHASES", "PhasedOrbit", "solve_half", "split_at", "violation",
+]
