@@ -13,6 +13,11 @@ has contact phases of finite duration instead of impacts. One module per step:
   (:func:`follow_mode`);
 - :mod:`~bladecase.nsm.massless.branches` — the modes as :class:`~bladecase.nsm.branches.Branch` es
   (:func:`massless_modes`, :func:`massless_mode`);
+- :mod:`~bladecase.nsm.massless.nodes` — several contacts, one per contact node (:class:`NodalSystem`): the
+  complementarity of their forces, the phases (sets of closed contacts) and the exact event-driven simulator
+  (:func:`simulate_nodes`), damped and against an out-of-round casing (:class:`Rub`);
+- :mod:`~bladecase.nsm.massless.rub` — the rub response of a turning blade at one speed and over speeds
+  (:func:`rub_response`, :func:`rub_sweep`);
 - :mod:`~bladecase.nsm.massless.forced` — forced and damped simulation (:func:`simulate_forced_massless`;
   damping and the energy balance are shared: :mod:`bladecase.nsm.damping`);
 - :mod:`~bladecase.nsm.massless.bar` — the 1-D benchmark bar (either contact model) and its continuum solution
@@ -39,6 +44,7 @@ from .model import (
     series_stiffness,
     simulate_massless,
 )
+from .nodes import NodalFlight, NodalSystem, NodalTrajectory, Rub, lcp, simulate_nodes
 from .orbits import (
     ADMISSIBILITY_RTOL,
     SymmetricOrbit,
@@ -50,8 +56,12 @@ from .orbits import (
     smoothest,
 )
 from .phases import PHASES, PhasedOrbit, solve_half, split_at, violation
+from .rub import RubResponse, rub_response, rub_sweep
 
 __all__ = [
+    # nodes, rub
+    "NodalFlight", "NodalSystem", "NodalTrajectory", "Rub", "lcp", "simulate_nodes", "RubResponse", "rub_response",
+    "rub_sweep",
     # bar
     "CONTACT_MODELS", "bar", "bar_continuum_band_energy", "bar_continuum_energy", "bar_continuum_field",
     # branches

@@ -1,0 +1,168 @@
+"""The massless contact model of a finite-element structure touched at every node of its contact group:
+:func:`nodal_model`.
+
+Each node ``j`` of the contact (its face group: :meth:`Contact.face <bladecase.reduction.Contact.face>`, or on a
+casing of revolution: :meth:`Contact.on_casing <bladecase.reduction.Contact.on_casing>`) is its own unilateral
+constraint ``ν_j·u_j <= d_j``, with its own normal ``ν_j`` and clearance ``d_j``. The contact dofs ``c`` are every
+dof of those nodes; they carry no inertia (their lumped mass moved to the neighbours as for one constraint,
+:func:`~bladecase.reduction.massless.massless_masses`), the others are the interior ``i``.
+
+- open phase: ``x_c = −K_cc⁻¹K_ci x_i``; the nodes' normal displacements ``W_cᵀx_c = Wᵀx_i`` with
+  ``W = −K_icK_cc⁻¹W_c`` (``W_c``: the ``m`` normal vectors on the contact dofs);
+- forces ``λ`` on the nodes: ``x_c = −K_cc⁻¹(K_ci x_i + W_cλ)``; the nodes' own flexibility is
+  ``H_s = W_cᵀK_cc⁻¹W_c`` (``m × m``, the interior held).
+
+**Reduction** (massless-boundary Craig–Bampton with ``m`` constraints): ``V_i`` = the ``size`` lowest modes of the
+massless structure plus the ``m`` attachment vectors ``(K⁻¹W_full)_i = S⁻¹W``, M-orthonormalised (an attachment
+vector already in the span is dropped). The static compliance of the nodes, ``H_s + WᵀS⁻¹W = W_fullᵀK⁻¹W_full``,
+is then exact at any size. The reduced model is
+``NodalSystem(V_iᵀM_iiV_i, V_fullᵀKV_full, V_fullᵀW_full, H_s, d, k)``.
+
+**Which nodes.** A node in 3-D is a point: its own flexibility grows like ``1/h`` as the mesh is refined; a
+casing compliance per unit area (``k_j = k_A·A_j``, ``A_j`` the node's tributary area) grows faster (``1/h²``)
+and keeps the contact forces and the penetrations converging. A rigid casing (``k_j = inf``) at every node of a
+fine mesh has no converged limit: the results then depend on the mesh (as for any node-to-surface contact).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..checks import integer
+from ..fe import FEModel
+from ..linalg import DENSE_LIMIT, SPDFactor, check_factor, spd_factor
+from ..nsm.massless.nodes import NodalSystem
+from .contact import Contact
+from .massless import _HINT, _K, _check_lumped, _interior_modes, _Split, massless_masses
+from .model import ReducedModel
+
+__all__ = ["NodalReducedModel", "nodal_model"]
+
+
+@dataclass(frozen=True, eq=False)
+class NodalReducedModel(ReducedModel):
+    """A reduced model of the massless contact model with one constraint per contact node: ``system`` is a
+    :class:`~bladecase.nsm.massless.nodes.NodalSystem`.
+
+    ``normal_map`` (``m × n_free``, sparse) gives each node's normal displacement ``ν_j·u_j``; ``closed_shapes``
+    (``n_free × m``) the free-dof displacement per unit force on each node with the interior held, added
+    ``λ_j`` times where a node is pressed; ``masses`` the redistributed lumped masses.
+    """
+
+    closed_shapes: np.ndarray = field(default=None, repr=False)  # type: ignore[assignment]
+    masses: np.ndarray = field(default=None, repr=False)  # type: ignore[assignment]
+    normal_map: sp.csr_array = field(default=None, repr=False)  # type: ignore[assignment]
+
+    def free_dofs(self, x_r, gap=None) -> np.ndarray:
+        """Free-dof displacements of reduced states, each pressed node's correction included."""
+        x = super().free_dofs(x_r)
+        lam = self.system.forces(np.asarray(x_r, dtype=float), gap)
+        return x + self.closed_shapes @ lam
+
+    def __repr__(self) -> str:
+        return (f"NodalReducedModel(size={self.size}, {self.n} reduced dofs of {self.model.n_dofs} free dofs, "
+                f"{self.system.m} contact nodes)")
+
+
+def _m_orthonormal(V: np.ndarray, m: np.ndarray, keep: int) -> np.ndarray:
+    """The columns of ``V`` M-orthonormalised (``M = diag(m)``) in order, twice; a column after the first ``keep``
+    that lies in the span of the previous ones to 1e-10 is dropped."""
+    out = []
+    for k in range(V.shape[1]):
+        e = V[:, k].copy()
+        size0 = np.sqrt(e @ (m * e))
+        if out:
+            Q = np.column_stack(out)
+            for _ in range(2):
+                e -= Q @ (Q.T @ (m * e))
+        size = np.sqrt(e @ (m * e))
+        if k >= keep and size <= 1e-10 * size0:
+            continue
+        out.append(e / size)
+    return np.column_stack(out)
+
+
+def nodal_model(model: FEModel, contact: Contact, size: int, factor: SPDFactor | None = None,
+                casing=None) -> NodalReducedModel:
+    """The massless contact model of ``model`` with one unilateral constraint per node of ``contact``, reduced to
+    the ``size`` lowest modes of the massless structure plus one attachment vector per node (module docstring).
+
+    Parameters
+    ----------
+    model : FEModel
+        A clamped model with lumped mass.
+    contact : Contact
+        A face contact (:meth:`Contact.face`, :meth:`Contact.on_casing`): its nodes, with their normals and
+        clearances (``Contact.node_clearances``).
+    size : int
+        Modes of the massless structure (``>= 1``).
+    factor : SPDFactor or None
+        ``bladecase.fe.stiffness_factor(model)``, reused.
+    casing : None, float or (m,) array_like
+        The casing's stiffness at each node (N/m); a float: a total shared by the nodes' weights (their
+        tributary areas); ``None``: the contact's own (``contact.casing``, shared the same way; ``inf``: rigid).
+    """
+    if not isinstance(model, FEModel):
+        raise ValueError(f"model must be an FEModel (from bladecase.assemble), got {type(model).__name__}")
+    if not isinstance(contact, Contact):
+        raise ValueError(f"contact must be a bladecase.Contact, got {type(contact).__name__}")
+    factor = check_factor(factor, model.K, "this model's K", "bladecase.fe.stiffness_factor(model)")
+    _check_lumped(model)
+    nodes = np.array(contact.nodes or (contact.node,))
+    m = nodes.size
+    d, _ = contact.node_clearances(model)
+    N = sp.csr_array(contact.node_normal_map(model))  # (m, n_dofs)
+    c = np.sort(contact.dofs(model))
+    i = np.setdiff1d(np.arange(model.n_dofs), c)
+    size = integer("size", size, 1, note=" (modes of the massless structure)")
+    if size > i.size - m:
+        raise ValueError(f"size = {size} is too large: the massless structure has {i.size} interior dofs and the "
+                         f"{m} attachment vectors take {m} (valid: 1..{i.size - m})")
+    if size > i.size // 2 and i.size > DENSE_LIMIT:
+        raise ValueError(f"size = {size}: more than half of the {i.size} massless modes needs a dense eigen-solution "
+                         f"(valid: 1..{i.size // 2})")
+    K = sp.csr_array(model.K)
+    K_cc = sp.csc_array(K[c][:, c])
+    cc = spd_factor(K_cc.toarray() if c.size <= 1500 else K_cc, "K_cc (the contact nodes' stiffness)", hint=_HINT)
+    Wfull = N.T.toarray()  # (n_dofs, m)
+    Wc = Wfull[c]
+    split = _Split(Wfull[:, 0], c, i, K, sp.csr_array(K[c][:, i]), cc)
+    masses = massless_masses(model, c)
+    fac = factor if factor is not None else spd_factor(model.K, _K, hint=_HINT)
+    attach = fac.solve(Wfull)[i]
+    phi = _interior_modes(split, masses, size, fac)
+    V_i = _m_orthonormal(np.column_stack([phi, attach]), masses[i], phi.shape[1])
+    V = np.zeros((model.n_dofs, V_i.shape[1]))
+    V[i], V[c] = V_i, split.slave(V_i)
+    M_r = V_i.T @ (masses[i][:, None] * V_i)
+    S_r = V.T @ (K @ V)
+    X = cc.solve(Wc)
+    Hs = Wc.T @ X
+    closed = np.zeros((model.n_dofs, m))
+    closed[c] = -X
+    k = _node_casing(contact, m, casing)
+    system = NodalSystem(M_r, S_r, V.T @ Wfull, Hs, d, k, nodes=tuple(model.mesh.node_id(k) for k in nodes))
+    return NodalReducedModel("massless-nodes", size, system, V, model, contact, closed_shapes=closed,
+                             masses=masses, normal_map=N)
+
+
+def _node_casing(contact: Contact, m: int, casing) -> np.ndarray:
+    """Per-node casing stiffness (N/m): an array as given, a total shared by the nodes' weights."""
+    if casing is None:
+        casing = contact.casing
+    k = np.asarray(casing, dtype=float)
+    if k.ndim == 0:
+        if np.isinf(k):
+            return np.full(m, np.inf)
+        w = np.array(contact.weights) if contact.weights else np.full(m, 1.0 / m)
+        w = w / w.sum()
+        if np.any(w <= 0):
+            raise ValueError("a contact node has no tributary area (a mid-side node or one beside the clamp): a "
+                             "casing stiffness shared by area cannot reach it; give one stiffness per node")
+        return float(k) * w
+    if k.shape != (m,) or np.any(np.isnan(k)) or np.any(k <= 0):
+        raise ValueError(f"casing stiffness per node must be {m} values > 0 (N/m; inf: rigid), got shape {k.shape}")
+    return k
