@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .rotation_report import rotation_report
+from .rub_report import rub_report
 
 #: Admissible arcs narrower than this (relative, in frequency) are called narrow in words.
 NARROW_RTOL = 1e-3
@@ -97,6 +98,7 @@ def report(summary: dict) -> str:
         lines.append(f"| {j + 1} | {f:.3f} | {b2:.3e} | {_counterpart(matches[j])} |")
     if summary.get("comparison"):
         lines += comparison_report(summary["comparison"])
+    lines += rub_report(summary.get("rub"))
     if summary.get("forcing"):
         lines += forcing_report(summary["forcing"], summary["files"].get("forced_animations", []),
                                 massless=massless)

@@ -541,6 +541,31 @@ def _area_weights(model: FEModel, group, nodes: np.ndarray) -> np.ndarray:
     """Tributary weights of ``nodes``: each boundary facet of the body cells whose corners all lie in ``group`` (a
     name or node indices) gives ``|f|/c`` to each of its ``c`` corners; divided by the face's total measure (see
     :meth:`Contact.face`)."""
+    share, total = _tributary(model, group)
+    return share[nodes] / total
+
+
+def tributary_areas(model: FEModel, nodes) -> np.ndarray:
+    """Each node's share of the boundary facets whose corners all lie in ``nodes`` (m²; in 2-D a length, times the
+    model's thickness when it has one): what a casing stiffness per unit area gives each node.
+
+    >>> from skfem import MeshTri
+    >>> from bladecase.fe import Mesh, assemble
+    >>> t = MeshTri.init_tensor(np.linspace(0, 0.1, 21), np.linspace(0, 0.02, 5))
+    >>> p = np.c_[t.p.T, np.zeros(t.p.shape[1])]
+    >>> strip = Mesh(p, {"triangle": t.t.T}, dim=2, groups={"root": np.flatnonzero(p[:, 0] == 0)})
+    >>> model = assemble(strip, "steel", order=1, thickness=0.002)
+    >>> (tributary_areas(model, np.flatnonzero(p[:, 0] == 0.1)) * 1e6).round(6).tolist()   # mm²: 5 mm × 2 mm
+    [5.0, 10.0, 10.0, 10.0, 5.0]
+    """
+    nodes = np.asarray(nodes, dtype=int)
+    share, _ = _tributary(model, nodes)
+    thickness = getattr(model, "thickness", None) if model.dim == 2 else None
+    return share[nodes] * (float(thickness) if thickness else 1.0)
+
+
+def _tributary(model: FEModel, group) -> tuple[np.ndarray, float]:
+    """``(share, total)``: every mesh node's tributary measure of the face ``group`` and the face's measure."""
     from ..fe.cells import KINDS
 
     mesh, dim = model.mesh, model.dim
@@ -562,7 +587,7 @@ def _area_weights(model: FEModel, group, nodes: np.ndarray) -> np.ndarray:
         what = _members(model, group)[1]
         raise ValueError(f"{what} {'holds' if what.startswith('group') else 'hold'} no boundary facet of the body "
                          "cells: weights='area' needs a face (use weights='equal' for a set of nodes)")
-    return share[nodes] / total
+    return share, total
 
 
 def _finite_vector(name: str, value) -> np.ndarray:

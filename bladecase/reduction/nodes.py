@@ -49,12 +49,14 @@ class NodalReducedModel(ReducedModel):
 
     ``normal_map`` (``m × n_free``, sparse) gives each node's normal displacement ``ν_j·u_j``; ``closed_shapes``
     (``n_free × m``) the free-dof displacement per unit force on each node with the interior held, added
-    ``λ_j`` times where a node is pressed; ``masses`` the redistributed lumped masses.
+    ``λ_j`` times where a node is pressed; ``masses`` the redistributed lumped masses; ``interior`` the interior
+    basis ``V_i`` (reusable at another speed: :func:`nodal_model`'s ``interior``).
     """
 
     closed_shapes: np.ndarray = field(default=None, repr=False)  # type: ignore[assignment]
     masses: np.ndarray = field(default=None, repr=False)  # type: ignore[assignment]
     normal_map: sp.csr_array = field(default=None, repr=False)  # type: ignore[assignment]
+    interior: np.ndarray = field(default=None, repr=False)  # type: ignore[assignment]
 
     def free_dofs(self, x_r, gap=None) -> np.ndarray:
         """Free-dof displacements of reduced states, each pressed node's correction included."""
@@ -86,7 +88,7 @@ def _m_orthonormal(V: np.ndarray, m: np.ndarray, keep: int) -> np.ndarray:
 
 
 def nodal_model(model: FEModel, contact: Contact, size: int, factor: SPDFactor | None = None,
-                casing=None) -> NodalReducedModel:
+                casing=None, interior: np.ndarray | None = None, residual: bool = False) -> NodalReducedModel:
     """The massless contact model of ``model`` with one unilateral constraint per node of ``contact``, reduced to
     the ``size`` lowest modes of the massless structure plus one attachment vector per node (module docstring).
 
@@ -104,6 +106,27 @@ def nodal_model(model: FEModel, contact: Contact, size: int, factor: SPDFactor |
     casing : None, float or (m,) array_like
         The casing's stiffness at each node (N/m); a float: a total shared by the nodes' weights (their
         tributary areas); ``None``: the contact's own (``contact.casing``, shared the same way; ``inf``: rigid).
+    interior : (n_interior, k) ndarray or None
+        An interior basis to reuse (``model_at_another_speed``'s ``interior_basis``, M-orthonormal for the same
+        masses): the model is then the Ritz projection of this ``model`` on it, the contact rows condensed with
+        this model's ``K`` — no eigen-solution (``size`` is recorded only).
+    residual : bool
+        ``False`` (default): the ``m`` attachment vectors are dofs of the reduced model (their local, mesh-scale
+        modes — MHz on a blade tip — are in its dynamics). ``True``: the interior basis is the ``size`` modes alone
+        and the static flexibility they miss, ``W_fullᵀK⁻¹W_full − W_rᵀS_r⁻¹W_r``, is added to the nodes' own
+        flexibility — the residual (mode-acceleration) correction: those local modes respond statically, the
+        static compliance stays exact, and the fastest phase is a few times the highest kept mode instead of MHz.
+
+    >>> from skfem import MeshTri
+    >>> from bladecase.fe import Mesh, assemble
+    >>> t = MeshTri.init_tensor(np.linspace(0, 0.1, 21), np.linspace(0, 0.02, 5))
+    >>> p = np.c_[t.p.T, np.zeros(t.p.shape[1])]
+    >>> strip = Mesh(p, {"triangle": t.t.T}, dim=2, groups={"root": np.flatnonzero(p[:, 0] == 0),
+    ...                                                     "tip": np.flatnonzero(p[:, 0] == 0.1)})
+    >>> model = assemble(strip, "steel", order=1, thickness=0.002, mass="lumped")
+    >>> reduced = nodal_model(model, Contact.face(model, "tip", (1.0, 0.0), 1e-4, weights="area"), 6)
+    >>> reduced.system        # 6 modes + one attachment vector per tip node
+    NodalSystem(n=11, m=5 contacts, gap 0.0001–0.0001 m, rigid)
     """
     if not isinstance(model, FEModel):
         raise ValueError(f"model must be an FEModel (from bladecase.assemble), got {type(model).__name__}")
@@ -131,22 +154,36 @@ def nodal_model(model: FEModel, contact: Contact, size: int, factor: SPDFactor |
     Wc = Wfull[c]
     split = _Split(Wfull[:, 0], c, i, K, sp.csr_array(K[c][:, i]), cc)
     masses = massless_masses(model, c)
-    fac = factor if factor is not None else spd_factor(model.K, _K, hint=_HINT)
-    attach = fac.solve(Wfull)[i]
-    phi = _interior_modes(split, masses, size, fac)
-    V_i = _m_orthonormal(np.column_stack([phi, attach]), masses[i], phi.shape[1])
+    fac = None
+    if interior is None or residual:
+        fac = factor if factor is not None else spd_factor(model.K, _K, hint=_HINT)
+        attach_full = fac.solve(Wfull)
+    if interior is None:
+        phi = _interior_modes(split, masses, size, fac)
+        V_i = _m_orthonormal(phi if residual else np.column_stack([phi, attach_full[i]]), masses[i], phi.shape[1])
+    else:
+        V_i = np.asarray(interior, dtype=float)
+        if V_i.ndim != 2 or V_i.shape[0] != i.size:
+            raise ValueError(f"interior basis of shape {V_i.shape}: expected ({i.size}, k), one row per interior dof")
     V = np.zeros((model.n_dofs, V_i.shape[1]))
     V[i], V[c] = V_i, split.slave(V_i)
     M_r = V_i.T @ (masses[i][:, None] * V_i)
     S_r = V.T @ (K @ V)
     X = cc.solve(Wc)
     Hs = Wc.T @ X
+    if residual:  # what the modes miss of the static compliance, on the nodes' own flexibility
+        W_r = V.T @ Wfull
+        Z = np.linalg.solve(S_r, W_r)
+        Hs = Wfull.T @ attach_full - W_r.T @ Z
     closed = np.zeros((model.n_dofs, m))
-    closed[c] = -X
+    if residual:  # the static response to the forces that the modes do not carry
+        closed = -(attach_full - V @ Z)
+    else:
+        closed[c] = -X
     k = _node_casing(contact, m, casing)
     system = NodalSystem(M_r, S_r, V.T @ Wfull, Hs, d, k, nodes=tuple(model.mesh.node_id(k) for k in nodes))
     return NodalReducedModel("massless-nodes", size, system, V, model, contact, closed_shapes=closed,
-                             masses=masses, normal_map=N)
+                             masses=masses, normal_map=N, interior=V_i)
 
 
 def _node_casing(contact: Contact, m: int, casing) -> np.ndarray:

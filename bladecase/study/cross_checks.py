@@ -10,7 +10,7 @@ import math
 from ..fe import Material, PlateGeometry
 from ..fe.geometry import estimate_cells
 from .keys import StudyError, one_line
-from .sections import casing_checks, execution_checks, forcing_checks, rotation_checks
+from .sections import casing_checks, execution_checks, forcing_checks, rotation_checks, rub_checks
 from .values import LIMITS
 
 __all__ = ["MASSLESS_METHODS", "cross_checks"]
@@ -86,6 +86,7 @@ def cross_checks(c: dict, model: bool = True) -> None:
     execution_checks(c)
     rotation_checks(c)
     casing_checks(c, model)
+    rub_checks(c)
     o, s = c["output"], c["search"]
     for i, item in enumerate(o["orbits"]):
         if item["ipp"] not in s["ipp"]:
@@ -142,6 +143,17 @@ def _contact_model_checks(c: dict) -> None:
         raise StudyError(f"[contact] casing_stiffness: a compliant casing needs model = 'massless' (Newton's impact "
                          f"law is for a rigid casing), got {c['contact']['casing_stiffness']!r} with model = "
                          f"{c['contact']['model']!r}")
+    per_area = c["contact"]["casing_stiffness_per_area"]
+    if per_area is not None:
+        if not massless:
+            raise StudyError(f"[contact] casing_stiffness_per_area: a compliant casing needs model = 'massless' "
+                             f"(Newton's impact law is for a rigid casing), got {per_area!r} with model = "
+                             f"{c['contact']['model']!r}")
+        if c["contact"]["casing_stiffness"] is not None:
+            raise StudyError("[contact] casing_stiffness_per_area: give it or casing_stiffness, not both")
+        if c["contact"]["face"] is None and c["contact"].get("nodes") is None:
+            raise StudyError("[contact] casing_stiffness_per_area: a stiffness per unit area needs a contact face "
+                             "(face or nodes) whose area it acts on")
     methods = [c["reduction"]["method"]] + [x["method"] for x in c["reduction"]["compare"]]
     if massless:
         bad = [m for m in methods if m not in MASSLESS_METHODS]

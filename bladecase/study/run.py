@@ -148,7 +148,8 @@ def run(study: Study | str | os.PathLike, out: str | os.PathLike | None = None, 
         check_inputs(out, [study.source])
     staging = staging_dir(out)
     stages = _Stages(progress, total=6 + (study["forcing"]["amplitude"] is not None)
-                     + bool(study.config.get("rotation") and study["rotation"]["speeds"]))
+                     + bool(study.config.get("rotation") and study["rotation"]["speeds"])
+                     + bool((study.config.get("rub") or {}).get("speeds")))
     x = study["execution"]
     own = None if executor is not None else make_executor(x["executor"], x["workers"], x["scheduler"])
     try:
@@ -265,6 +266,14 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
             orbits = forcing.pop("orbits")
             files["forced"] = dict(forcing["files"])
             files["forced_animations"] = _animate_forced(study, reduced, forcing, orbits, staging)
+    rub = None
+    if (study.config.get("rub") or {}).get("speeds"):
+        with stage("rub"):
+            from .rub import rub_stage
+
+            rub = rub_stage(study, rest_model, cold_contact, families=families, executor=executor, progress=progress,
+                            folder=staging, figures="png" in o["formats"], title=study.name)
+            files["rub"] = rub.pop("files")
     files["log"] = "run.log"
     from .. import __version__
 
@@ -282,6 +291,7 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         "search": {**study["search"], "period_unit_s": unit},
         "families": [family_summary(f, functools.partial(orbit_engineering, reduced)) for f in families],
         "forcing": forcing,
+        "rub": rub,
         "comparison": None if comparison is None else {k: comparison[k] for k in ("rows", "diagnostics", "figures")},
         "files": files,
     }

@@ -37,6 +37,7 @@ from .sections import (
     FORCING_KEYS,
     LIMIT_KEYS,
     ROTATION_KEYS,
+    RUB_KEYS,
 )
 from .values import (  # noqa: F401  (RANGES, LIMITS: part of the schema's documented surface)
     LIMITS,
@@ -157,8 +158,14 @@ SCHEMA: dict[str, dict[str, Key]] = {
                      _one_of("newton", "massless")),
         "casing_stiffness": Key(_NUM, None, "Stiffness of a compliant casing (N/m) in series with the contact "
                                 "(its local flexibility and coating); default: a rigid casing. Massless model only; "
-                                "well below the contact's own stiffness, the modes converge (docs/massless.md).",
+                                "well below the contact's own stiffness, the modes converge (docs/massless.md). "
+                                "With one contact per node ([rub]), shared by the nodes' tributary areas.",
                                 lambda v: "must be > 0 (N/m)" if not v > 0 else _in_range("casing_stiffness")(v)),
+        "casing_stiffness_per_area": Key(_NUM, None, "A compliant casing's stiffness per unit area (N/m³, e.g. an "
+                                         "abradable layer's modulus / thickness): each node gets it times its "
+                                         "tributary area, the face mean its total; instead of casing_stiffness.",
+                                         lambda v: None if math.isfinite(v) and 1 <= v <= 1e18
+                                         else "must be a finite number in [1, 1e18] (N/m³)"),
         "clearance_at": Key(_STR, "cold", "A rotating blade's 'clearance' is the cold one ('cold': the "
                             "centrifugal growth of the blade along the normal closes it at speed) or the running "
                             "one at [rotation] speed ('speed').", _one_of("cold", "speed")),
@@ -220,6 +227,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
     },
     "rotation": ROTATION_KEYS,
     "casing": CASING_KEYS,
+    "rub": RUB_KEYS,
     "execution": EXECUTION_KEYS,
     "limits": LIMIT_KEYS,
 }

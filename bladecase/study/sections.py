@@ -290,6 +290,12 @@ CASING_KEYS: dict[str, Key] = {
                  "axis from its origin), linear in between and beyond.", _radii),
     "axis": Key((dict,), None, "The casing's axis, {origin = [x, y, z], direction = [dx, dy, dz]}; default: "
                 "[rotation] axis.", _axis),
+    "lobes": Key(_INT, None, "An out-of-round casing: the number n of lobes of its shape. A contact node at the "
+                 "angle φ about the axis, turning at Ω, sees the clearance d − amplitude·cos(n(Ωt + φ)) ([rub]).",
+                 _int_between(1, 1000)),
+    "amplitude": Key(_NUM, None, "The out-of-round casing's amplitude (m): how far each lobe reaches inwards from the "
+                     "round casing; with 'lobes'.",
+                     lambda v: None if np.isfinite(v) and 0 < v <= 0.1 else "must be a finite number in (0, 0.1] (m)"),
 }
 
 
@@ -300,8 +306,9 @@ def casing_checks(c: dict, model: bool = True) -> None:
     given = k and (k.get("radius") is not None or k.get("radii") is not None)
     ct = c["contact"]
     if not given:
-        if k.get("axis") is not None:
-            raise StudyError("[casing] axis: a casing needs radius (a cylinder) or radii (a cone)")
+        for key in ("axis", "lobes", "amplitude"):
+            if k.get(key) is not None:
+                raise StudyError(f"[casing] {key}: a casing needs radius (a cylinder) or radii (a cone)")
         if ct["clearance"] is None and model:
             raise StudyError("[contact] clearance: required (m), or a [casing] with radius or radii from which each "
                              "contact node's clearance is computed")
@@ -317,9 +324,61 @@ def casing_checks(c: dict, model: bool = True) -> None:
     else:
         axis = k["axis"]
         k["axis"] = {"origin": list(axis.get("origin", [0.0, 0.0, 0.0])), "direction": list(axis["direction"])}
+    if (k["lobes"] is None) != (k["amplitude"] is None):
+        given, missing = ("lobes", "amplitude") if k["amplitude"] is None else ("amplitude", "lobes")
+        raise StudyError(f"[casing] {missing}: an out-of-round casing needs lobes and amplitude together (got "
+                         f"{given} = {k[given]!r} alone)")
     if ct["face"] is None and ct.get("nodes") is None:
         raise StudyError("[casing]: each node of a contact face gets its clearance from the casing: set [contact] "
                          "face (e.g. 'tip') or nodes")
     if ct["clearance"] is not None:
         raise StudyError(f"[contact] clearance: with a [casing], each node's clearance comes from the casing; remove "
                          f"clearance = {ct['clearance']!r}")
+
+
+#: ``[rub]``: key → :class:`~bladecase.study.keys.Key` (the rub response of a turning blade in an out-of-round casing;
+#: runs when ``speeds`` is given).
+RUB_KEYS: dict[str, Key] = {
+    "speeds": Key(_LIST, [], "Rotation speeds of the rub response (in 'speed_unit'), e.g. [8000, 8100, …]: at each, "
+                  "the blade turns from rest inside the out-of-round [casing] (lobes, amplitude) with one contact per "
+                  "node of the contact face; the figures are read on the last 'window' revolutions.", _speeds),
+    "speed_unit": Key(_STR, "rpm", "'rpm', 'rad/s' or 'Hz' (revolutions per second).", _one_of("rpm", "rad/s", "Hz")),
+    "revolutions": Key(_INT, 40, "Revolutions simulated at each speed (from rest).", _int_between(2, 100_000)),
+    "window": Key(_INT, 10, "The last revolutions read for the figures; the window before them tells whether the "
+                  "response has settled (at most revolutions / 2).", _int_between(1, 50_000)),
+    "rayleigh": Key(_LIST, None, "Rayleigh damping [alpha, beta]: C = alpha K + beta M (alpha in s, beta in 1/s); "
+                    "give this or 'ratio'.", _rayleigh),
+    "ratio": Key(_NUM, None, "Modal damping ratio of every mode of the blade with its contacts open (e.g. 0.005); "
+                 "give this or 'rayleigh'.", lambda v: None if 0 < v < 1 else "must be in (0, 1) (a damping ratio)"),
+    "size": Key(_INT, 8, "Modes of the massless structure in the rub's reduced model (plus one static attachment "
+                "vector per contact node).", _int_between(1, 500)),
+}
+
+
+def rub_checks(c: dict) -> None:
+    """``[rub]`` (when its speeds are given): an out-of-round [casing], a face contact, the massless model, one
+    damping, a window of at most half the revolutions."""
+    r = c.get("rub")
+    if not r:
+        return
+    if not r["speeds"]:
+        given = sorted(k for k, spec in RUB_KEYS.items() if r[k] != spec.default)
+        if given:
+            raise StudyError(f"[rub] speeds: required to run the rub response (the section sets {', '.join(given)})")
+        return
+    if min(r["speeds"]) <= 0:
+        raise StudyError(f"[rub] speeds: must all be > 0 (the blade turns), got {r['speeds']}")
+    k = c.get("casing") or {}
+    if k.get("lobes") is None:
+        raise StudyError("[rub] speeds: the rub response needs an out-of-round casing: [casing] radius (or radii), "
+                         "lobes and amplitude")
+    if c["contact"]["model"] != "massless" or c["fem"]["mass"] != "lumped":
+        raise StudyError("[rub] speeds: the rub response uses the massless contact model at every contact node: set "
+                         "[contact] model = \"massless\" and [fem] mass = \"lumped\"")
+    if (r["rayleigh"] is None) == (r["ratio"] is None):
+        raise StudyError("[rub] rayleigh / ratio: give exactly one damping: rayleigh = [alpha, beta] "
+                         "(C = alpha K + beta M) or ratio = zeta (every mode)")
+    if r["window"] > r["revolutions"] // 2:
+        raise StudyError(f"[rub] window: at most revolutions / 2 = {r['revolutions'] // 2} (the window before it "
+                         f"tells whether the response settled), got {r['window']}")
+    r["speed_unit"] = {"hz": "Hz"}.get(r["speed_unit"].lower(), r["speed_unit"])

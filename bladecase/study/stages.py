@@ -249,6 +249,13 @@ def build_contact(study: Study, model: FEModel) -> Contact:
         log.info("contact: node %d of %s (index %d in mesh.vtu)%s", mesh.node_id(contact.node), mesh.source,
                  contact.node, f", the centre of a face of {len(contact.nodes)} nodes" if contact.nodes else "")
     casing = study["contact"]["casing_stiffness"]
+    per_area = study["contact"].get("casing_stiffness_per_area")
+    if per_area is not None:  # the face mean's spring: every node's share in parallel
+        from ..reduction.contact import tributary_areas
+
+        area = float(tributary_areas(model, contact.nodes).sum())
+        casing = per_area * area
+        log.info("casing: %.4g N/m³ over the contact face's %.4g mm²: %.4g N/m", per_area, area * 1e6, casing)
     return contact if casing is None else contact.with_casing(casing)
 
 

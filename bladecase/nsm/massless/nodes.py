@@ -276,6 +276,9 @@ class _Phase:
         else:
             L = -Wq.T.copy()
         self.L, self.P = L, P
+        self.idx = idx
+        self.GWt = G @ WA.T if idx.size else np.zeros((0, n))  # λ_A = G_A(W_Aᵀq − g_A(t))
+        self.G = G if idx.size else np.zeros((0, 0))
         f0 = WA @ (G @ s.gap[idx]) if idx.size else np.zeros(n)
         self.q_eq = np.linalg.solve(K, f0)
         nu = fl.nu
@@ -595,6 +598,7 @@ class NodalTrajectory:
     p: np.ndarray
     t_end: float
     complete: bool
+    amplitudes: np.ndarray = field(default=None, repr=False)  # type: ignore[assignment]
 
     @property
     def system(self) -> NodalSystem:
@@ -607,15 +611,29 @@ class NodalTrajectory:
 
     def state(self, t) -> tuple[np.ndarray, np.ndarray]:
         """Interior ``(x, v)`` at the times ``t`` (``(n, k)``), in closed form from the phase holding each."""
+        x, v, _ = self.sample(t)
+        return x, v
+
+    def sample(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Interior ``(x, v)`` and the contact forces ``λ`` (``(m, k)``) at the times ``t``, in closed form from the
+        phase holding each (its forces from its own linear law: no complementarity problem to solve)."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
         k = np.clip(np.searchsorted(self.starts, t, side="right") - 1, 0, self.starts.size - 1)
-        Q, P = np.empty((self.flight.n, t.size)), np.empty((self.flight.n, t.size))
-        for i in np.unique(k):
-            sel = np.flatnonzero(k == i)
-            ph = self.flight.phase(self.active[i])
-            a = ph.amplitudes(self.q[:, i], self.p[:, i], self.starts[i])
+        fl = self.flight
+        Q, P = np.empty((fl.n, t.size)), np.empty((fl.n, t.size))
+        lam = np.zeros((self.system.m, t.size))
+        order = np.argsort(k, kind="stable")
+        bounds = np.searchsorted(k[order], np.arange(self.starts.size + 1))
+        for i in np.flatnonzero(np.diff(bounds)):
+            sel = order[bounds[i]:bounds[i + 1]]
+            ph = fl.phase(self.active[i])
+            a = self.amplitudes[i] if self.amplitudes is not None else ph.amplitudes(self.q[:, i], self.p[:, i],
+                                                                                      self.starts[i])
             Q[:, sel], P[:, sel] = ph.advance(a, self.starts[i], t[sel] - self.starts[i])
-        return self.flight.decode(Q, P)
+            if ph.idx.size:
+                lam[np.ix_(ph.idx, sel)] = np.maximum(ph.GWt @ Q[:, sel] - ph.G @ fl.gap(t[sel])[ph.idx], 0.0)
+        x, v = fl.decode(Q, P)
+        return x, v, lam
 
     @property
     def x_end(self) -> np.ndarray:
@@ -627,9 +645,7 @@ class NodalTrajectory:
 
     def forces(self, t) -> np.ndarray:
         """Contact forces ``(m, k)`` at the times ``t``."""
-        t = np.atleast_1d(np.asarray(t, dtype=float))
-        x, _ = self.state(t)
-        return self.system.forces(x, self.flight.gap(t))
+        return self.sample(t)[2]
 
     def contact_time(self, t0: float = 0.0, t1: float | None = None) -> np.ndarray:
         """Time each contact spends closed in ``[t0, t1]`` (s)."""
@@ -662,20 +678,20 @@ def simulate_nodes(system: NodalSystem, x0, v0, t_end: float, damping=None, rub:
     t = 0.0
     A = fl.active_set(q, p, t)
     on = np.zeros(system.m, dtype=bool)
-    starts, actives, qs, ps = [0.0], [A], [q], [p]
+    starts, actives, qs, ps, amps = [0.0], [A], [q], [p], []
     while len(starts) <= max_switches:
         ph = fl.phase(A)
         a = ph.amplitudes(q, p, t)
-        hit = first_switch(ph.signals(a, t), t_end - t, on)
+        amps.append(a)
+        signals = ph.signals(a, t)
+        hit = first_switch(signals, t_end - t, on)
         if hit is None:
             t = t_end
             break
         tau, j = hit
         q, p = ph.advance(a, t, tau)
         t += tau
-        sig = ph.signals(a, t - tau).values(tau)[0][0]
-        scale = np.maximum(np.abs(ph.signals(a, t - tau).magnitude), np.finfo(float).tiny)
-        on = np.abs(sig) <= SURFACE_RTOL * scale
+        on = np.abs(signals.values(tau)[0][0]) <= SURFACE_RTOL * np.maximum(signals.magnitude, np.finfo(float).tiny)
         on[j] = True
         if on.sum() == 1:  # one contact switches: it changes status (the next flight checks it leaves its surface)
             A = A.copy()
@@ -690,5 +706,7 @@ def simulate_nodes(system: NodalSystem, x0, v0, t_end: float, damping=None, rub:
         actives.append(A)
         qs.append(q)
         ps.append(p)
+    if len(amps) < len(starts):
+        amps.append(fl.phase(A).amplitudes(q, p, starts[-1]))
     return NodalTrajectory(fl, np.array(starts), np.array(actives), np.array(qs).T, np.array(ps).T, t,
-                           bool(t >= t_end))
+                           bool(t >= t_end), np.array(amps))

@@ -77,8 +77,7 @@ class RubResponse:
 def _peaks(tr, flight: NodalFlight, t0: float, t1: float, samples: int) -> tuple[np.ndarray, ...]:
     s = flight.system
     t = np.unique(np.r_[np.linspace(t0, t1, samples), tr.starts[(tr.starts >= t0) & (tr.starts <= t1)]])
-    x, _ = tr.state(t)
-    lam = s.forces(x, flight.gap(t))
+    x, _, lam = tr.sample(t)
     u = s.W.T @ x - s.flexibility @ lam  # the nodes' own normal displacements
     pen = lam / s.casing[:, None]
     return u.max(axis=1), lam.max(axis=1), pen.max(axis=1)

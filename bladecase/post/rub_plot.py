@@ -1,0 +1,60 @@
+"""The interaction diagram of a rub sweep: peak tip displacement and peak contact force against speed, with the
+speeds where the casing's lobes excite a linear mode (``n·Ω = ω_k``, dashed) and where they excite a nonsmooth
+mode's frequency band (shaded).
+
+>>> section = {"speed_unit": "rpm", "lobes": 3, "rows": [
+...     {"speed": s, "tip_displacement_mm": d, "contact_force_n": f, "settled": True}
+...     for s, d, f in [(3000, 0.05, 1.0), (4000, 0.4, 9.0), (5000, 0.1, 2.0)]],
+...     "resonances": [{"mode": 1, "speed": 4100.0}], "nonsmooth_bands_hz": [(210.0, 216.0)]}
+>>> fig = interaction_plot(section)
+>>> [ax.get_ylabel() for ax in fig.axes]
+['peak tip displacement (mm)', 'peak contact force (N)']
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from ..fe.rotation import SPEED_UNITS
+from .plots import new_figure
+
+__all__ = ["interaction_plot"]
+
+
+def interaction_plot(section: dict, title: str | None = None) -> Figure:
+    """The figure of a ``[rub]`` summary section (:func:`bladecase.study.rub.rub_stage`): hollow markers where the
+    response had not settled."""
+    rows = section["rows"]
+    unit = section["speed_unit"]
+    scale = SPEED_UNITS[unit.lower()]
+    speed = np.array([r["speed"] for r in rows])
+    settled = np.array([r["settled"] for r in rows], dtype=bool)
+    fig = new_figure(figsize=(7.0, 5.6), layout="constrained")
+    axes = fig.subplots(2, 1, sharex=True)
+    series = [("tip_displacement_mm", "peak tip displacement (mm)"), ("contact_force_n", "peak contact force (N)")]
+    lobes = section["lobes"]
+    for ax, (key, label) in zip(axes, series):
+        y = np.array([r[key] for r in rows], dtype=float)
+        ax.plot(speed, y, "-", color="C0", lw=1.2)
+        ax.plot(speed[settled], y[settled], "o", color="C0", ms=4, label="settled")
+        if (~settled).any():
+            ax.plot(speed[~settled], y[~settled], "o", mfc="none", color="C3", ms=5, label="not settled")
+        ax.set_ylabel(label)
+        ax.grid(True, alpha=0.3)
+        for k, (lo, hi) in enumerate(section.get("nonsmooth_bands_hz") or []):
+            a, b = (2 * math.pi * f / lobes / scale for f in (lo, hi))
+            label = f"nonsmooth-mode band ({section.get('bands_at', 'at rest')})" if k == 0 else None
+            ax.axvspan(a, b, color="C1", alpha=0.2, lw=0, label=label)
+        for res in section.get("resonances") or []:
+            ax.axvline(res["speed"], ls="--", color="0.4", lw=0.9)
+            if key == series[0][0]:
+                ax.annotate(f"mode {res['mode']}", (res["speed"], 1.0), xycoords=("data", "axes fraction"),
+                            rotation=90, va="top", ha="right", fontsize=8, color="0.3")
+    axes[0].legend(loc="upper left", fontsize=8)
+    axes[-1].set_xlabel(f"speed ({unit}); casing with {lobes} lobes: excitation at {lobes} × the speed")
+    if title:
+        fig.suptitle(title)
+    return fig

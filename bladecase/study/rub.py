@@ -1,0 +1,268 @@
+"""The ``[rub]`` stage: the rub response of the blade turning inside an out-of-round casing, over speeds.
+
+At each speed of ``[rub] speeds`` the blade is taken about its centrifugal state at that speed (stiffness and
+running clearances, :func:`bladecase.fe.rotation.spin` about the casing's axis) and reduced with one massless
+contact per node of the contact face (:func:`bladecase.reduction.nodes.nodal_model` with the residual correction:
+``[rub] size`` modes of the massless structure, the static flexibility they miss added to the nodes'; one
+interior basis for every speed, computed at the middle of the range: each speed's model is its Ritz projection,
+the contact rows and the residual flexibility computed with that speed's stiffness); then simulated from rest
+(:func:`bladecase.nsm.massless.rub.rub_response`). The speeds run through the study's executor. Outputs:
+``rub.csv`` (one row per speed), ``rub_nodes.csv`` (one row per speed and node), ``rub.png`` (the interaction
+diagram: peak tip displacement and peak contact force against speed, with the speeds where the casing's lobes
+excite a linear mode and, when the study found nonsmooth modes, where they excite the nonsmooth mode's band).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .. import log
+from ..fe.rotation import SPEED_UNITS, RotationAxis, spin, to_rad_s
+from ..io import save_figure, write_text
+from ..nsm.damping import Damping
+from ..nsm.massless.rub import rub_response
+from ..reduction.contact import Contact, tributary_areas
+from ..reduction.nodes import nodal_model
+from .keys import StudyError
+
+__all__ = ["node_angles", "rub_stage"]
+
+#: Columns of ``rub.csv``: name (its unit is the suffix) → what it holds.
+COLUMNS = {
+    "speed": "the speed, in [rub] speed_unit",
+    "speed_rad_s": "the speed (rad/s)",
+    "tip_displacement_mm": "the largest peak outward normal displacement over the contact nodes (mm)",
+    "contact_force_n": "the largest peak contact force over the nodes (N)",
+    "contact_fraction": "the largest fraction of a revolution a node spends in contact",
+    "penetration_mm": "the casing's largest yield under a node (mm; 0 for a rigid casing)",
+    "nodes_touching": "how many contact nodes touch the casing",
+    "switches": "contact switches simulated",
+    "settled": "whether the last window's peaks match the previous window's within 2 %",
+}
+
+
+def node_angles(model, nodes, axis: RotationAxis) -> np.ndarray:
+    """Each node's angle (rad) about ``axis``, from the nodes' mean radial direction.
+
+    >>> from types import SimpleNamespace
+    >>> m = SimpleNamespace(mesh=SimpleNamespace(points=np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])), dim=3)
+    >>> np.degrees(node_angles(m, [0, 1], RotationAxis((0, 0, 0), (1, 0, 0)))).round(6).tolist()   # from their mean
+    [-45.0, 45.0]
+    """
+    a = axis.direction
+    P = np.zeros((len(nodes), 3))
+    P[:, : model.dim] = np.asarray(model.mesh.points, dtype=float)[list(nodes), : model.dim]
+    x = P - axis.origin
+    radial = x - np.outer(x @ a, a)
+    e1 = radial.mean(axis=0)
+    if np.linalg.norm(e1) == 0:
+        e1 = np.eye(3)[int(np.argmin(np.abs(a)))] - a * a[int(np.argmin(np.abs(a)))]
+    e1 = e1 / np.linalg.norm(e1)
+    e2 = np.cross(a, e1)
+    return np.arctan2(radial @ e2, radial @ e1)
+
+
+def _axis(study) -> RotationAxis:
+    k = study["casing"]["axis"]
+    return RotationAxis(k["origin"], k["direction"])
+
+
+def _node_stiffness(study, model, contact: Contact) -> np.ndarray:
+    """The casing's stiffness at each node (N/m): per area × tributary area, or the total shared by area."""
+    c = study["contact"]
+    m = len(contact.nodes)
+    if c.get("casing_stiffness_per_area") is not None:
+        return c["casing_stiffness_per_area"] * tributary_areas(model, contact.nodes)
+    if c["casing_stiffness"] is None:
+        return np.full(m, np.inf)
+    area = tributary_areas(model, contact.nodes)
+    if np.any(area <= 0):
+        bad = [model.mesh.node_id(k) for k, a in zip(contact.nodes, area) if a <= 0]
+        raise StudyError(f"[contact] casing_stiffness: the contact nodes {bad} have no share of the face's area, so a "
+                         "stiffness shared by area cannot reach them")
+    return c["casing_stiffness"] * area / area.sum()
+
+
+def _damping(r: dict) -> Damping:
+    if r["rayleigh"] is not None:
+        alpha, beta = r["rayleigh"]
+        return Damping(alpha=alpha, beta=beta)
+    return Damping(zeta=r["ratio"])
+
+
+def _running(model, contact: Contact, u: np.ndarray, speed: float) -> Contact:
+    """The contact at its running clearances (the centrifugal displacement ``u``); ``ValueError`` naming the first
+    node whose clearance it closes."""
+    d = np.array(contact.clearances) - contact.node_normal_map(model) @ u
+    if d.min() <= 0:
+        k = int(np.argmin(d))
+        raise ValueError(f"at {speed:.6g} rad/s ({speed * 60 / (2 * np.pi):.6g} rpm) the blade's centrifugal growth "
+                         f"({(contact.clearances[k] - d[k]) * 1e3:.4g} mm along the normal) closes the clearance of "
+                         f"contact node {model.mesh.node_id(contact.nodes[k])} ({contact.clearances[k] * 1e3:.4g} mm "
+                         "cold): it rubs statically there; lower the speeds or widen the casing")
+    return contact.closed_by(model, u)
+
+
+def _rub_point(speed: float, *, model, contact: Contact, interior: np.ndarray, size: int, casing: np.ndarray,
+               angles: np.ndarray, axis: RotationAxis, static: str, lobes: int, amplitude: float, damping: Damping,
+               revolutions: int, window: int) -> dict:
+    """One speed (module level: an executor ships it to its workers)."""
+    state = spin(model, speed, axis, static=static)
+    hot = _running(model, contact, state.displacement, speed)
+    reduced = nodal_model(state.model, hot, size, factor=state.factor, casing=casing, interior=interior, residual=True)
+    r = rub_response(reduced.system, speed, lobes, amplitude, angles, damping, revolutions, window)
+    out = r.as_dict()
+    out["open_hz"] = (reduced.system.modes[0][:6] / (2 * np.pi)).tolist()
+    out["clearances_m"] = reduced.system.gap.tolist()
+    return out
+
+
+def _resonances(speeds: np.ndarray, open_hz: np.ndarray, lobes: int) -> list[dict]:
+    """Speeds where ``lobes·Ω/2π`` crosses an open-phase frequency (linear interpolation between speeds)."""
+    out = []
+    excite = lobes * speeds / (2 * np.pi)
+    for k in range(open_hz.shape[1]):
+        d = excite - open_hz[:, k]
+        for i in np.flatnonzero(np.sign(d[:-1]) * np.sign(d[1:]) <= 0):
+            if d[i] == d[i + 1]:
+                continue
+            w = speeds[i] + (speeds[i + 1] - speeds[i]) * d[i] / (d[i] - d[i + 1])
+            f = float(np.interp(w, speeds, open_hz[:, k]))
+            out.append({"mode": k + 1, "speed_rad_s": float(w), "frequency_hz": f})
+    return out
+
+
+def _bands(families) -> list[tuple[float, float]]:
+    """The admissible frequency ranges (Hz) of the study's nonsmooth modes."""
+    out = []
+    for f in families or []:
+        ok = np.asarray(f.admissible, dtype=bool)
+        if ok.any():
+            fr = np.asarray(f.frequencies, dtype=float)[ok]
+            out.append((float(fr.min()), float(fr.max())))
+    return out
+
+
+def rub_stage(study, model, contact: Contact, *, families=None, executor=None, progress: bool = False,
+              folder: str | Path | None = None, figures: bool = True, title: str | None = None) -> dict:
+    """The rub response over ``[rub] speeds`` (module docstring) of ``model`` at rest with its cold ``contact`` (a
+    face on the [casing]); writes ``rub.csv``, ``rub_nodes.csv`` and ``rub.png`` into ``folder``; returns the
+    summary section."""
+    r, k = study["rub"], study["casing"]
+    unit = r["speed_unit"]
+    speeds = np.array([to_rad_s(v, unit) for v in r["speeds"]])
+    axis = _axis(study)
+    static = (study.config.get("rotation") or {}).get("static", "auto")
+    nodes = list(contact.nodes)
+    angles = node_angles(model, nodes, axis)
+    casing = _node_stiffness(study, model, contact)
+    middle = float(np.sqrt(speeds.min() * speeds.max()))
+    try:
+        base = spin(model, middle, axis, static=static)
+        hot = _running(model, contact, base.displacement, middle)
+        interior = nodal_model(base.model, hot, r["size"], factor=base.factor, casing=casing, residual=True).interior
+    except ValueError as exc:
+        raise StudyError(f"[rub] {exc}") from None
+    damping = _damping(r)
+    log.info("rub: %d speeds %.6g–%.6g %s, casing with %d lobes of %.4g mm, %d contact nodes (%s casing), %d "
+             "revolutions each (the last %d read)", speeds.size, min(r["speeds"]), max(r["speeds"]), unit,
+             k["lobes"], k["amplitude"] * 1e3, len(nodes),
+             "rigid" if np.isinf(casing).all() else f"{casing.sum():.4g} N/m", r["revolutions"], r["window"])
+    shared = dict(model=model, contact=contact, interior=interior, size=r["size"], casing=casing, angles=angles,
+                  axis=axis, static=static, lobes=k["lobes"], amplitude=k["amplitude"], damping=damping,
+                  revolutions=r["revolutions"], window=r["window"])
+    try:
+        points = executor.map(_rub_point, [float(w) for w in speeds], shared=shared, desc="rub speeds",
+                              progress=progress)
+    except ValueError as exc:
+        raise StudyError(f"[rub] speeds: {exc}") from None
+    section = _summary(study, speeds, points, families, contact, model)
+    if folder is not None:
+        section["files"] = _write(Path(folder), section, points, figures, title)
+    return section
+
+
+def _summary(study, speeds: np.ndarray, points: list[dict], families, contact: Contact, model) -> dict:
+    r, k = study["rub"], study["casing"]
+    unit = r["speed_unit"]
+    scale = SPEED_UNITS[unit.lower()]
+    rows = []
+    for given, w, p in zip(r["speeds"], speeds, points):
+        frac = np.array(p["contact_fraction"])
+        rows.append({"speed": float(given), "speed_rad_s": float(w),
+                     "tip_displacement_mm": 1e3 * max(p["peak_displacement"]),
+                     "contact_force_n": max(p["peak_force"]), "contact_fraction": float(frac.max()),
+                     "penetration_mm": 1e3 * max(p["penetration"]), "nodes_touching": int((frac > 0).sum()),
+                     "switches": p["switches"], "settled": bool(p["settled"])})
+    worst = int(np.argmax([row["tip_displacement_mm"] for row in rows]))
+    p = points[worst]
+    touching = [i for i, f in enumerate(p["contact_fraction"]) if f > 0]
+    where = _along_tip(model, contact, touching)
+    open_hz = np.array([q["open_hz"] for q in points])
+    resonances = _resonances(speeds, open_hz, k["lobes"]) if speeds.size > 1 else []
+    for res in resonances:
+        res["speed"] = res["speed_rad_s"] / scale
+    return {
+        "speed_unit": unit, "lobes": k["lobes"], "amplitude_m": k["amplitude"], "revolutions": r["revolutions"],
+        "window": r["window"], "damping": ({"ratio": r["ratio"]} if r["ratio"] is not None
+                                           else {"rayleigh": r["rayleigh"]}),
+        "nodes": [int(n) for n in points[0]["nodes"]],
+        "rows": rows,
+        "worst": {**rows[worst], "touching_nodes": [int(points[worst]["nodes"][i]) for i in touching],
+                  "touching_along_tip": where},
+        "unsettled_speeds": [row["speed"] for row in rows if not row["settled"]],
+        "resonances": resonances,
+        "nonsmooth_bands_hz": _bands(families),
+        "bands_at": _bands_at(study),
+        "model": {"size": r["size"], "contact_nodes": len(contact.nodes),
+                  "casing_n_per_m": None if np.isinf(_node_stiffness(study, model, contact)).all()
+                  else float(_node_stiffness(study, model, contact).sum())},
+    }
+
+
+def _bands_at(study) -> str:
+    """Where the study's own nonsmooth modes were computed: at rest, or at its [rotation] speed."""
+    r = study.config.get("rotation") or {}
+    if r.get("speed") is None and not r.get("speeds"):
+        return "at rest"
+    speed = r["speed"] if r.get("speed") is not None else max(r["speeds"])
+    return f"at {speed:.6g} {r.get('speed_unit', 'rpm')}"
+
+
+def _along_tip(model, contact: Contact, touching: list[int]) -> list[float] | None:
+    """Where the touching nodes sit along the tip (0–1 along its longest extent)."""
+    if not touching:
+        return None
+    P = np.asarray(model.mesh.points, dtype=float)[list(contact.nodes)]
+    C = P - P.mean(axis=0)
+    direction = np.linalg.svd(C, full_matrices=False)[2][0]
+    s = C @ direction
+    s = (s - s.min()) / max(float(np.ptp(s)), 1e-300)
+    return [float(np.round(s[i], 3)) for i in touching]
+
+
+def _write(folder: Path, section: dict, points: list[dict], figures: bool, title: str | None) -> dict:
+    rows = section["rows"]
+    lines = [",".join(COLUMNS)]
+    for row in rows:
+        lines.append(",".join(f"{row[c]:.9g}" if isinstance(row[c], float) else str(row[c]).lower()
+                              if isinstance(row[c], bool) else str(row[c]) for c in COLUMNS))
+    write_text(folder / "rub.csv", "\n".join(lines) + "\n")
+    node_lines = ["speed,speed_rad_s,node,peak_displacement_mm,peak_force_n,contact_fraction,penetration_mm,"
+                  "clearance_mm"]
+    for row, p in zip(rows, points):
+        for j, n in enumerate(p["nodes"]):
+            node_lines.append(f"{row['speed']:.9g},{row['speed_rad_s']:.9g},{n},{p['peak_displacement'][j] * 1e3:.9g},"
+                              f"{p['peak_force'][j]:.9g},{p['contact_fraction'][j]:.9g},"
+                              f"{p['penetration'][j] * 1e3:.9g},{p['clearances_m'][j] * 1e3:.9g}")
+    write_text(folder / "rub_nodes.csv", "\n".join(node_lines) + "\n")
+    files = {"csv": "rub.csv", "nodes_csv": "rub_nodes.csv"}
+    if figures:
+        from ..post.rub_plot import interaction_plot
+
+        fig = interaction_plot(section, title=f"{title}: rub response" if title else None)
+        save_figure(fig, folder / "rub.png")
+        files["figure"] = "rub.png"
+    return files

@@ -1,0 +1,117 @@
+"""The [rub] stage: the rub response of the demo blade turning in an out-of-round casing, from a study file to
+rub.csv, rub_nodes.csv, rub.png, the summary and the report; its input checks."""
+
+from __future__ import annotations
+
+import csv
+
+import numpy as np
+import pytest
+
+from bladecase.study import run
+from bladecase.study.demo import demo_text
+from bladecase.study.keys import StudyError
+from bladecase.study.schema import loads
+
+#: The demo blade under a cylindrical casing whose axis runs along the tip's chord (the tip is an arc of it, so
+#: every tip node sits 0.5 mm from the casing cold), with 8 lobes of 0.3 mm.
+CASING = """
+[casing]
+radius = 0.4505
+axis = {origin = [-0.000167, 0.030778, -0.3], direction = [-0.350089, -0.936717, 0.0]}
+lobes = 8
+amplitude = 3e-4
+"""
+
+RUB = """
+[rub]
+speeds = [1450, 1650]
+ratio = 0.005
+revolutions = 12
+window = 4
+"""
+
+
+def _study(casing: str = CASING, rub: str = RUB, **contact) -> str:
+    text = demo_text().replace("clearance = 1e-4            # 0.1 mm tip clearance; normal: radial (+z)\n", "")
+    text = text.replace('formats = ["gif", "mp4", "vtu", "png"]', 'formats = ["png"]').replace("animate = 2",
+                                                                                                 "animate = 0")
+    for key, value in contact.items():
+        text = text.replace("[contact]\n", f"[contact]\n{key} = {value}\n")
+    return text + casing + rub
+
+
+@pytest.fixture(scope="module")
+def result(tmp_path_factory):
+    out = tmp_path_factory.mktemp("rub")
+    study = loads(_study(), source="<rub>")
+    return run(study, out, progress=False), out
+
+
+def test_rub_outputs(result):
+    res, out = result
+    for name in ("rub.csv", "rub_nodes.csv", "rub.png"):
+        assert (out / name).is_file()
+    rows = list(csv.DictReader(open(out / "rub.csv")))
+    assert [float(r["speed"]) for r in rows] == [1450.0, 1650.0]
+    nodes = list(csv.DictReader(open(out / "rub_nodes.csv")))
+    assert len(nodes) == 2 * 26
+    s = res.summary["rub"]
+    slow, fast = s["rows"]
+    # past the linear resonance of mode 1 with 8 lobes (about 1626 rpm, f1 216.8 Hz at speed) the rub is far
+    # harder: measured 0.014 mm / 2.0 N at 1450 rpm and 0.69 mm / 8.5 N at 1650 rpm (30 revolutions)
+    assert fast["tip_displacement_mm"] > 10 * slow["tip_displacement_mm"] > 0
+    assert fast["contact_force_n"] > 2 * slow["contact_force_n"] > 0
+    assert 0 < slow["contact_fraction"] < fast["contact_fraction"] < 1
+    assert s["worst"]["speed"] == 1650 and len(s["worst"]["touching_nodes"]) == fast["nodes_touching"] > 0
+    assert all(0 <= x <= 1 for x in s["worst"]["touching_along_tip"])
+    assert [r["mode"] for r in s["resonances"]] == [1]
+    assert 1600 < s["resonances"][0]["speed"] < 1650
+    # the casing's yield is the force over each node's share of the 1e6 N/m casing
+    assert s["model"]["casing_n_per_m"] == pytest.approx(1e6, rel=1e-9)
+    text = (out / "report.md").read_text()
+    assert "## Rub response" in text and "The hardest rub is at 1650 rpm" in text
+    assert "lobes excite linear mode 1" in text
+
+
+@pytest.mark.parametrize("casing, rub, contact, match", [
+    (CASING.replace("lobes = 8\n", ""), RUB, {}, r"\[casing\] lobes: an out-of-round casing needs lobes and amplitude"),
+    ("\n[casing]\nradius = 0.4505\naxis = {origin = [0, 0.03, -0.3], direction = [-0.35, -0.94, 0]}\n", RUB, {},
+     r"\[rub\] speeds: the rub response needs an out-of-round casing"),
+    (CASING, RUB.replace("window = 4", "window = 7"), {}, r"\[rub\] window: at most revolutions / 2 = 6"),
+    (CASING, RUB.replace("ratio = 0.005\n", ""), {}, r"\[rub\] rayleigh / ratio: give exactly one damping"),
+    (CASING, RUB.replace("speeds = [1450, 1650]", "speeds = [0, 1650]"), {}, r"\[rub\] speeds: must all be > 0"),
+    (CASING, "\n[rub]\nratio = 0.01\n", {}, r"\[rub\] speeds: required to run the rub response"),
+    (CASING, RUB, {"casing_stiffness_per_area": "1e9"}, r"casing_stiffness_per_area: give it or casing_stiffness"),
+])
+def test_rub_input_errors(casing, rub, contact, match):
+    with pytest.raises(StudyError, match=match):
+        loads(_study(casing, rub, **contact), source="<rub>")
+
+
+def test_a_speed_whose_growth_closes_a_clearance_is_named(tmp_path):
+    study = loads(_study(rub=RUB.replace("speeds = [1450, 1650]", "speeds = [1450, 3000]")), source="<rub>")
+    with pytest.raises(StudyError, match=r"rpm\) the blade's centrifugal growth .* closes the clearance of contact "
+                                         r"node \d+ \(0.5 mm cold\)"):
+        run(study, tmp_path, progress=False)
+    assert not (tmp_path / "rub.csv").exists()
+
+
+def test_stiffness_per_area_gives_each_node_its_share(tmp_path):
+    from bladecase.study.rub import _node_stiffness
+    from bladecase.study.stages import build_contact, build_mesh, build_model
+
+    text = _study().replace("casing_stiffness = 1e6      # N/m: a thin casing's local radial stiffness; the modes "
+                            "converge (docs/massless.md)\n", "casing_stiffness_per_area = 2e9\n")
+    study = loads(text, source="<rub>")
+    mesh = build_mesh(study)
+    model = build_model(study, mesh)
+    contact = build_contact(study, model)
+    from bladecase.reduction.contact import tributary_areas
+
+    area = tributary_areas(model, contact.nodes)
+    np.testing.assert_allclose(_node_stiffness(study, model, contact), 2e9 * area, rtol=1e-12)
+    assert contact.casing == pytest.approx(2e9 * area.sum(), rel=1e-12)   # the face mean's spring: all in parallel
+    # the tip section's area: a NACA 4-digit profile of thickness t and chord c has about 0.685 t c² (2412, 35 mm:
+    # 100.7 mm²); the meshed tip face gives 103.2 mm²
+    assert area.sum() == pytest.approx(0.685 * 0.12 * 0.035**2, rel=0.05)
