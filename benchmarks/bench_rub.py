@@ -26,12 +26,12 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from test_nodes import X0, V0, chain, reference  # noqa: E402
+from test_nodes import V0, X0, chain, reference  # noqa: E402
 from test_rub_study import CASING, _study  # noqa: E402
 
 from bladecase.fe.rotation import spin  # noqa: E402
 from bladecase.nsm import Damping, simulate_massless  # noqa: E402
-from bladecase.nsm.massless.nodes import NodalFlight, NodalSystem, Rub, simulate_nodes  # noqa: E402
+from bladecase.nsm.massless.nodes import NodalSystem, Rub, simulate_nodes  # noqa: E402
 from bladecase.nsm.massless.rub import rub_response  # noqa: E402
 from bladecase.reduction.massless import massless_model  # noqa: E402
 from bladecase.reduction.nodes import nodal_model  # noqa: E402

@@ -150,3 +150,54 @@ def test_rub_response_and_sweep():
     # a node reaches at most its clearance's lowest point plus the casing's yield: u <= d + a + λ/k
     assert np.all(slow.peak_displacement <= s.gap + 0.35 + slow.penetration + 1e-12)
     assert np.all(slow.peak_displacement >= s.gap - 0.35 - 1e-12)   # the touching nodes reach the casing
+
+
+@pytest.fixture(scope="module")
+def strip():
+    from skfem import MeshTri
+
+    from bladecase.fe import Mesh, assemble
+    from bladecase.reduction import Contact
+
+    t = MeshTri.init_tensor(np.linspace(0, 0.1, 21), np.linspace(0, 0.02, 5))
+    p = np.c_[t.p.T, np.zeros(t.p.shape[1])]
+    mesh = Mesh(p, {"triangle": t.t.T}, dim=2, groups={"root": np.flatnonzero(p[:, 0] == 0),
+                                                       "tip": np.flatnonzero(p[:, 0] == 0.1)})
+    model = assemble(mesh, "steel", order=1, thickness=0.002, mass="lumped")
+    return model, Contact.face(model, "tip", (1.0, 0.0), 1e-4, weights="area")
+
+
+@pytest.mark.parametrize("residual", [False, True], ids=["attachment vectors", "residual correction"])
+def test_nodal_model_static_compliance_is_exact(strip, residual):
+    import scipy.sparse.linalg as spla
+
+    from bladecase.reduction.nodes import nodal_model
+
+    model, contact = strip
+    reduced = nodal_model(model, contact, 4, residual=residual)
+    s = reduced.system
+    W = contact.node_normal_map(model).T.toarray()
+    exact = W.T @ spla.spsolve(model.K.tocsc(), W)            # every node's static compliance, the full model's
+    model_compliance = s.flexibility + s.W.T @ np.linalg.solve(s.S, s.W)
+    np.testing.assert_allclose(model_compliance, exact, rtol=1e-9, atol=1e-9 * np.abs(exact).max())
+    assert s.n == (4 if residual else 4 + 5)
+    # a force on one node: the nodes' static displacements from the expansion match the full model
+    f = np.zeros(s.m)
+    f[2] = 1.0
+    q = np.linalg.solve(s.S, -s.W @ f)
+    u = reduced.basis @ q + reduced.closed_shapes @ f
+    np.testing.assert_allclose(W.T @ u, -exact @ f, rtol=1e-8, atol=1e-10 * np.abs(exact).max())
+
+
+def test_one_node_nodal_model_is_the_massless_model(strip):
+    from bladecase.reduction import Contact
+    from bladecase.reduction.massless import massless_model
+    from bladecase.reduction.nodes import nodal_model
+
+    model, face = strip
+    node = Contact(face.node, (1.0, 0.0), 1e-4, nodes=(face.node,))
+    a = massless_model(model, Contact(face.node, (1.0, 0.0), 1e-4), 6).system
+    b = nodal_model(model, node, 6).system
+    assert b.m == 1 and b.n == a.n
+    assert 1.0 / b.flexibility[0, 0] == pytest.approx(a.kc, rel=1e-12)
+    np.testing.assert_allclose(np.sort(b.modes[0]), np.sort(a.open.omega), rtol=1e-10)

@@ -3,9 +3,10 @@
 
 Each node ``j`` of the contact (its face group: :meth:`Contact.face <bladecase.reduction.Contact.face>`, or on a
 casing of revolution: :meth:`Contact.on_casing <bladecase.reduction.Contact.on_casing>`) is its own unilateral
-constraint ``ν_j·u_j <= d_j``, with its own normal ``ν_j`` and clearance ``d_j``. The contact dofs ``c`` are every
-dof of those nodes; they carry no inertia (their lumped mass moved to the neighbours as for one constraint,
-:func:`~bladecase.reduction.massless.massless_masses`), the others are the interior ``i``.
+constraint ``ν_j·u_j <= d_j``, with its own normal ``ν_j`` and clearance ``d_j``. The contact dofs ``c`` are the
+dofs of those nodes that their normals move (every one for a normal off the axes); they carry no inertia (their
+lumped mass moved to the neighbours as for one constraint, :func:`~bladecase.reduction.massless.massless_masses`),
+the others are the interior ``i``. With one node, this is :func:`~bladecase.reduction.massless.massless_model`.
 
 - open phase: ``x_c = −K_cc⁻¹K_ci x_i``; the nodes' normal displacements ``W_cᵀx_c = Wᵀx_i`` with
   ``W = −K_icK_cc⁻¹W_c`` (``W_c``: the ``m`` normal vectors on the contact dofs);
@@ -138,7 +139,7 @@ def nodal_model(model: FEModel, contact: Contact, size: int, factor: SPDFactor |
     m = nodes.size
     d, _ = contact.node_clearances(model)
     N = sp.csr_array(contact.node_normal_map(model))  # (m, n_dofs)
-    c = np.sort(contact.dofs(model))
+    c = np.flatnonzero(np.asarray(abs(N).sum(axis=0)).ravel())  # the dofs some node's normal moves (w ≠ 0)
     i = np.setdiff1d(np.arange(model.n_dofs), c)
     size = integer("size", size, 1, note=" (modes of the massless structure)")
     if size > i.size - m:
