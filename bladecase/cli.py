@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import logging
 import os
 import sys
 from collections.abc import Sequence
@@ -219,7 +220,7 @@ def _setup(args) -> bool:
     logger = logging.getLogger("bladecase")
     handler = next((h for h in logger.handlers if getattr(h, "_bladecase", False)), None)
     if handler is None:
-        handler = logging.StreamHandler(sys.stderr)
+        handler = _BarSafeHandler(sys.stderr)
         handler.setFormatter(logging.Formatter("bladecase: %(message)s"))
         handler._bladecase = True
         logger.addHandler(handler)
@@ -228,6 +229,20 @@ def _setup(args) -> bool:
     handler.setLevel(logging.WARNING if args.quiet else logging.INFO)
     logger.setLevel(logging.INFO)
     return not args.no_progress and not args.quiet and sys.stderr.isatty()
+
+
+class _BarSafeHandler(logging.StreamHandler):
+    """A stderr handler that writes through ``tqdm.write``: a message clears the progress bars, is printed on its
+    own line, and the bars are drawn again below it (a log line never lands inside a bar)."""
+
+    def emit(self, record) -> None:
+        try:
+            from tqdm import tqdm
+
+            tqdm.write(self.format(record), file=self.stream)
+            self.flush()
+        except Exception:  # noqa: BLE001 — logging's own convention: report, never raise
+            self.handleError(record)
 
 
 def _study(path: Path, model: bool = True):

@@ -141,3 +141,28 @@ def test_backbone_ipp2_writes_json_plot_table(tmp_path, capsys):
     assert any(abs(a["T_hi"] - 5 * 2 * np.pi / 2.2882456112707374) < 1e-6 for a in arcs)  # the paper's point 2
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert "2-ipp family" in txt.read_text() and "admissible arc" in capsys.readouterr().out
+
+
+def test_log_lines_do_not_land_inside_a_progress_bar():
+    """The command line's log handler writes through tqdm: the bar is cleared, the message printed on its own line,
+    the bar drawn again (before, a message written mid-bar read ``…]bladecase: …``)."""
+    import io
+    import logging
+
+    from tqdm import tqdm
+
+    from bladecase.cli import _BarSafeHandler
+
+    buf = io.StringIO()
+    handler = _BarSafeHandler(buf)
+    handler.setFormatter(logging.Formatter("bladecase: %(message)s"))
+    record = logging.LogRecord("bladecase", logging.INFO, __file__, 1, "mesh: %d nodes", (360,), None)
+    with tqdm(total=4, desc="bladecase run", file=buf, mininterval=0, ascii=True) as bar:
+        bar.update(1)
+        handler.emit(record)
+        bar.update(1)
+    out = buf.getvalue()
+    at = out.index("bladecase: mesh: 360 nodes\n")
+    assert at > 0 and out[at - 1] in "\r\n"            # on a line of its own, after the bar was cleared
+    assert "]bladecase" not in out and "|bladecase" not in out
+    assert out.rstrip().count("bladecase run") >= 2     # the bar drawn again after the message
