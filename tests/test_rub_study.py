@@ -34,7 +34,7 @@ window = 4
 
 def _study(casing: str = CASING, rub: str = RUB, **contact) -> str:
     text = demo_text().replace("clearance = 1e-4            # 0.1 mm tip clearance; normal: radial (+z)\n", "")
-    text = text.replace('formats = ["gif", "mp4", "vtu", "png"]', 'formats = ["png"]').replace("animate = 2",
+    text = text.replace('formats = ["gif", "mp4", "vtu", "png"]', 'formats = ["png", "vtu"]').replace("animate = 2",
                                                                                                  "animate = 0")
     for key, value in contact.items():
         text = text.replace("[contact]\n", f"[contact]\n{key} = {value}\n")
@@ -50,8 +50,15 @@ def result(tmp_path_factory):
 
 def test_rub_outputs(result):
     res, out = result
-    for name in ("rub.csv", "rub_nodes.csv", "rub.png"):
+    for name in ("rub.csv", "rub_nodes.csv", "rub.png", "rub.vtu"):
         assert (out / name).is_file()
+    import meshio
+
+    vtu = meshio.read(out / "rub.vtu")
+    force = vtu.point_data["rub_peak_force_n"]
+    assert (force > 0).sum() == res.summary["rub"]["rows"][1]["nodes_touching"]       # the touching nodes, 1650 rpm
+    assert vtu.point_data["rub_contact_node"].sum() == 26 and force.max() == pytest.approx(
+        res.summary["rub"]["rows"][1]["contact_force_n"], rel=1e-12)
     rows = list(csv.DictReader(open(out / "rub.csv")))
     assert [float(r["speed"]) for r in rows] == [1450.0, 1650.0]
     nodes = list(csv.DictReader(open(out / "rub_nodes.csv")))

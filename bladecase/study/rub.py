@@ -181,7 +181,40 @@ def rub_stage(study, model, contact: Contact, *, families=None, executor=None, p
     section = _summary(study, speeds, points, families, contact, model)
     if folder is not None:
         section["files"] = _write(Path(folder), section, points, figures, title)
+        if "vtu" in study["output"]["formats"]:
+            section["files"]["vtu"] = _write_vtu(Path(folder) / "rub.vtu", model, contact, section, points)
     return section
+
+
+def _write_vtu(path: Path, model, contact: Contact, section: dict, points: list[dict]) -> str:
+    """The mesh with the rub's per-node figures as point data, for ParaView: at the hardest speed (``rub_*``) and
+    the largest over every speed (``rub_max_*``); zero off the contact nodes."""
+    import meshio
+
+    from ..io import atomic_path
+
+    mesh = model.mesh
+    n = len(mesh.points)
+    idx = np.asarray(contact.nodes)
+    worst = points[int(np.argmax([r["tip_displacement_mm"] for r in section["rows"]]))]
+    data = {}
+    for key, scale, unit in (("peak_displacement", 1e3, "mm"), ("peak_force", 1.0, "n"),
+                             ("contact_fraction", 1.0, ""), ("penetration", 1e3, "mm")):
+        name = f"{key}_{unit}" if unit else key
+        at, top = np.zeros(n), np.zeros(n)
+        at[idx] = np.asarray(worst[key]) * scale
+        top[idx] = np.max([np.asarray(p[key]) for p in points], axis=0) * scale
+        data[f"rub_{name}"], data[f"rub_max_{name}"] = at, top
+    mask = np.zeros(n, dtype=np.uint8)
+    mask[idx] = 1
+    data["rub_contact_node"] = mask
+    if mesh.numbering == "file":
+        data["node_id"] = np.asarray(mesh.node_ids)
+    out = meshio.Mesh(mesh.points, [(t, np.asarray(c)) for t, c in mesh.cells.items()], point_data=data,
+                      field_data={"rub_hardest_speed": np.array([section["worst"]["speed"]])})
+    with atomic_path(path) as tmp:
+        meshio.write(tmp, out, file_format="vtu")
+    return path.name
 
 
 def _summary(study, speeds: np.ndarray, points: list[dict], families, contact: Contact, model) -> dict:
