@@ -34,8 +34,8 @@ window = 3
 
 def _study(casing: str = CASING, rub: str = RUB, **contact) -> str:
     text = demo_text().replace("clearance = 1e-4            # 0.1 mm tip clearance; normal: radial (+z)\n", "")
-    text = text.replace('formats = ["gif", "mp4", "vtu", "png"]', 'formats = ["png", "vtu"]\nreference = false').replace("animate = 2",
-                                                                                                 "animate = 0")
+    text = text.replace('formats = ["gif", "mp4", "vtu", "png"]', 'formats = ["png", "vtu"]\nreference = false')
+    text = text.replace("animate = 2", "animate = 0")
     for key, value in contact.items():
         text = text.replace("[contact]\n", f"[contact]\n{key} = {value}\n")
     return text + casing + rub
