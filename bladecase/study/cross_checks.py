@@ -139,7 +139,7 @@ MASSLESS_METHODS = ("massless", "massless-lanczos", "massless-modal")
 def _contact_model_checks(c: dict) -> None:
     """The massless contact model and the keys it needs go together."""
     massless = c["contact"]["model"] == "massless"
-    if c["contact"]["casing_stiffness"] is not None and not massless:
+    if c["contact"]["casing_stiffness"] is not None and not massless:  # (a number or a list)
         raise StudyError(f"[contact] casing_stiffness: a compliant casing needs model = 'massless' (Newton's impact "
                          f"law is for a rigid casing), got {c['contact']['casing_stiffness']!r} with model = "
                          f"{c['contact']['model']!r}")

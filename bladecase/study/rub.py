@@ -75,14 +75,17 @@ def _node_stiffness(study, model, contact: Contact) -> np.ndarray:
     m = len(contact.nodes)
     if c.get("casing_stiffness_per_area") is not None:
         return c["casing_stiffness_per_area"] * tributary_areas(model, contact.nodes)
-    if c["casing_stiffness"] is None:
+    from .stages import casing_stiffness
+
+    total = casing_stiffness(study)
+    if total is None:
         return np.full(m, np.inf)
     area = tributary_areas(model, contact.nodes)
     if np.any(area <= 0):
         bad = [model.mesh.node_id(k) for k, a in zip(contact.nodes, area) if a <= 0]
         raise StudyError(f"[contact] casing_stiffness: the contact nodes {bad} have no share of the face's area, so a "
                          "stiffness shared by area cannot reach them")
-    return c["casing_stiffness"] * area / area.sum()
+    return total * area / area.sum()
 
 
 def _damping(r: dict) -> Damping:

@@ -83,6 +83,20 @@ from .values import (  # noqa: F401  (RANGES, LIMITS: part of the schema's docum
 FORMATS = OUTPUT_FORMATS
 
 
+def _casing_stiffness(v) -> str | None:
+    """One casing stiffness (N/m), or a list of 2 to 12 of them (a sensitivity sweep)."""
+    values = v if isinstance(v, list) else [v]
+    if isinstance(v, list) and not 2 <= len(v) <= 12:
+        return f"must be a number (N/m) or a list of 2 to 12 numbers, got a list of {len(v)}"
+    for x in values:
+        if isinstance(x, bool) or not isinstance(x, (int, float)) or not x > 0:
+            return f"must be > 0 (N/m), got {x!r}" if isinstance(v, list) else "must be > 0 (N/m)"
+        err = _in_range("casing_stiffness")(x)
+        if err:
+            return err
+    return None
+
+
 #: The study-file schema: section → key → :class:`Key`.  ``[geometry]`` also
 #: takes the fields of :class:`~bladecase.BladeGeometry` (``kind = "blade"``)
 #: or :class:`~bladecase.PlateGeometry` (``kind = "plate"``), see :data:`GEOMETRY_FIELDS`.
@@ -156,11 +170,13 @@ SCHEMA: dict[str, dict[str, Key]] = {
                      "mass is moved to the neighbours; Signorini without an impact law; needs [fem] mass = "
                      "'lumped', [reduction] method = 'massless', [search] ipp = [1]).",
                      _one_of("newton", "massless")),
-        "casing_stiffness": Key(_NUM, None, "Stiffness of a compliant casing (N/m) in series with the contact "
-                                "(its local flexibility and coating); default: a rigid casing. Massless model only; "
-                                "well below the contact's own stiffness, the modes converge (docs/massless.md). "
-                                "With one contact per node ([rub]), shared by the nodes' tributary areas.",
-                                lambda v: "must be > 0 (N/m)" if not v > 0 else _in_range("casing_stiffness")(v)),
+        "casing_stiffness": Key((int, float, list), None, "Stiffness of a compliant casing (N/m) in series with the "
+                                "contact (its local flexibility and coating); default: a rigid casing. Massless model "
+                                "only; well below the contact's own stiffness, the modes converge (docs/massless.md). "
+                                "With one contact per node ([rub]), shared by the nodes' tributary areas. A list "
+                                "[k1, k2, …]: the results use k1, and the nonsmooth modes are also searched with each "
+                                "of the others (casing.png, the report: how much the answer moves).",
+                                _casing_stiffness),
         "casing_stiffness_per_area": Key(_NUM, None, "A compliant casing's stiffness per unit area (N/m³, e.g. an "
                                          "abradable layer's modulus / thickness): each node gets it times its "
                                          "tributary area, the face mean its total; instead of casing_stiffness.",

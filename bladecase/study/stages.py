@@ -248,7 +248,7 @@ def build_contact(study: Study, model: FEModel) -> Contact:
     if mesh.numbering == "file":  # the file's number, beside the 0-based index of mesh.vtu
         log.info("contact: node %d of %s (index %d in mesh.vtu)%s", mesh.node_id(contact.node), mesh.source,
                  contact.node, f", the centre of a face of {len(contact.nodes)} nodes" if contact.nodes else "")
-    casing = study["contact"]["casing_stiffness"]
+    casing = casing_stiffness(study)
     per_area = study["contact"].get("casing_stiffness_per_area")
     if per_area is not None:  # the face mean's spring: every node's share in parallel
         from ..reduction.contact import tributary_areas
@@ -257,6 +257,18 @@ def build_contact(study: Study, model: FEModel) -> Contact:
         casing = per_area * area
         log.info("casing: %.4g N/m³ over the contact face's %.4g mm²: %.4g N/m", per_area, area * 1e6, casing)
     return contact if casing is None else contact.with_casing(casing)
+
+
+def casing_stiffness(study: Study) -> float | None:
+    """``[contact] casing_stiffness`` of the run's results: the value, or the first of a list (N/m; ``None``: rigid)."""
+    k = study["contact"]["casing_stiffness"]
+    return k[0] if isinstance(k, list) else k
+
+
+def casing_sweep_values(study: Study) -> list[float]:
+    """The stiffnesses of a ``casing_stiffness = [k1, k2, …]`` sensitivity sweep (N/m; empty without a list)."""
+    k = study["contact"]["casing_stiffness"]
+    return [float(x) for x in k] if isinstance(k, list) else []
 
 
 def _casing(study: Study):
