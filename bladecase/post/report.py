@@ -6,28 +6,7 @@ import numpy as np
 
 from .rotation_report import rotation_report
 from .rub_report import rub_report
-
-#: Admissible arcs narrower than this (relative, in frequency) are called narrow in words.
-NARROW_RTOL = 1e-3
-
-
-def massless_summary(summary: dict) -> bool:
-    """Whether a run's summary is of the massless contact model (contact phases, not impacts)."""
-    model = summary["contact"].get("model")
-    if model is not None:
-        return model == "massless"
-    return str(summary["reduction"].get("method", "")).startswith("massless")  # a summary without the key
-
-
-def orbit_words(k: int, massless: bool) -> str:
-    """An orbit named by its contacts per period, in the contact model's words.
-
-    >>> orbit_words(1, True), orbit_words(2, True), orbit_words(2, False)
-    ('orbit with one contact phase per period', 'orbit with 2 contact phases per period', '2-ipp orbit')
-    """
-    if not massless:
-        return f"{k}-ipp orbit"
-    return f"orbit with {'one contact phase' if k == 1 else f'{k} contact phases'} per period"
+from .verdict import NARROW_RTOL, massless_summary, narrow_words, orbit_words, verdict  # noqa: F401 (re-exported)
 
 
 def engineering_words(a: dict, massless: bool) -> str:
@@ -57,11 +36,18 @@ def engineering_words(a: dict, massless: bool) -> str:
     return "; ".join(words)
 
 
+def verdict_lines(summary: dict) -> list[str]:
+    """The verdict at the top of the report: what was found, whether to trust it, what to do next — the summary's
+    ``verdict`` (:func:`~bladecase.post.verdict.verdict`), or computed from the summary when it has none."""
+    v = summary.get("verdict") or verdict(summary)
+    return [f"- **Found:** {v['found']}", f"- **Trust:** {v['trust']}", f"- **Next:** {v['next']}"]
+
+
 def report(summary: dict) -> str:
     """A human-readable Markdown report of a run's :data:`summary`."""
     m, c, r = summary["model"], summary["contact"], summary["reduction"]
     massless = massless_summary(summary)
-    lines = [f"# bladecase study `{summary['study']}`", "",
+    lines = [f"# bladecase study `{summary['study']}`", "", *verdict_lines(summary), "",
              f"Study file: `{summary['source']}` — bladecase {summary['bladecase_version']} — "
              f"total {summary['timings_s']['total']:.1f} s.", "",
              "## Model", "",
@@ -110,11 +96,13 @@ def report(summary: dict) -> str:
               f"scan {s['scan']}.", ""]
     fams = summary["families"]
     with_arcs = [(i, f) for i, f in enumerate(fams) if f["admissible_arcs"]]
-    lines.append(f"{len(fams)} families found, {len(with_arcs)} with admissible arcs "
-                 f"(families without any are listed in `summary.json`).")
-    lines += ["", f"| family | {'contact phases / period' if massless else 'ipp'} | orbits | f range (Hz) | "
-              "admissible arc f (Hz) | energy on arc (J) | linearly stable (Floquet) |",
-              "|---:|---:|---:|---|---|---|---|"]
+    lines.append(f"{len(fams)} {'family' if len(fams) == 1 else 'families'} found, {len(with_arcs)} with admissible "
+                 "arcs" + (" (families without any are listed in `summary.json`)." if len(with_arcs) < len(fams)
+                           else "."))
+    if with_arcs:
+        lines += ["", f"| family | {'contact phases / period' if massless else 'ipp'} | orbits | f range (Hz) | "
+                  "admissible arc f (Hz) | energy on arc (J) | linearly stable (Floquet) |",
+                  "|---:|---:|---:|---|---|---|---|"]
     for i, f in with_arcs:
         for a in f["admissible_arcs"]:
             stable = a.get("stable_fraction")
@@ -124,24 +112,18 @@ def report(summary: dict) -> str:
                          f"{'—' if stable is None else f'{stable:.0%} of its orbits'} |")
     lines += _arc_engineering_table(with_arcs, massless)
     lines += [w for i, f in with_arcs if (w := _resonance_words(i, f))]
-    widths = [(a["f_hi"] - a["f_lo"]) / a["f_hi"] for _, f in with_arcs for a in f["admissible_arcs"] if a["f_hi"] > 0]
-    if widths and max(widths) < NARROW_RTOL:
-        lines += ["", f"**Narrow:** the widest admissible arc spans {max(widths):.1e} of its frequency — in this model "
-                  "the mode exists only next to where it grows from a linear mode (grazing); beyond, its orbits are "
-                  "not admissible" + (" (the contact splits into several phases, docs/massless.md)" if massless else "")
-                  + ". Read its energies as those of a barely touching linear mode."]
+    narrow = narrow_words(summary)
+    if narrow:
+        lines += ["", f"**Narrow:** {narrow}."]
     files = summary["files"]
-    if summary.get("reference") and not files.get("animations") and not with_arcs:
-        lines += ["", "**No orbit animated:** no family has an admissible arc in the search range (widen [search] "
-                  "periods)."]
+    if not files.get("animations") and not with_arcs:
+        lines += ["", "**No orbit animated:** no family has an admissible arc in the search range (the verdict at the "
+                  "top says why)."]
     elif summary.get("reference") and not files.get("animations"):
         ref = summary["reference"]
-        lines += ["", f"**No orbit animated:** no admissible orbit of the {r['method']} model that was tried survives "
-                  f"in the reference model {ref['method']} ({ref['reduced_dofs']} dofs) — the families above are "
-                  "artefacts of the reduced model (see run.log)." + ("" if massless else
-                  " With Newton's impact law the orbits depend on the node's reduced mass; enlarging the model does "
-                  "not cure that: the massless contact model ([contact] model = \"massless\", docs/massless.md) "
-                  "removes the impact law.")]
+        lines += ["", f"**No orbit animated:** unless `[output] animate = 0`, no admissible orbit of the {r['method']} "
+                  f"model that was tried survives in the reference model {ref['method']} ({ref['reduced_dofs']} dofs) "
+                  "— the families above are artefacts of the reduced model (run.log names the orbits)."]
     lines += ["", "## Files", ""]
     if "frequency_energy_plot" in files:
         lines += [f"![frequency–energy]({files['frequency_energy_plot']})", ""]

@@ -24,6 +24,7 @@ from ..io import write_json, write_text
 from ..post.compare import ModelResult, fe_reference
 from ..post.outputs import FORMATS, PlotScene
 from ..post.report import report
+from ..post.verdict import verdict
 from ..progress import progress_counter
 from .comparison import FE_MODES, compare_models
 from .documents import contact_summary, families_document, family_summary, model_summary, reduced_summary
@@ -160,6 +161,7 @@ def run(study: Study | str | os.PathLike, out: str | os.PathLike | None = None, 
             log.info("results in %s (%.1f s)", out, summary["timings_s"]["total"])
         write_text(staging / "run.log", "\n".join(lines) + "\n")
         summary["outputs"] = sorted(set(staged_names(staging)) | {"summary.json", "report.md"})
+        summary["verdict"] = verdict(summary, staging / "modes.json")
         write_json(staging / "summary.json", summary)
         write_text(staging / "report.md", report(summary))
         publish(staging, out, RUN_RESULTS, whole=True)
