@@ -57,15 +57,20 @@ def spread(rows: list[dict]) -> dict:
 
 
 def casing_sweep(study, model, contact: Contact, stiffnesses, *, factor=None, search_fn=None, unit=None,
-                 progress: bool = False) -> dict:
+                 progress: bool = False, first: tuple | None = None) -> dict:
     """Search the study's nonsmooth modes with each casing stiffness (N/m) of ``stiffnesses``; return the summary
     section ``{"rows": [...], "spread": {...}, "branches": [...]}`` (``branches``: each stiffness's families, for
-    the figure; not JSON)."""
+    the figure; not JSON). ``first``: ``(series stiffness, families)`` already found with the first stiffness (the
+    run's own), not searched again."""
     from .stages import build_reduced, search
 
     search_fn = search if search_fn is None else search_fn
     rows, branches = [], []
-    for k in stiffnesses:
+    for i, k in enumerate(stiffnesses):
+        if i == 0 and first is not None:
+            rows.append(_arc_row(k, first[0], first[1]))
+            branches.append(first[1])
+            continue
         c = dataclasses.replace(contact, casing=float(k))
         reduced = build_reduced(study, model, c, factor=factor)
         fams = search_fn(study, reduced.system, progress=progress, unit=unit, label=f"casing {k:.3g} N/m")

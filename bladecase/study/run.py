@@ -40,6 +40,7 @@ from .stages import (
     build_mesh,
     build_model,
     build_reduced,
+    casing_sweep_values,
     check_plausibility,
     contact_group,
     period_unit,
@@ -150,7 +151,7 @@ def run(study: Study | str | os.PathLike, out: str | os.PathLike | None = None, 
     staging = staging_dir(out)
     stages = _Stages(progress, total=6 + (study["forcing"]["amplitude"] is not None)
                      + bool(study.config.get("rotation") and study["rotation"]["speeds"])
-                     + bool((study.config.get("rub") or {}).get("speeds")))
+                     + bool((study.config.get("rub") or {}).get("speeds")) + bool(casing_sweep_values(study)))
     x = study["execution"]
     own = None if executor is not None else make_executor(x["executor"], x["workers"], x["scheduler"])
     try:
@@ -268,6 +269,12 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
             orbits = forcing.pop("orbits")
             files["forced"] = dict(forcing["files"])
             files["forced_animations"] = _animate_forced(study, reduced, forcing, orbits, staging)
+    sweep = None
+    if casing_sweep_values(study):
+        with stage("casing"):
+            sweep = _casing_sweep(study, model, contact, factor, unit, staging, "png" in o["formats"], progress,
+                                  (reduced.system.kc, families))
+            files.update(sweep.pop("files"))
     rub = None
     if (study.config.get("rub") or {}).get("speeds"):
         with stage("rub"):
@@ -294,10 +301,30 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         "families": [family_summary(f, functools.partial(orbit_engineering, reduced)) for f in families],
         "forcing": forcing,
         "rub": rub,
+        "casing_sweep": sweep,
         "comparison": None if comparison is None else {k: comparison[k] for k in ("rows", "diagnostics", "figures")},
         "files": files,
     }
     return summary, families, {m.name: m for m in models}
+
+
+def _casing_sweep(study: Study, model, contact, factor, unit: float, staging: Path, figures: bool,
+                  progress: bool, main: tuple) -> dict:
+    """The nonsmooth modes searched with each casing stiffness of ``[contact] casing_stiffness = [...]`` (the first
+    is the run's own; :mod:`bladecase.study.casing_sweep`): the rows and their spread, ``casing.png``."""
+    from ..io import save_figure
+    from ..post.casing import casing_figure
+    from .casing_sweep import casing_sweep
+
+    values = casing_sweep_values(study)
+    out = casing_sweep(study, model, contact, values, factor=factor, unit=unit, progress=progress, first=main)
+    branches = out.pop("branches")
+    out["files"] = {}
+    if figures:
+        title = f"{study.name}: the nonsmooth mode for each casing stiffness"
+        save_figure(casing_figure(values, branches, title=title), staging / "casing.png")
+        out["files"]["casing_plot"] = "casing.png"
+    return out
 
 
 def _contact_words(study: Study, contact, mesh) -> str:
