@@ -307,7 +307,10 @@ class Study:
         return cls(**args)
 
     def mesh_path(self) -> Path:
-        """The mesh file of ``[mesh]``, resolved against :attr:`base`."""
+        """The mesh file of ``[mesh]``, resolved against :attr:`base` (``ValueError`` for a parametric study, whose
+        mesh gmsh makes from ``[geometry]``)."""
+        if "mesh" not in self.config:
+            raise ValueError(f"study {self.name!r} has no mesh file: its mesh is made by gmsh from [geometry]")
         return (self.base / self.config["mesh"]["path"]).resolve()
 
     def output_dir(self, override: str | os.PathLike | None = None) -> Path:
