@@ -16,6 +16,9 @@ has contact phases of finite duration instead of impacts. One module per step:
 - :mod:`~bladecase.nsm.massless.nodes` — several contacts, one per contact node (:class:`NodalSystem`): the
   complementarity of their forces, the phases (sets of closed contacts) and the exact event-driven simulator
   (:func:`simulate_nodes`), damped and against an out-of-round casing (:class:`Rub`);
+- :mod:`~bladecase.nsm.massless.nodal_modes` — the nonsmooth modes of a :class:`NodalSystem`: periodic orbits by
+  shooting with exact sensitivities, a family followed from the first node's grazing through changes of the set of
+  touching nodes, Floquet multipliers (:func:`nodal_family`, :class:`NodalFamily`, :class:`NodalOrbit`);
 - :mod:`~bladecase.nsm.massless.rub` — the rub response of a turning blade at one speed and over speeds
   (:func:`rub_response`, :func:`rub_sweep`);
 - :mod:`~bladecase.nsm.massless.forced` — forced and damped simulation (:func:`simulate_forced_massless`;
@@ -44,6 +47,15 @@ from .model import (
     series_stiffness,
     simulate_massless,
 )
+from .nodal_modes import (
+    NodalFamily,
+    NodalOrbit,
+    flow_map,
+    grazing_orbit,
+    nodal_family,
+    nodal_orbit,
+    transfer_state,
+)
 from .nodes import NodalFlight, NodalSystem, NodalTrajectory, Rub, lcp, simulate_nodes
 from .orbits import (
     ADMISSIBILITY_RTOL,
@@ -59,7 +71,8 @@ from .phases import PHASES, PhasedOrbit, solve_half, split_at, violation
 from .rub import RubResponse, rub_response, rub_sweep
 
 __all__ = [
-    # nodes, rub
+    # nodes, nodal_modes, rub
+    "NodalFamily", "NodalOrbit", "flow_map", "grazing_orbit", "nodal_family", "nodal_orbit", "transfer_state",
     "NodalFlight", "NodalSystem", "NodalTrajectory", "Rub", "lcp", "simulate_nodes", "RubResponse", "rub_response",
     "rub_sweep",
     # bar
