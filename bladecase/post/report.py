@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .casing import casing_report
+from .nodal_report import nodal_report
 from .rotation_report import rotation_report
 from .rub_report import rub_report
 from .verdict import NARROW_RTOL, massless_summary, narrow_words, orbit_words, verdict  # noqa: F401 (re-exported)
@@ -85,6 +86,7 @@ def report(summary: dict) -> str:
         lines.append(f"| {j + 1} | {f:.3f} | {b2:.3e} | {_counterpart(matches[j])} |")
     if summary.get("comparison"):
         lines += comparison_report(summary["comparison"])
+    lines += nodal_report(summary.get("nodal_modes"))
     lines += casing_report(summary.get("casing_sweep"))
     lines += rub_report(summary.get("rub"))
     if summary.get("forcing"):

@@ -143,6 +143,10 @@ def _contact_model_checks(c: dict) -> None:
         raise StudyError(f"[contact] casing_stiffness: a compliant casing needs model = 'massless' (Newton's impact "
                          f"law is for a rigid casing), got {c['contact']['casing_stiffness']!r} with model = "
                          f"{c['contact']['model']!r}")
+    if c["contact"].get("points") == "nodes" and (not massless or (c["contact"]["face"] is None
+                                                                    and c["contact"].get("nodes") is None)):
+        raise StudyError("[contact] points: 'nodes' (every node of the face a contact of its own) needs a contact "
+                         "face (face or nodes) and model = 'massless'")
     per_area = c["contact"]["casing_stiffness_per_area"]
     if per_area is not None:
         if not massless:

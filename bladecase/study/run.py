@@ -151,7 +151,8 @@ def run(study: Study | str | os.PathLike, out: str | os.PathLike | None = None, 
     staging = staging_dir(out)
     stages = _Stages(progress, total=6 + (study["forcing"]["amplitude"] is not None)
                      + bool(study.config.get("rotation") and study["rotation"]["speeds"])
-                     + bool((study.config.get("rub") or {}).get("speeds")) + bool(casing_sweep_values(study)))
+                     + bool((study.config.get("rub") or {}).get("speeds")) + bool(casing_sweep_values(study))
+                     + (study["contact"].get("points") == "nodes"))
     x = study["execution"]
     own = None if executor is not None else make_executor(x["executor"], x["workers"], x["scheduler"])
     try:
@@ -269,6 +270,14 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
             orbits = forcing.pop("orbits")
             files["forced"] = dict(forcing["files"])
             files["forced_animations"] = _animate_forced(study, reduced, forcing, orbits, staging)
+    nodal = None
+    if study["contact"].get("points") == "nodes":
+        with stage("nodes"):
+            from .nodal import nodal_stage
+
+            nodal = nodal_stage(study, model, contact, families, reduced, factor=factor, folder=staging,
+                                figures="png" in o["formats"], title=study.name)
+            files.update({f"nodal_{k}": v for k, v in nodal.pop("files").items()})
     sweep = None
     if casing_sweep_values(study):
         with stage("casing"):
@@ -302,6 +311,7 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         "forcing": forcing,
         "rub": rub,
         "casing_sweep": sweep,
+        "nodal_modes": nodal,
         "comparison": None if comparison is None else {k: comparison[k] for k in ("rows", "diagnostics", "figures")},
         "files": files,
     }

@@ -182,6 +182,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
                                          "tributary area, the face mean its total; instead of casing_stiffness.",
                                          lambda v: None if math.isfinite(v) and 1 <= v <= 1e18
                                          else "must be a finite number in [1, 1e18] (N/m³)"),
+        "points": Key(_STR, "face", "'face': the face's nodes meet the casing through their (weighted) mean, one "
+                      "constraint; 'nodes': also the nonsmooth mode with every node of the face a contact of its own "
+                      "(massless model; nodal_modes.csv, nodal_modes.png).", _one_of("face", "nodes")),
         "clearance_at": Key(_STR, "cold", "A rotating blade's 'clearance' is the cold one ('cold': the "
                             "centrifugal growth of the blade along the normal closes it at speed) or the running "
                             "one at [rotation] speed ('speed').", _one_of("cold", "speed")),

@@ -1,0 +1,56 @@
+"""The report's words on the nonsmooth mode with every face node a contact (``summary["nodal_modes"]``), beside the
+face-mean mode.
+
+>>> section = {"contact_nodes": 26, "reduced_dofs": 8, "size": 8, "orbits": 18, "stop": "internal resonance",
+...            "frequency_range_hz": [210.5, 215.5], "energy_range_j": [0.0031, 0.026], "stable_fraction": 1.0,
+...            "first_touch_nodes": ["3"], "most_nodes_touching": 18,
+...            "rows": [{"energy_j": 0.026, "max_force_n": 3.4, "max_penetration_mm": 0.118,
+...                      "max_contact_fraction": 0.31, "nodes_touching": 18}],
+...            "face_mean": {"energy_j": [0.0082, 0.07], "node_beyond_clearance_mm": [0.06, 0.18]}}
+>>> nodal_report(section)[5][:58]
+'- From 210.5 Hz, where node 3 touches first, to 215.5 Hz: '
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["nodal_report"]
+
+
+def nodal_report(section: dict | None) -> list[str]:
+    """Markdown lines for ``summary["nodal_modes"]`` (:func:`bladecase.study.nodal.nodal_stage`)."""
+    if not section or not section.get("rows"):
+        return [] if not section else ["", "## Every face node a contact", "",
+                                       f"- No orbit: {section.get('stop', 'the family could not be started')}."]
+    rows = section["rows"]
+    top = max(rows, key=lambda r: r["energy_j"])
+    lo, hi = section["frequency_range_hz"]
+    first = section.get("first_touch_nodes") or []
+    stable = section.get("stable_fraction")
+    lines = ["", "## Every face node a contact", "",
+             f"- The same blade with each of its {section['contact_nodes']} face nodes a contact of its own (the "
+             f"massless model, {section['reduced_dofs']} dofs: {section['size']} modes with the nodes' residual "
+             "flexibility); its nonsmooth mode followed from the first node's grazing. `nodal_modes.csv`: every "
+             "orbit; `nodal_modes.png`: both models' frequency–energy curves and how far the tip goes.",
+             "",
+             f"- From {lo:.5g} Hz, where node{'s' if len(first) > 1 else ''} {', '.join(first[:6])} "
+             f"touch{'' if len(first) > 1 else 'es'} first, to {hi:.5g} Hz: {len(rows)} orbits, up to "
+             f"{section['most_nodes_touching']} nodes touching; at the top ({top['energy_j']:.3g} J) the hardest "
+             f"node carries {top['max_force_n']:.3g} N, a node is in contact for up to "
+             f"{top['max_contact_fraction']:.0%} of the period and the casing yields up to "
+             f"{top['max_penetration_mm'] * 1e3:.0f} µm"
+             + ("" if stable is None else f"; {stable:.0%} of the orbits are linearly stable") + ".",
+             f"- The family ends: {section['stop']}."]
+    fm = section.get("face_mean")
+    if fm and fm.get("energy_j"):
+        e = np.asarray(fm["energy_j"])
+        beyond = np.asarray(fm["node_beyond_clearance_mm"])
+        at = float(np.interp(top["energy_j"], e, beyond)) if e.min() <= top["energy_j"] <= e.max() else None
+        lines.append(f"- The face-mean model (one constraint on the face's mean) starts touching only at "
+                     f"{e.min():.3g} J, when the mean reaches the clearance; by then its farthest node is "
+                     f"{beyond[int(np.argmin(e))] * 1e3:.0f} µm past its own clearance"
+                     + (f", and at {top['energy_j']:.3g} J {at * 1e3:.0f} µm, where every node as a contact lets the "
+                        f"casing yield {top['max_penetration_mm'] * 1e3:.0f} µm" if at is not None else "")
+                     + ": where on the tip it rubs, and how hard, comes from this model, not from the mean.")
+    return lines

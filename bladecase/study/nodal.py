@@ -1,0 +1,133 @@
+"""``[contact] points = "nodes"``: the nonsmooth mode with every node of the contact face a contact of its own,
+beside the face-mean mode of the same study.
+
+The face-mean contact (the study's main model) sees the tip through one averaged constraint: its mean meets the
+clearance while the tip's corners may run far past it. With ``points = "nodes"`` the same blade is reduced with one
+massless contact per face node (:func:`bladecase.reduction.nodes.nodal_model`, the residual correction, ``[reduction]
+size`` modes) and its nonsmooth mode is followed from the first node's grazing
+(:func:`bladecase.nsm.massless.nodal_modes.nodal_family`): each orbit's frequency, energy, the nodes that touch,
+each node's peak force, contact fraction and casing yield, its Floquet verdict. Outputs: ``nodal_modes.csv`` (one
+row per orbit), ``nodal_modes.png`` (frequency–energy of both models, and the largest penetration over the face's
+nodes against energy), ``summary.json["nodal_modes"]``, a section of the report.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .. import log
+from ..io import save_figure, write_text
+from ..nsm.massless.nodal_modes import nodal_family
+from ..reduction.nodes import nodal_model
+
+__all__ = ["nodal_stage"]
+
+COLUMNS = ("frequency_hz", "period_s", "energy_j", "nodes_touching", "touching_nodes", "max_force_n",
+           "max_contact_fraction", "max_penetration_mm", "max_tip_mm", "stable", "residual")
+
+
+def _face_penetration(reduced, contact, model, family) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The face-mean model's admissible orbits expanded to the face's nodes: each orbit's energy, the largest
+    distance a node runs past its own clearance (m; the face mean cannot say it, the nodes do), its frequency."""
+    N = contact.node_normal_map(model)
+    d, _ = contact.node_clearances(model)
+    energies, beyond, freqs = [], [], []
+    ok = np.asarray(family.admissible, dtype=bool)
+    for o, good in zip(family.orbits, ok):
+        if o is None or not good:
+            continue
+        t = np.linspace(0.0, o.T, 96, endpoint=False)
+        x, _ = o.state(t)
+        u = N @ reduced.free_dofs(x)
+        energies.append(o.energy)
+        freqs.append(1.0 / o.T)
+        beyond.append(float(np.max(u - d[:, None])))
+    return np.array(energies), np.array(beyond), np.array(freqs)
+
+
+def nodal_stage(study, model, contact, families, reduced, *, factor=None, folder: str | Path | None = None,
+                figures: bool = True, title: str | None = None) -> dict:
+    """The nonsmooth mode with one contact per face node of ``contact`` on ``model`` (module docstring), beside
+    the study's face-mean ``families`` on ``reduced``; writes ``nodal_modes.csv`` (and ``nodal_modes.png``) into
+    ``folder``; returns the summary section."""
+    size = study["reduction"]["size"] or 8
+    nodal = nodal_model(model, contact, size, factor=factor, residual=True)
+    fam = nodal_family(nodal.system, 0)
+    orbits = fam.orbits
+    rows = []
+    for o in orbits:
+        pen = np.asarray(o.penetration)
+        rows.append({"frequency_hz": float(o.frequency), "period_s": float(o.T), "energy_j": float(o.energy),
+                     "nodes_touching": int(len(o.touching_nodes)),
+                     "touching_nodes": " ".join(str(n) for n in o.touching_nodes),
+                     "max_force_n": float(np.max(o.peak_force)),
+                     "max_contact_fraction": float(np.max(o.contact_fraction)),
+                     "max_penetration_mm": float(np.max(pen)) * 1e3 if np.isfinite(pen).all() else 0.0,
+                     "max_tip_mm": float(o.max_tip) * 1e3, "stable": bool(o.stable()), "residual": float(o.residual)})
+    stable = [r["stable"] for r in rows]
+    section = {
+        "size": size, "contact_nodes": nodal.system.m, "reduced_dofs": nodal.system.n,
+        "orbits": len(rows), "stop": fam.stop,
+        "frequency_range_hz": [rows[0]["frequency_hz"], max(r["frequency_hz"] for r in rows)] if rows else None,
+        "energy_range_j": [rows[0]["energy_j"], max(r["energy_j"] for r in rows)] if rows else None,
+        "stable_fraction": float(np.mean(stable)) if stable else None,
+        "first_touch_nodes": next((r["touching_nodes"].split() for r in rows if r["touching_nodes"]), []),
+        "most_nodes_touching": max((r["nodes_touching"] for r in rows), default=0),
+        "rows": rows,
+    }
+    face = [f for f in families if f.arcs]
+    if face:
+        e, b, fr = _face_penetration(reduced, contact, model, face[0])
+        section["face_mean"] = {"energy_j": e.tolist(), "node_beyond_clearance_mm": (b * 1e3).tolist(),
+                                "frequency_hz": fr.tolist(),
+                                "frequency_range_hz": [float(np.min(face[0].frequencies[face[0].admissible])),
+                                                       float(np.max(face[0].frequencies[face[0].admissible]))]}
+    log.info("every face node a contact (%d nodes, %d dofs): %d orbits from %.5g Hz (nodes %s touch first) to "
+             "%.5g Hz; %s", nodal.system.m, nodal.system.n, len(rows), rows[0]["frequency_hz"] if rows else np.nan,
+             ", ".join(section["first_touch_nodes"]), section["frequency_range_hz"][1] if rows else np.nan, fam.stop)
+    if folder is not None:
+        folder = Path(folder)
+        lines = [",".join(COLUMNS)] + [",".join(f"{r[c]:.9g}" if isinstance(r[c], float) and not isinstance(
+            r[c], bool) else str(r[c]).lower() if isinstance(r[c], bool) else str(r[c]) for c in COLUMNS)
+            for r in rows]
+        write_text(folder / "nodal_modes.csv", "\n".join(lines) + "\n")
+        section["files"] = {"csv": "nodal_modes.csv"}
+        if figures and rows:
+            save_figure(_figure(section, title), folder / "nodal_modes.png")
+            section["files"]["figure"] = "nodal_modes.png"
+    return section
+
+
+def _figure(section: dict, title: str | None):
+    from ..post.plots import new_figure
+
+    fig = new_figure(figsize=(10.0, 4.2), layout="constrained")
+    a, b = fig.subplots(1, 2)
+    rows = section["rows"]
+    f = [r["frequency_hz"] for r in rows]
+    e = [r["energy_j"] for r in rows]
+    pen = [r["max_penetration_mm"] for r in rows]
+    a.semilogy(f, e, "-o", ms=3, color="C3", label=f"every face node a contact ({section['contact_nodes']})")
+    b.plot(e, pen, "-o", ms=3, color="C3", label="every node a contact: the casing's largest yield")
+    fm = section.get("face_mean")
+    if fm:
+        b.plot(fm["energy_j"], fm["node_beyond_clearance_mm"], "-", color="C0",
+               label="face mean: the farthest node past its clearance")
+        order = np.argsort(fm["frequency_hz"])
+        a.semilogy(np.asarray(fm["frequency_hz"])[order], np.asarray(fm["energy_j"])[order], "-", color="C0",
+                   label="face mean (one constraint): admissible orbits")
+    a.set_xlabel("frequency 1/T (Hz)")
+    a.set_ylabel("energy (J)")
+    b.set_xscale("log")
+    from matplotlib.ticker import NullFormatter
+
+    b.xaxis.set_minor_formatter(NullFormatter())
+    b.set_xlabel("energy (J)")
+    b.set_ylabel("mm")
+    for ax in (a, b):
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(title or "the nonsmooth mode with every face node a contact")
+    return fig
