@@ -32,8 +32,9 @@ def interaction_plot(section: dict, title: str | None = None) -> Figure:
     scale = SPEED_UNITS[unit.lower()]
     speed = np.array([r["speed"] for r in rows])
     settled = np.array([r["settled"] for r in rows], dtype=bool)
-    fig = new_figure(figsize=(7.0, 5.6), layout="constrained")
-    axes = fig.subplots(2, 1, sharex=True)
+    campbell = bool(section.get("open_hz"))
+    fig = new_figure(figsize=(7.0, 7.8 if campbell else 5.6), layout="constrained")
+    axes = fig.subplots(3 if campbell else 2, 1, sharex=True)
     series = [("tip_displacement_mm", "peak tip displacement (mm)"), ("contact_force_n", "peak contact force (N)")]
     lobes = section["lobes"]
     for ax, (key, label) in zip(axes, series):
@@ -53,6 +54,22 @@ def interaction_plot(section: dict, title: str | None = None) -> Figure:
             if key == series[0][0]:
                 ax.annotate(f"mode {res['mode']}", (res["speed"], 1.0), xycoords=("data", "axes fraction"),
                             rotation=90, va="top", ha="right", fontsize=8, color="0.3")
+    if campbell:  # the Campbell diagram on the same speed axis: the modes at each speed, the lobes' order line
+        ax = axes[2]
+        f = np.asarray(section["open_hz"], dtype=float)
+        excite = lobes * speed * scale / (2 * math.pi)
+        lo = 0.9 * min(float(excite.min()), float(f[:, 0].min()))
+        top = 1.1 * max(float(excite.max()), float(f[:, 0].max()))
+        for k in range(f.shape[1]):
+            if f[:, k].min() <= top:
+                ax.plot(speed, f[:, k], "-", color=f"C{k + 2}", lw=1.2, label=f"mode {k + 1} (linear, at speed)")
+        ax.plot(speed, excite, "--", color="0.3", lw=1.0, label=f"EO {lobes} (the lobes)")
+        for k, (lo, hi) in enumerate(section.get("nonsmooth_bands_hz") or []):
+            ax.axhspan(lo, hi, color="C1", alpha=0.2, lw=0, label="nonsmooth-mode band" if k == 0 else None)
+        ax.set_ylim(lo, top)
+        ax.set_ylabel("frequency (Hz)")
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="upper left", fontsize=8)
     axes[0].legend(loc="upper left", fontsize=8)
     axes[-1].set_xlabel(f"speed ({unit}); casing with {lobes} lobes: excitation at {lobes} × the speed")
     if title:

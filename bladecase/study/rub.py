@@ -250,6 +250,7 @@ def _summary(study, speeds: np.ndarray, points: list[dict], families, contact: C
                   "touching_along_tip": where},
         "unsettled_speeds": [row["speed"] for row in rows if not row["settled"]],
         "resonances": resonances,
+        "open_hz": open_hz[:, :3].tolist(),
         "nonsmooth_bands_hz": _bands(families),
         "bands_at": _bands_at(study),
         "model": {"size": r["size"], "contact_nodes": len(contact.nodes),
