@@ -309,6 +309,7 @@ class _Phase:
                 raise ValueError("a damped contact phase is nearly defective (critically damped mode): change the "
                                  "damping slightly")
             self.lam, self.Vx, self.Vv = np.minimum(lam.real, 0.0) + 1j * lam.imag, V[:n], V[n:]
+            self._Vinv = sla.lu_solve(self._lu, np.eye(2 * n, dtype=complex))  # amplitudes by one small product
             self._psi = None
         self.LVx = L @ self.Vx
         self.nu = nu
@@ -328,7 +329,7 @@ class _Phase:
         r, s = q - qp, p - pp
         if self._psi is not None:
             return self._psi.T @ r - 1j * (self._psi.T @ s) / self._w
-        return sla.lu_solve(self._lu, np.r_[r, s].astype(complex))
+        return self._Vinv @ np.concatenate([r, s])
 
     def advance(self, a: np.ndarray, t0: float, tau) -> tuple[np.ndarray, np.ndarray]:
         """States at ``t₀ + τ`` (``tau`` scalar or ``(k,)``: columns)."""
@@ -359,6 +360,17 @@ class _Signals:
     nu: float
     const: np.ndarray
     lam2: np.ndarray
+
+    def at(self, tau: float, js: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(f, f')`` of the signals ``js`` at one point ``tau``."""
+        e = np.exp(tau * self.lam)
+        C = self.C[js]
+        f = (C @ e).real + self.const[js]
+        df = (C @ (self.lam * e)).real
+        if self.nu > 0:
+            z = np.exp(1j * self.nu * tau) * self.E[js]
+            f, df = f + z.real, df - self.nu * z.imag
+        return f, df
 
     def values(self, tau) -> tuple[np.ndarray, np.ndarray]:
         """``(f, f')`` at the points ``tau``: ``(len(tau), m)``."""
@@ -554,8 +566,8 @@ def _many(sig: _Signals, B2, hmin, a: float, b: float, js, Fa, Fb, Da, Db) -> tu
                 best = (float(root), int(j))
         return best
     m = 0.5 * (a + b)
-    Fm, Dm = sig.values(m)
-    Fm, Dm = -Fm[0, js], -Dm[0, js]
+    Fm, Dm = sig.at(m, js)
+    Fm, Dm = -Fm, -Dm
     hit = _many(sig, B2, hmin, a, m, js, Fa, Fm, Da, Dm)
     return hit if hit is not None else _many(sig, B2, hmin, m, b, js, Fm, Fb, Dm, Db)
 
