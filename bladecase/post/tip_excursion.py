@@ -65,4 +65,5 @@ def words(x: dict) -> str:
     return (f"{mean_words}, but {x['nodes_beyond']} of its {x['nodes']} nodes pass the clearance, node "
             f"{x['node_id']} (at {', '.join(f'{c:.4g}' for c in x['position_mm'])} mm) by "
             f"{x['node_max_m'] * um:.0f} µm at t/T = {x['t_over_T']:.3f}: the casing sees the face's mean only, so "
-            "where and how hard the tip rubs is not resolved by this contact model")
+            "where and how hard the tip rubs is not resolved by this contact model ([contact] points = \"nodes\" "
+            "makes every node a contact)")

@@ -465,7 +465,10 @@ def search(study: Study, system: LinearSystem, progress: bool = False, unit: flo
         found = nonsmooth_mode(system, k, T_range, scan=s["scan"], step=s["step"], max_points=s["max_points"],
                                progress=progress, resolution=s["resolution"])
         n_arcs = sum(len(f.arcs) for f in found)
-        log.info("%s%d-ipp: %d families, %d with admissible arcs (%d arcs) (%.1f s)", f"{label}: " if label else "",
-                 k, len(found), sum(1 for f in found if f.arcs), n_arcs, time.perf_counter() - t0)
+        massless = getattr(system, "contact_model", "") == "massless"
+        what = f"{k} contact phase{'s' if k > 1 else ''} per period" if massless else f"{k}-ipp"
+        log.info("%s%s: %d famil%s, %d with admissible arcs (%d arc%s) (%.1f s)", f"{label}: " if label else "",
+                 what, len(found), "y" if len(found) == 1 else "ies", sum(1 for f in found if f.arcs), n_arcs,
+                 "" if n_arcs == 1 else "s", time.perf_counter() - t0)
         families.extend(found)
     return families
