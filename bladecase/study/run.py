@@ -205,14 +205,18 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         check_plausibility(study, rest_model, float(f_fe[0]) if rotation is None else None)
     with stage("reduce"):
         build_s = []
+        count = 1 + len(study["reduction"]["compare"]) + bool(o["reference"])
+        models_bar = progress_counter(count, "reduced models", enabled=progress and count > 1, unit="model")
         t0 = time.perf_counter()
         reduced = build_reduced(study, model, contact, factor=factor)
         build_s.append(time.perf_counter() - t0)
+        models_bar.update()
         compares = []
         for c in study["reduction"]["compare"]:
             t0 = time.perf_counter()
             compares.append(build_reduced(study, model, contact, c["method"], c.get("size"), factor=factor))
             build_s.append(time.perf_counter() - t0)
+            models_bar.update()
         log.info("contact: %s at %s mm, normal %s, clearance %g mm", _contact_words(study, contact, mesh),
                  np.round(mesh.points[contact.node] * 1e3, 4).tolist(), np.round(contact.normal_for(model), 6).tolist(),
                  contact.gap * 1e3)
@@ -221,6 +225,7 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         t0 = time.perf_counter()
         reference = reference_model(model, contact, reduced, factor) if o["reference"] else None
         build_s.append(time.perf_counter() - t0)
+        models_bar.close()
         if reference is not None:
             log.info("reference model for the orbits' check: %s", reference)
         # a comparison study compares the reference of the verification too, through the same search
