@@ -39,7 +39,7 @@ from bladecase.post.compare import (
     match_modes,
     model_matches,
 )
-from bladecase.post.compare_plots import convergence_plot, observed_order, overlay_plot, spectral_plot
+from bladecase.post.compare_plots import MARKERS, convergence_plot, observed_order, overlay_plot, spectral_plot
 from bladecase.post.compare_table import (
     comparison_rows,
     convergence_verdict,
@@ -228,18 +228,23 @@ def test_rows_have_the_columns_and_round_trip_through_csv(models, fe, tmp_path):
     assert [r["model"] for r in rows] == ["FE", "modal-4", "modal-8", "lanczos-si-6"]
     by = {r["model"]: r for r in rows}
     energy = [energy_column(f) for f in (0.9, 0.95, 0.99)]
-    assert energy == ["energy_0.9T1", "energy_0.95T1", "energy_0.99T1"]
-    assert list(rows[0]) == [
+    assert energy == ["energy_0.9T1_j", "energy_0.95T1_j", "energy_0.99T1_j"]  # J: every dimensional column has
+    assert list(rows[0]) == [                                                      # its unit in its name
         "model", "method", "size", "contact_model", "dofs", "build_s", "search_s", "frequencies_hz", "modes_checked",
-        "modes_matched", "max_frequency_error", "artefacts", "artefact_modes", "unchecked_modes", "impact_mass",
-        "impact_mass_kept", "static_compliance", "static_compliance_kept", "contact_stiffness", "families",
-        "families_with_arcs", "admissible_arcs", "T1_s", *energy, "convergence", "convergence_delta"]
+        "modes_matched", "max_frequency_error", "artefacts", "artefact_modes", "unchecked_modes", "impact_mass_kg",
+        "impact_mass_kept", "static_compliance_m_per_n", "static_compliance_kept", "contact_stiffness_n_per_m",
+        "families", "families_with_arcs", "admissible_arcs", "T1_s", *energy, "is_reference", "ref_energy_deviation",
+        "ref_frequency_deviation", "convergence", "convergence_delta", "observed_order"]
+    assert by["FE"]["contact_model"] is None  # no search ran on the FE model: it has no contact model
     assert all(list(r) == list(rows[0]) for r in rows)
     assert by["FE"]["dofs"] == 1084 and by["FE"]["impact_mass_kept"] == 1.0
     assert by["modal-8"]["dofs"] == 8 and by["modal-8"]["modes_matched"] == 8 and by["modal-8"]["artefacts"] == 0
     li = by["lanczos-si-6"]
     assert li["artefacts"] == 1 and li["artefact_modes"].startswith("5 (39156") and li["unchecked_modes"] == 1
-    assert li["impact_mass_kept"] == pytest.approx(li["impact_mass"] / fe.impact_mass, rel=1e-14)
+    assert li["impact_mass_kept"] == pytest.approx(li["impact_mass_kg"] / fe.impact_mass, rel=1e-14)
+    # the reference is the largest model (modal-8: 8 dofs); lanczos-si-6's modes 1–4 are FE modes 1–4, 2.6e-3 off
+    assert [r["is_reference"] for r in rows] == [0, 0, 1, 0] and by["modal-8"]["ref_frequency_deviation"] == 0
+    assert 1e-3 < li["ref_frequency_deviation"] < 3e-3 and by["modal-4"]["ref_frequency_deviation"] < 1e-10
     assert li["static_compliance_kept"] == pytest.approx(1.0, abs=1e-10)
     for name, entry in models.items():
         assert by[name]["admissible_arcs"] == sum(len(b.arcs) for b in entry.branches)
@@ -283,7 +288,7 @@ def test_diagnose_says_why_models_disagree(models, fe):
     rows = comparison_rows(list(models.values()), fe)
     lines = diagnose(rows, fe)
     by = {r["model"]: r for r in rows}
-    ratio = by["modal-4"]["impact_mass"] / by["lanczos-si-6"]["impact_mass"]
+    ratio = by["modal-4"]["impact_mass_kg"] / by["lanczos-si-6"]["impact_mass_kg"]
     assert ratio > 50
     assert f"impact mass differs {ratio:.0f}× between modal-4" in lines[0] and "lanczos-si-6" in lines[0]
     assert any(s.startswith("lanczos-si-6: 1 mode with no FE counterpart") for s in lines)
@@ -296,14 +301,14 @@ def test_diagnose_says_why_models_disagree(models, fe):
 
 
 def test_diagnose_on_rows_built_to_disagree_and_to_agree():
-    base = {"method": "modal", "impact_mass": 1e-3, "static_compliance": 4e-8, "admissible_arcs": 3,
-            "energy_0.95T1": 1e-6}
+    base = {"method": "modal", "impact_mass_kg": 1e-3, "static_compliance_m_per_n": 4e-8, "admissible_arcs": 3,
+            "energy_0.95T1_j": 1e-6}
     agree = [base | {"model": "modal-8", "size": 8}, base | {"model": "modal-16", "size": 16}]
     assert diagnose(agree) == []
-    disagree = [agree[0], base | {"model": "cb-8", "method": "craig-bampton", "size": 8, "impact_mass": 1e-5,
-                                  "energy_0.95T1": 1.2e-5},
+    disagree = [agree[0], base | {"model": "cb-8", "method": "craig-bampton", "size": 8, "impact_mass_kg": 1e-5,
+                                  "energy_0.95T1_j": 1.2e-5},
                 base | {"model": "lanczos-si-6", "method": "lanczos-si", "size": 6, "admissible_arcs": 0,
-                        "families": 285, "energy_0.95T1": None}]
+                        "families": 285, "energy_0.95T1_j": None}]
     lines = diagnose(disagree)
     assert "impact mass differs 100× between modal-8 (0.001) and cb-8 (1e-05)" in lines
     assert "lanczos-si-6 found no admissible arc (285 families)" in lines
@@ -317,37 +322,53 @@ def test_diagnose_on_rows_built_to_disagree_and_to_agree():
 
 
 def test_overlay_puts_every_model_on_one_pair_of_axes(models, fe):
+    """One colour per method, one line style per size, the reference (the largest model) thicker; a legend of a
+    fixed number of entries (methods, sizes, kinds of marks), never one per model."""
     entries = list(models.values())
-    fig = overlay_plot(entries, fe)
+    T1 = 1 / fe.frequencies[0]
+    fig = overlay_plot(entries, fe, periods=[0.95 * T1])
     (ax,) = fig.axes
-    labels = ax.get_legend_handles_labels()[1]
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
     assert ax.get_xlabel() == "frequency 1/T (Hz)" and ax.get_ylabel() == "energy E (J)"
-    assert labels[-1] == "linear frequencies (FE)" and len(ax.get_legend().get_texts()) == len(labels)
-    for e in entries:
-        n_arcs = sum(len(b.arcs) for b in e.branches)
-        mine = [lab for lab in labels if lab.startswith(f"{e.name}: ")]
-        assert bool(mine) == (n_arcs > 0)
+    assert labels[:5] == ["modal", "lanczos-si", "size 4", "size 6", "size 8"]
+    assert labels[5] == "thick: the reference (modal-8)"
+    assert labels[-2:] == ["linear frequencies (FE)", "comparison periods (1/T)"]
+    assert tuple(fig.get_size_inches()) == (10.0, 5.5)
+    arcs = [ln for ln in ax.lines if ln.get_color() not in ("k", "0.5")]  # not the vertical lines
+    assert {ln.get_color() for ln in arcs} == {"C0", "C1"}  # modal, lanczos-si
+    widths = {ln.get_linewidth() for ln in arcs if ln.get_marker() in ("None", None, "")}
+    assert len(widths) == 2 and max(widths) > min(widths) + 1  # the reference thicker
+    styles = {str(ln.get_linestyle()) for ln in arcs
+              if ln.get_marker() in ("None", None, "") and ln.get_color() == "C0"}
+    assert len(styles) == 2  # modal-4, modal-8
     # every arc a marker when a "pixel" is huge; curves (arcs of >= 2 points) when it is 0
     big = overlay_plot(entries, fe, min_px=1e9).axes[0]
-    dots = [ln for ln in big.lines if ln.get_label().endswith(")") and "narrower" in ln.get_label()]
+    dots = [ln for ln in big.lines if ln.get_marker() not in ("None", None, "")]
     assert sum(len(ln.get_xdata()) for ln in dots) == sum(len(b.arcs) for e in entries for b in e.branches)
     small = overlay_plot(entries, fe, min_px=0.0, nonadmissible=True).axes[0]
-    assert "modal-4: non-admissible orbits" in small.get_legend_handles_labels()[1]
-    dots = [ln for ln in small.lines if "narrower" in ln.get_label()]  # arcs of one computed point only
+    assert "non-admissible orbits" in [t.get_text() for t in small.get_legend().get_texts()]
+    dots = [ln for ln in small.lines if ln.get_marker() in MARKERS]  # arcs of one computed point only
     assert sum(len(ln.get_xdata()) for ln in dots) == sum(a.stop == a.start for e in entries for b in e.branches
                                                           for a in b.arcs)
     assert [t.get_text().strip() for t in ax.texts] == ["1"]  # FE mode 1 is the only one in range
 
 
 def test_convergence_plot_reports_the_observed_order():
-    rows = [{"method": "modal", "size": s, "energy_0.95T1": 2.0 + 5.0 * s**-2.0, "energy_0.99T1": None}
-            for s in (8, 16, 32, 64)]
-    rows.append({"method": "lanczos-si", "size": 6, "energy_0.95T1": 2.1, "energy_0.99T1": None})
-    fig = convergence_plot(rows)
+    """Top: the distance from the reference; bottom: the change from the previous size, with the observed order
+    only where three sizes converge monotonically."""
+    rows = [{"method": "modal", "size": s, "dofs": s, "energy_0.95T1_j": 2.0 + 5.0 * s**-2.0,
+             "energy_0.99T1_j": None} for s in (8, 16, 32, 64)]
+    rows += [{"method": "lanczos-si", "size": s, "dofs": s, "energy_0.95T1_j": e, "energy_0.99T1_j": None}
+             for s, e in ((6, 2.1), (12, 2.3), (24, 2.2))]
+    fig = convergence_plot(rows, tolerance=0.01)
     top, bottom = fig.axes
-    assert top.get_legend_handles_labels()[1] == ["modal, 0.95 T1 (order 2.0)", "lanczos-si, 0.95 T1"]
+    assert top.get_legend_handles_labels()[1] == ["modal, 0.95 T1", "lanczos-si, 0.95 T1", "tolerance 1 %"]
+    assert bottom.get_legend_handles_labels()[1] == ["modal, 0.95 T1: order 2", "lanczos-si, 0.95 T1: not monotone"]
     assert top.get_xscale() == top.get_yscale() == bottom.get_yscale() == "log"
     assert top.get_shared_x_axes().joined(top, bottom)
+    (modal, _, _) = top.lines  # every modal size but the reference (modal-64), distance from it
+    assert modal.get_xdata().tolist() == [8, 16, 32]
+    assert np.allclose(modal.get_ydata(), [abs((2 + 5 * s**-2.0) / (2 + 5 * 64**-2.0) - 1) for s in (8, 16, 32)])
     assert observed_order([8, 16, 32], [1.0, 1.0, 1.0]) is None and observed_order([8, 16], [1, 2]) is None
 
 

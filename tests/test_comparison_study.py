@@ -28,7 +28,7 @@ def test_grid_expands_to_every_model(result):
     for m in result.models.values():
         assert m.build_s >= 0 and m.search_s >= 0 and m.reduced.n >= 6 and m.reduced.model is result.fe_model
     table = result.comparison  # a dict of columns for a notebook (no pandas needed)
-    assert table["model"] == ["FE", *names] and len(table["impact_mass"]) == len(names) + 1
+    assert table["model"] == ["FE", *names] and len(table["impact_mass_kg"]) == len(names) + 1
     doc = json.loads((result.directory / "modes.json").read_text())
     assert [c["model"] for c in doc["compare"]] == names[1:]  # every model's families are kept
 
@@ -106,12 +106,20 @@ def test_the_grid_on_a_dask_local_cluster_gives_the_serial_results(result, tmp_p
 
 
 def test_comparison_periods_are_a_study_key(result, tmp_path):
-    """[reduction] compare_periods: the energy columns at the asked periods (× FE T1), distinct near 1."""
+    """[reduction] compare_periods: the energy columns at the asked periods (× FE T1), distinct near 1 — as long as
+    one of them is inside an admissible arc; periods that miss every arc are replaced by periods inside the arcs
+    (run.log says so)."""
     small = GRID.replace('methods = ["modal", "craig-bampton", "lanczos-si"]', 'methods = ["modal"]'
                          ).replace('formats = ["png"]', "formats = []")  # the columns only: no figures
-    text = small.replace("sizes = [6, 12]\n", "sizes = [6]\ncompare_periods = [0.6, 0.99999889, 0.9999993]\n")
+    text = small.replace("sizes = [6, 12]\n", "sizes = [6]\ncompare_periods = [0.998, 0.99999889, 0.9999993]\n")
     other = run(loads(text, base=ROOT), out=tmp_path / "p", progress=False)
     cols = [c for c in other.comparison if c.startswith("energy_")]
-    assert cols == ["energy_0.6T1", "energy_0.99999889T1", "energy_0.9999993T1"]
+    assert cols == ["energy_0.998T1_j", "energy_0.99999889T1_j", "energy_0.9999993T1_j"]
+    assert all(e is not None for e in other.comparison["energy_0.998T1_j"][1:])  # 0.998 T1: in both models' arcs
+    missed = run(loads(text.replace("0.998, ", "0.6, "), base=ROOT), out=tmp_path / "m", progress=False)
+    cols = [c for c in missed.comparison if c.startswith("energy_")]
+    assert "energy_0.6T1_j" not in cols and all(e is not None for c in cols for e in missed.comparison[c][1:])
+    assert "comparison: compare_periods outside every arc: the compare_periods asked for (0.6, 0.99999889, " \
+           "0.9999993 T1) miss every admissible arc" in (missed.directory / "run.log").read_text()
     with pytest.raises(StudyError, match=r"\[reduction\] compare_periods: periods repeat"):
         loads(GRID.replace("sizes = [6, 12]\n", "sizes = [6, 12]\ncompare_periods = [0.9, 0.9]\n"), base=ROOT)

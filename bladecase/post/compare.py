@@ -9,7 +9,9 @@ Plain functions over numpy data and the package's types; the table, CSV and diag
 - :func:`mac_matrix`, :func:`match_modes`, :func:`model_matches` — reduced modes against FE modes by mode shape
   (mass-weighted MAC), never by index: a mode without an FE counterpart is an artefact of the reduction;
 - :func:`contact_spectrum`, :func:`kept_fraction` — the contact spectral data that decides impacts;
-- :func:`arc_energies` — energies of the admissible orbits at given periods, on the admissible arcs only.
+- :func:`arc_energies` — energies of the admissible orbits at given periods, on the admissible arcs only;
+- :func:`choose_periods` — where to read them: inside the models' common admissible range (:class:`PeriodChoice`);
+  :func:`largest_model` — the reference of the comparison.
 """
 
 from __future__ import annotations
@@ -28,8 +30,9 @@ from ..nsm import Branch, LinearSystem, MasslessSystem, Spectrum
 from ..reduction import Contact, ReducedModel
 
 __all__ = [
-    "CLUSTER_RTOL", "MAC_THRESHOLD", "ContactSpectrum", "FEReference", "ModeMatch", "ModelResult", "arc_energies",
-    "contact_spectrum", "fe_reference", "kept_fraction", "mac_matrix", "match_modes", "model_matches",
+    "AUTO_PERIODS", "CLUSTER_RTOL", "MAC_THRESHOLD", "ContactSpectrum", "FEReference", "ModeMatch", "ModelResult",
+    "PeriodChoice", "admissible_spans", "arc_energies", "choose_periods", "contact_spectrum", "fe_reference",
+    "kept_fraction", "largest_model", "mac_matrix", "match_modes", "model_matches",
 ]
 
 #: Default MAC a reduced mode needs with an FE mode to be its counterpart (above 0.5 the pairing is one-to-one).
@@ -356,8 +359,9 @@ def arc_energies(branches: Sequence[Branch], periods) -> list[np.ndarray]:
     """Energies of the admissible orbits at each of ``periods``, sorted, one array per period.
 
     Interpolated (linearly in ``T``, geometrically in ``E``) between consecutive computed points of an admissible
-    arc only — never across a non-admissible stretch, never extrapolated beyond the arc's computed points. A
-    curve that crosses a period several times (turning points, several families) gives several energies.
+    arc only — never across a non-admissible stretch, never extrapolated beyond the arc's computed points (a
+    period within 1e-12 of a computed point is that point). A curve that crosses a period several times (turning
+    points, several families) gives several energies. Only the arcs' own points are read.
 
     >>> from bladecase.nsm import backbone, chain
     >>> bb = backbone(chain(2, k=1.0, m=0.5, gap=1.0), np.linspace(4.0, 12.0, 9))
@@ -367,17 +371,206 @@ def arc_energies(branches: Sequence[Branch], periods) -> list[np.ndarray]:
     P = np.atleast_1d(np.asarray(periods, dtype=float))
     found: list[list[float]] = [[] for _ in P]
     for br in branches:
-        T, E = br.T, br.energy
-        for arc in br.arcs:
-            t, e = T[arc.start:arc.stop + 1], E[arc.start:arc.stop + 1]
+        for t, e in _arc_points(br):
             ok = np.isfinite(t) & np.isfinite(e) & (e > 0)
             seg = ok[:-1] & ok[1:] & (t[1:] != t[:-1])
+            near = np.abs(P[:, None] - t[None, :]) <= 1e-12 * np.abs(t[None, :])
+            Pa = np.where(near.any(axis=1), t[np.argmax(near, axis=1)], P)  # round-off next to a point: the point
             with np.errstate(divide="ignore", invalid="ignore"):
-                a = (P[:, None] - t[None, :-1]) / (t[1:] - t[:-1])[None, :]
+                a = (Pa[:, None] - t[None, :-1]) / (t[1:] - t[:-1])[None, :]
                 logE = (1 - a) * np.log(e[:-1]) + a * np.log(e[1:])
             hit = seg[None, :] & (a >= 0) & (a < 1)
             ends = ok & ~np.r_[seg, False]  # a point no segment starts from: its period counts on its own
-            at_end = ends[None, :] & (P[:, None] == t[None, :])
+            at_end = ends[None, :] & (Pa[:, None] == t[None, :])
             for i in range(P.size):
                 found[i] += np.exp(logE[i, hit[i]]).tolist() + e[at_end[i]].tolist()
     return [np.sort(np.array(v, dtype=float)) for v in found]
+
+
+def _arc_points(br: Branch) -> list[tuple[np.ndarray, np.ndarray]]:
+    """``(T, E)`` of the computed points of each admissible arc of ``br`` (no orbit outside an arc is read)."""
+    T = br.T
+    return [(np.asarray(T[a.start:a.stop + 1], dtype=float),
+             np.array([np.nan if o is None else o.energy for o in br.orbits[a.start:a.stop + 1]], dtype=float))
+            for a in br.arcs]
+
+
+# ----------------------------------------------------------------------------- the comparison periods
+
+
+def admissible_spans(branches: Sequence[Branch]) -> list[tuple[float, float]]:
+    """The period ranges ``(lo, hi)`` where :func:`arc_energies` has an energy: the stretches between consecutive
+    computed points of the admissible arcs (a lone point is ``(T, T)``), merged where they meet, ascending.
+
+    >>> from bladecase.nsm import backbone, chain
+    >>> admissible_spans([backbone(chain(2, k=1.0, m=0.5, gap=1.0), np.linspace(4.0, 12.0, 9))])
+    [(4.0, 5.0), (6.0, 7.0)]
+    """
+    spans = []
+    for br in branches:
+        for t, e in _arc_points(br):
+            ok = np.isfinite(t) & np.isfinite(e) & (e > 0)
+            seg = ok[:-1] & ok[1:]
+            spans += [(min(t[i], t[i + 1]), max(t[i], t[i + 1])) for i in np.flatnonzero(seg)]
+            alone = ok & ~np.r_[False, seg] & ~np.r_[seg, False]
+            spans += [(t[i], t[i]) for i in np.flatnonzero(alone)]
+    merged: list[list[float]] = []
+    for lo, hi in sorted(spans):
+        if merged and lo <= merged[-1][1]:
+            merged[-1][1] = max(merged[-1][1], hi)
+        else:
+            merged.append([lo, hi])
+    return [(float(lo), float(hi)) for lo, hi in merged]
+
+
+def largest_model(entries: Sequence[ModelResult]) -> ModelResult | None:
+    """The reference of a comparison: the model of most reduced dofs (the later one of a tie), ``None`` if empty."""
+    entries = list(entries)
+    return max(reversed(entries), key=lambda e: e.reduced.n) if entries else None
+
+
+@dataclass(frozen=True)
+class PeriodChoice:
+    """The periods (× ``T1``) at which a comparison reads every model's energy, and why these.
+
+    ``source``: ``"given"`` (asked for, and inside some model's arc), ``"intersection"`` (spread inside the
+    intersection of every model's admissible arcs), ``"overlap"`` (inside the stretch where the most models' arcs
+    overlap — the reference's first), ``"own arcs"`` (the arcs do not overlap: one period inside each model's own
+    widest arc; or the only model with arcs), ``"none"`` (no model has an admissible arc: the given periods,
+    or none); ``models``: the models whose arcs hold the periods; ``words``: the sentence for the log and report.
+    """
+
+    fractions: tuple[float, ...]
+    source: str
+    words: str
+    models: tuple[str, ...] = ()
+    T1: float | None = None
+
+    def to_dict(self) -> dict:
+        T1 = self.T1
+        return {"fractions": list(self.fractions), "periods_s": None if T1 is None else
+                [f * T1 for f in self.fractions], "T1_s": T1, "source": self.source, "models": list(self.models),
+                "words": self.words}
+
+
+#: How many periods a comparison spreads over the common admissible range.
+AUTO_PERIODS = 5
+
+
+def _spread(lo: float, hi: float, T1: float, count: int) -> list[float]:
+    """``count`` fractions of ``T1`` evenly inside ``[lo, hi]`` (s), distinct in the energy columns' 10 digits;
+    the middle alone when the range is narrower than that (a lone computed point: that point)."""
+    P = lo + (hi - lo) * (np.arange(count) + 0.5) / count if hi - lo > 1e-8 * hi else [0.5 * (lo + hi)]
+    out: dict[str, float] = {}
+    for p in P:
+        out.setdefault(f"{p / T1:.10g}", float(p / T1))
+    return list(out.values())
+
+
+def _regions(spans: dict[str, list[tuple[float, float]]]) -> list[tuple[float, float, frozenset]]:
+    """Maximal stretches (lo, hi) covered by one set of models, degenerate points included."""
+    edges = sorted({x for s in spans.values() for iv in s for x in iv})
+    pieces = [(x, x) for x in edges] + list(zip(edges[:-1], edges[1:]))
+    out = []
+    for lo, hi in pieces:
+        cover = frozenset(n for n, s in spans.items() if any(a <= lo and hi <= b for a, b in s))
+        if cover:
+            out.append((lo, hi, cover))
+    out.sort()
+    merged: list[list] = []
+    for lo, hi, cover in out:  # join neighbouring pieces with the same models
+        if merged and merged[-1][2] == cover and lo <= merged[-1][1]:
+            merged[-1][1] = max(merged[-1][1], hi)
+        else:
+            merged.append([lo, hi, cover])
+    return [(lo, hi, c) for lo, hi, c in merged]
+
+
+def _range_words(lo: float, hi: float, T1: float) -> str:
+    return f"{lo / T1:.6g} T1" if hi - lo <= 1e-9 * hi else f"{lo / T1:.6g}–{hi / T1:.6g} T1"
+
+
+def _names(names) -> str:
+    names = list(names)
+    return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
+
+
+def choose_periods(entries: Sequence[ModelResult], T1: float, *, given: Sequence[float] | None = None,
+                   reference: str | None = None, count: int = AUTO_PERIODS) -> PeriodChoice:
+    """The periods (fractions of ``T1``) where a comparison reads the models' energies (:class:`PeriodChoice`).
+
+    ``given`` periods are kept when at least one lies inside some model's admissible range. Otherwise (none
+    given, or all outside every arc) ``count`` periods are spread inside the stretch where the admissible arcs
+    (:func:`admissible_spans`) of the most models overlap — the ``reference`` model's arcs first (default: the
+    largest model, :func:`largest_model`), then the most models, then the widest stretch; when no two models'
+    arcs overlap, one period at the middle of each model's widest arc (the reference first, at most 8).
+
+    >>> from types import SimpleNamespace as NS
+    >>> from bladecase.nsm import backbone, chain
+    >>> def model(name, k, T):   # what a comparison reads of a model: its name and its branches
+    ...     return NS(name=name, branches=[backbone(chain(2, k=k, m=0.5, gap=1.0), T)])
+    >>> a, b = model("a", 1.0, np.linspace(4.0, 12.0, 9)), model("b", 1.2, np.linspace(4.0, 12.0, 17))
+    >>> admissible_spans(a.branches), admissible_spans(b.branches)
+    ([(4.0, 5.0), (6.0, 7.0)], [(4.0, 5.0), (5.5, 6.5), (12.0, 12.0)])
+    >>> c = choose_periods([a, b], 1.0, reference="b")
+    >>> c.source, c.fractions    # the widest common stretch: [4, 5]
+    ('intersection', (4.1, 4.3, 4.5, 4.7, 4.9))
+    >>> choose_periods([a, b], 1.0, given=[6.25]).source    # inside a's and b's arcs: as asked
+    'given'
+    >>> print(*choose_periods([a, b], 1.0, given=[8.0], reference="b").words.split(": "), sep=":\\n")
+    the compare_periods asked for (8 T1) miss every admissible arc:
+    5 periods spread inside the intersection of the admissible arcs of a and b (4–5 T1)
+    """
+    T1 = positive("T1", T1)
+    entries = list(entries)
+    spans = {e.name: admissible_spans(e.branches) for e in entries}
+    spans = {n: s for n, s in spans.items() if s}
+    if given is not None:
+        given = tuple(float(f) for f in given)
+        inside = [f for f in given if any(lo <= f * T1 <= hi for s in spans.values() for lo, hi in s)]
+        if inside:
+            return PeriodChoice(given, "given", f"energies read at the periods asked for ({_fractions(given)} T1)",
+                                tuple(n for n, s in spans.items() if any(lo <= f * T1 <= hi for f in given
+                                                                         for lo, hi in s)), T1)
+    missed = ("" if given is None else
+              f"the compare_periods asked for ({_fractions(given)} T1) miss every admissible arc: ")
+    if not spans:
+        return PeriodChoice(given or (), "none", "no model has an admissible arc: no period to compare energies at",
+                            (), T1)
+    if reference is None and entries:
+        reference = largest_model(entries).name
+    best = max(_regions(spans), key=lambda r: (reference in r[2], len(r[2]), (r[1] - r[0]) / r[1]))
+    lo, hi, cover = best
+    if len(cover) >= 2 or len(spans) == 1:
+        fractions = tuple(_spread(lo, hi, T1, count))
+        models = tuple(n for n in spans if n in cover)
+        where = _range_words(lo, hi, T1)
+        n = f"{len(fractions)} period{'s' if len(fractions) > 1 else ''}"
+        if len(spans) == 1:
+            source, text = "own arcs", f"only {models[0]} has an admissible arc: {n} inside it ({where})"
+        elif len(cover) == len(spans):
+            source = "intersection"
+            text = (f"{n} {'spread ' if len(fractions) > 1 else ''}inside the intersection of the admissible arcs "
+                    f"of {_names(models)} ({where})")
+        else:
+            source = "overlap"
+            out = [m for m in spans if m not in cover]
+            text = (f"{n} inside {where}, where the admissible arcs of {_names(models)} overlap "
+                    f"({_names(out)} {'has' if len(out) == 1 else 'have'} no admissible arc there)")
+        none = [e.name for e in entries if e.name not in spans]
+        if none:
+            text += f"; {_names(none)} found no admissible arc"
+        return PeriodChoice(fractions, source, missed + text, models, T1)
+    order = sorted(spans, key=lambda n: (n != reference, list(spans).index(n)))[:8]
+    picks = {}
+    for n in order:
+        a, b = max(spans[n], key=lambda s: s[1] - s[0])
+        picks[n] = 0.5 * (a + b) / T1
+    fractions = tuple(sorted({f"{f:.10g}": f for f in picks.values()}.values()))
+    text = ("the models' admissible arcs do not overlap: one period inside each model's own widest arc ("
+            + ", ".join(f"{n} at {f:.10g} T1" for n, f in picks.items()) + ")")
+    return PeriodChoice(fractions, "own arcs", missed + text, tuple(picks), T1)
+
+
+def _fractions(fractions) -> str:
+    return ", ".join(f"{f:.10g}" for f in fractions)

@@ -339,26 +339,42 @@ def forcing_report(section: dict, animations: list[dict], massless: bool | None 
 
 
 def comparison_report(section: dict) -> list[str]:
-    """The comparison section of ``report.md``: a table, the verdicts and the sentences in words."""
+    """The comparison section of ``report.md``: the verdict first (which model to use, or why none can be trusted:
+    the section's ``verdict``, else computed from its rows), then the table, the sentences in words and the
+    figures."""
+    from .compare_table import comparison_verdict, energy_columns, period_labels
+
     rows = section["rows"]
-    energy_cols = [k for k in rows[0] if k.startswith("energy_")]
+    energy_cols = energy_columns(rows[0])
+    v = section.get("verdict") or comparison_verdict(rows)
     # the impact mass is Newton's (the inertia an impact meets): a comparison of massless models has none
     impact = any(r.get("impact_mass_kept") is not None for r in rows if r.get("method") != "fe")
+    versus = any(r.get("is_reference") is not None for r in rows)
+    energy_heads = [f"E at {t} (J)" for t in period_labels(energy_cols).values()]
     head = ["model", "dofs", "modes matched / checked", "artefact modes", *["impact mass kept"] * impact,
-            "static compliance kept", "families with arcs", *[c.replace("energy_", "E at ") for c in energy_cols],
-            "convergence"]
-    lines = ["", "## Model comparison", "",
-             "Every model got the same search. Frequencies are matched to FE modes by mode shape (MAC), never by "
-             "index; \"kept\" is the model's value over the FE model's. Full table: `comparison.csv`.", "",
-             "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+            "static compliance kept", "families with arcs", *energy_heads,
+            *["energy off the reference", "frequencies off the reference"] * versus, "convergence", "observed order"]
+    lines = ["", "## Model comparison", "", f"**Verdict:** {_sentence(v['sentence'])}", ""]
+    periods = section.get("periods") or {}
+    if periods.get("words"):
+        lines += [f"Comparison periods: {_sentence(periods['words'])}", ""]
+    lines += ["Every model got the same search. Frequencies are matched to FE modes by mode shape (MAC), never by "
+              "index; \"kept\" is the model's value over the FE model's; \"off the reference\" is the largest "
+              "relative difference from the reference model (the largest) over the comparison periods (energies) and "
+              "the modes both match to one FE mode (frequencies). Full table: `comparison.csv`.", "",
+              "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rows:
         if r.get("method") == "fe":
             continue
+        ref = bool(r.get("is_reference"))
         cells = [r["model"], str(r["dofs"]), f"{r.get('modes_matched')} / {r.get('modes_checked')}",
                  r.get("artefact_modes") or "—", *[_num(r.get("impact_mass_kept"), "×")] * impact,
                  _num(r.get("static_compliance_kept"), "×"),
                  f"{r.get('families_with_arcs')} of {r.get('families')}",
-                 *[_num(r.get(c), " J") for c in energy_cols], r.get("convergence") or "n/a"]
+                 *[_num(r.get(c), "") for c in energy_cols],
+                 *(["reference"] * 2 if ref else [_pct(r.get("ref_energy_deviation")),
+                                                  _pct(r.get("ref_frequency_deviation"))]) * versus,
+                 r.get("convergence") or "n/a", r.get("observed_order") or "—"]
         lines.append("| " + " | ".join(str(c) for c in cells) + " |")
     lines.append("")
     if section["diagnostics"]:
@@ -370,6 +386,16 @@ def comparison_report(section: dict) -> list[str]:
         if key in section["figures"]:
             lines += [f"![{key}]({section['figures'][key]})", ""]
     return lines
+
+
+def _sentence(text: str) -> str:
+    """``text`` as a sentence: capital first letter, a full stop."""
+    text = text.strip()
+    return text[:1].upper() + text[1:] + ("" if text.endswith(".") else ".")
+
+
+def _pct(x) -> str:
+    return "—" if x is None or x == "" else f"{100 * float(x):.2g} %"
 
 
 def _num(x, unit: str) -> str:

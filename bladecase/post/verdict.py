@@ -598,7 +598,8 @@ class _Verdict:
             if len(vals) >= 2 and max(vals) > 0 and (max(vals) - min(vals)) / max(vals) > ENERGY_SCATTER:
                 spread = (max(vals) - min(vals)) / max(vals)
                 if worst is None or spread > worst[0]:
-                    worst = (spread, col.removeprefix("energy_").replace("T1", " T1"), min(vals), max(vals))
+                    label = col.removeprefix("energy_").removesuffix("_j").replace("T1", " T1")
+                    worst = (spread, label, min(vals), max(vals))
         return None if worst is None else worst[1:]
 
     def _comparison(self, facts: list, doubts: list) -> None:

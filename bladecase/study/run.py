@@ -26,7 +26,7 @@ from ..post.outputs import FORMATS, PlotScene
 from ..post.report import report
 from ..post.verdict import verdict
 from ..progress import progress_counter
-from .comparison import FE_MODES, compare_models
+from .comparison import FE_MODES, compare_models, summary_section
 from .documents import contact_summary, families_document, family_summary, model_summary, reduced_summary
 from .executor import Executor, make_executor
 from .forcing import forced_response, forced_scene
@@ -252,7 +252,7 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         files["modes"] = "modes.json"
     with stage("plots"):
         scene = PlotScene(study.name, [(f"{r.method} ({r.n} dofs)", fams) for r, fams in
-                                       zip([reduced, *compares], found)], f_fe)
+                                       zip([reduced], found)], f_fe)
         files.update(FORMATS.write(o["formats"], "run", scene, staging))
         comparison = None
         if compares:
@@ -317,7 +317,7 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         "rub": rub,
         "casing_sweep": sweep,
         "nodal_modes": nodal,
-        "comparison": None if comparison is None else {k: comparison[k] for k in ("rows", "diagnostics", "figures")},
+        "comparison": None if comparison is None else summary_section(comparison),
         "files": files,
     }
     return summary, families, {m.name: m for m in models}
