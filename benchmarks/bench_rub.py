@@ -12,6 +12,7 @@
 
     python benchmarks/bench_rub.py                 # everything
     python benchmarks/bench_rub.py --skip-sweep    # without the 50-speed sweep
+    python benchmarks/bench_rub.py --sweep-only    # the 50-speed sweep alone
 """
 
 from __future__ import annotations
@@ -152,11 +153,13 @@ def node_count() -> None:
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--skip-sweep", action="store_true")
+    p.add_argument("--sweep-only", action="store_true", help="only the 50-speed sweep")
     p.add_argument("--workers", type=int, default=2)
     a = p.parse_args()
-    against_solve_ivp()
-    one_contact()
-    node_count()
+    if not a.sweep_only:
+        against_solve_ivp()
+        one_contact()
+        node_count()
     if not a.skip_sweep:
         sweep(a.workers)
 

@@ -57,3 +57,28 @@ def test_the_excursion_agrees_with_the_written_frames(demo):
     excess = top - x["clearance_m"]
     assert excess <= x["node_max_m"] * (1 + 1e-6) + 1e-12  # frames are instants of the same period
     assert excess == pytest.approx(x["node_max_m"], rel=0.1)
+
+
+def test_the_animation_marks_the_face_nodes_past_their_clearance(demo, tmp_path):
+    """The scene carries, frame by frame, the face nodes past their own clearance (red dots in the GIF): the nodes
+    marked at some frame are the summary's nodes beyond the clearance, and the GIF renders with them."""
+    from bladecase.post import animation
+    from bladecase.study.choose import choose_orbits
+    from bladecase.study.render import orbit_scene
+    from bladecase.study.stages import period_unit
+
+    model = next(iter(demo.models.values()))
+    reduced = model.reduced
+    study = loads(demo_text().replace("frames = 40", "frames = 80") + "\n", source="demo")
+    unit, _ = period_unit(study, reduced.system)
+    (choice,) = choose_orbits(study, demo.families, unit)[:1]
+    scene = orbit_scene(study, reduced, demo.families, choice)
+    x = demo.summary["files"]["animations"][0]["tip_excursion"]
+    assert scene.face_beyond.shape == (x["nodes"], 80)
+    assert int(scene.face_beyond.any(axis=1).sum()) == pytest.approx(x["nodes_beyond"], abs=1)  # 80 frames vs 400
+    assert not scene.face_beyond.all()                                     # open frames: nobody past it
+    out = animation.animate(scene.mesh, scene.u[:, :, ::8], scene.times[::8], period=scene.orbit.T,
+                            impact_frames=scene.impact[::8], contact_node=scene.contact_node, normal=scene.normal,
+                            gap=scene.gap, scale=scene.scale, gif=tmp_path / "a.gif", window_size=(320, 240),
+                            marks=scene.face_points, marked=scene.face_beyond[:, ::8])
+    assert out["gif"].stat().st_size > 0

@@ -84,6 +84,8 @@ def animate(
     window_size: tuple[int, int] = (800, 600),
     fps: float = 20.0,
     contact_label: str = "IMPACT",
+    marks: np.ndarray | None = None,
+    marked: np.ndarray | None = None,
 ) -> dict[str, Path]:
     """Render the blade over one period of an impact orbit to a looping GIF (and an MP4).
 
@@ -134,6 +136,9 @@ def animate(
     contact_label : str
         The word shown on the frames of ``impact_frames``: ``"IMPACT"`` (Newton's law), ``"CONTACT"`` for the
         frames inside a contact phase of the massless model.
+    marks, marked : (k,) int array and (k, n_frames) bool array, optional
+        Nodes drawn as red dots on the frames where ``marked`` holds them (a contact face's nodes past their own
+        clearance: where the tip rubs).
 
     Returns
     -------
@@ -169,8 +174,16 @@ def animate(
         f"T = {period:.4g} s   f = {1.0 / period:.4g} Hz",
         f"displacements \u00d7 {scale:.4g} (casing at clearance {_length(gap)}, same scale)",
     ]
+    if marks is not None:
+        marks = np.asarray(marks, dtype=int)
+        marked = np.asarray(marked, dtype=bool)
+        if marks.ndim != 1 or marked.shape != (marks.size, nframes) or (marks.size and not
+                                                                          0 <= marks.min() <= marks.max() < n):
+            raise ValueError(f"marks must be node indices (k,) with marked of shape (k, {nframes}), got "
+                             f"{marks.shape} and {marked.shape}")
+        texts.append("red dots: face nodes past their own clearance")
     frames = _render(pts, mesh, dim, u3, scale, warped, umax, corners, contact_node, impact, times / period, title,
-                     texts, window_size, size, bounds, normal, e1, contact_label)
+                     texts, window_size, size, bounds, normal, e1, contact_label, marks, marked)
     out = {"gif": Path(gif)}
     with atomic_path(gif) as tmp:
         _write_gif(tmp, frames, impact, fps)
@@ -286,7 +299,7 @@ def _surface(pts: np.ndarray, mesh: Mesh, dim: int, u3: np.ndarray):
 
 
 def _render(pts, mesh, dim, u3, scale, warped, umax, corners, contact_node, impact, phase, title, texts,
-            window_size, size, bounds, normal, e1, contact_label="IMPACT"):
+            window_size, size, bounds, normal, e1, contact_label="IMPACT", marks=None, marked=None):
     """The ``(F, h, w, 3)`` uint8 frames, rendered with one plotter whose actors are updated in place."""
     if not os.environ.get("DISPLAY"):  # headless: go straight to EGL rather than failing over from X11 noisily
         os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
@@ -314,6 +327,11 @@ def _render(pts, mesh, dim, u3, scale, warped, umax, corners, contact_node, impa
         pl.add_mesh(outline, color="black", opacity=0.25 if dim == 3 else 0.12, line_width=1)
         casing_actor = pl.add_mesh(casing, color="grey", opacity=0.4 if dim == 3 else 0.8, lighting=False)
         pl.add_mesh(marker, color="magenta", lighting=False)
+        dots = dots_actor = None
+        if marks is not None and marks.size:
+            dots = pv.PolyData(warped[marks, :, 0].copy())
+            dots_actor = pl.add_mesh(dots, color="red", point_size=9, render_points_as_spheres=True,
+                                     lighting=False)
         pl.add_text(title, position="upper_left", font_size=11)
         clock = pl.add_text("", position="lower_left", font_size=8)
         hit = pl.add_text(str(contact_label), position="upper_right", font_size=12, color="red")
@@ -323,6 +341,13 @@ def _render(pts, mesh, dim, u3, scale, warped, umax, corners, contact_node, impa
             surf.points = ref + scale * su[:, :, i]
             surf.point_data[_FIELD] = smag[:, i]
             marker.points = sphere0.points + warped[contact_node, :, i]
+            if dots is not None:  # the marked nodes; the others hidden behind the first marked one
+                on = marked[:, i]
+                if on.any():
+                    at = warped[marks, :, i]
+                    at[~on] = at[on][0]
+                    dots.points = at
+                dots_actor.SetVisibility(bool(on.any()))
             casing_actor.prop.color = "red" if impact[i] else "grey"
             hit.SetVisibility(bool(impact[i]))
             # the frame number keeps consecutive frames distinct: GIF writers merge identical ones

@@ -45,11 +45,18 @@ def orbit_scene(study: Study, reduced: ReducedModel, families: list[Branch], cho
     scale = animation.auto_scale(mesh, u, o["auto_fraction"]) if o["scale"] == "auto" else float(o["scale"])
     what = (f"nonsmooth mode, {orbit.k} contact phase{'' if orbit.k == 1 else 's'} per period" if is_massless(orbit)
             else f"{orbit.k}-ipp nonsmooth mode")
+    face_points = face_beyond = None
+    contact = reduced.contact
+    if contact.nodes:  # each face node against its own clearance, frame by frame (the mean cannot show it)
+        d, nu = contact.node_clearances(model)
+        face_points = np.array([grid_index(model, k) for k in contact.nodes])
+        un = np.einsum("kd,kdf->kf", nu, u[face_points, : model.dim])
+        face_beyond = un > d[:, None]
     return OrbitScene(stem=choice.stem, title=f"{study.name}: {what} (family {choice.family})",
                       mesh=mesh, orbit=orbit, times=times, u=u, v=v, impact=impact,
                       contact_node=int(grid_index(model, reduced.contact.node)),
                       normal=reduced.contact.normal_for(model), scale=scale, options=o,
-                      branch=families[choice.family])
+                      branch=families[choice.family], face_points=face_points, face_beyond=face_beyond)
 
 
 def render(study: Study, reduced: ReducedModel, families: list[Branch], choice: Choice, folder: Path,

@@ -24,7 +24,8 @@ def write(scene: OrbitScene, folder: Path, formats: set[str]) -> dict[str, str]:
                               scale=scene.scale, gif=folder / "animations" / f"{scene.stem}.gif",
                               mp4=folder / "animations" / f"{scene.stem}.mp4" if want_mp4 else None,
                               title=scene.title, window_size=tuple(o["window"]), fps=o["fps"],
-                              contact_label="CONTACT" if _massless(scene.orbit) else "IMPACT")
+                              contact_label="CONTACT" if _massless(scene.orbit) else "IMPACT",
+                              marks=scene.face_points, marked=scene.face_beyond)
     if "gif" not in formats:
         paths.pop("gif").unlink()
     return {k: f"animations/{p.name}" for k, p in paths.items()}

@@ -97,6 +97,10 @@ class OrbitScene:
     scale: float
     options: dict
     branch: Branch | None = None
+    #: Grid points of a contact face's nodes and, per frame, which of them are past their own clearance
+    #: (``(k,)``, ``(k, n_frames)``; ``None``: a one-node contact).
+    face_points: np.ndarray | None = None
+    face_beyond: np.ndarray | None = None
 
     @property
     def gap(self) -> float:
