@@ -12,7 +12,7 @@ from bladecase.nsm.massless.nodes import NodalFlight, NodalSystem, Rub, lcp, sim
 from bladecase.nsm.massless.rub import rub_response, rub_sweep
 
 
-def chain(casing=np.inf) -> NodalSystem:
+def chain(casing=np.inf, masses=(1.0, 1.5, 0.7)) -> NodalSystem:
     """Three masses in a chain from a wall; massless contact points hang off masses 2 and 3 by springs and are
     coupled to each other (so the two contacts interact), condensed exactly."""
     K = np.zeros((5, 5))
@@ -30,7 +30,7 @@ def chain(casing=np.inf) -> NodalSystem:
     Kcc, Kci = K[np.ix_(c, c)], K[np.ix_(c, i)]
     S = K[np.ix_(i, i)] - Kci.T @ np.linalg.solve(Kcc, Kci)
     W = -Kci.T @ np.linalg.solve(Kcc, np.eye(2))
-    return NodalSystem(np.diag([1.0, 1.5, 0.7]), S, W, np.linalg.inv(Kcc), gap=[0.2, 0.3], casing=casing)
+    return NodalSystem(np.diag(masses), S, W, np.linalg.inv(Kcc), gap=[0.2, 0.3], casing=casing)
 
 
 def reference(s: NodalSystem, x0, v0, t_end, damping=None, rub=None):

@@ -414,20 +414,23 @@ def _brent(f: TrigSum, a: float, b: float) -> float:
     return brentq(lambda x: f(x)[0], a, b, xtol=1e-15 * max(1.0, abs(b)), rtol=4 * np.finfo(float).eps)
 
 
-def _search(f, B2, hmin, a, b, fa, fb, da, db):
+def _search(f, B2, hmin, a, b, fa, fb, da, db, polish=None):
+    """The first root of ``f`` in ``[a, b]`` (``None`` when the interval is proved free of one): bisected, leftmost
+    first, until a bracket where ``f`` provably rises is found, which ``polish(f, a, b, fa, fb, da, db)`` (default:
+    Brent's method) refines."""
     if fb >= 0:
         if da - B2 * (b - a) > 0 or b - a < hmin:
-            return _brent(f, a, b)
+            return _brent(f, a, b) if polish is None else polish(f, a, b, fa, fb, da, db)
     elif interval_bound(fa, fb, da, db, b - a, B2) < 0 or b - a < hmin:
         return None
     m = 0.5 * (a + b)
     fm, dm = (float(z) for z in f(m))
     if fm >= 0:
-        return _search(f, B2, hmin, a, m, fa, fm, da, dm)
-    root = _search(f, B2, hmin, a, m, fa, fm, da, dm)
+        return _search(f, B2, hmin, a, m, fa, fm, da, dm, polish)
+    root = _search(f, B2, hmin, a, m, fa, fm, da, dm, polish)
     if root is not None:
         return root
-    return _search(f, B2, hmin, m, b, fm, fb, dm, db)
+    return _search(f, B2, hmin, m, b, fm, fb, dm, db, polish)
 
 
 def all_roots(f: TrigSum, a: float, b: float, max_points: int = 2_000_000) -> np.ndarray:

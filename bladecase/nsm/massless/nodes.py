@@ -50,7 +50,7 @@ import numpy as np
 import scipy.linalg as sla
 from scipy.optimize import nnls
 
-from ..signals import POINTS_PER_PERIOD, interval_bound
+from ..signals import POINTS_PER_PERIOD, _search, interval_bound
 
 __all__ = ["NodalFlight", "NodalSystem", "NodalTrajectory", "Rub", "lcp", "simulate_nodes"]
 
@@ -450,26 +450,6 @@ def _newton(row: _Row, a: float, b: float, fa: float, fb: float, da: float, db: 
     return x
 
 
-def _search_row(row: _Row, B2: float, hmin: float, a: float, b: float, fa: float, fb: float, da: float,
-                db: float) -> float | None:
-    """:func:`bladecase.nsm.signals.first_upcrossing`'s certified bisection on one (negated) signal: the first
-    root in ``[a, b]``, or ``None`` when the interval is proved free of one; a bracket where the slope provably
-    stays positive is finished by :func:`_newton`."""
-    if fb >= 0:
-        if da - B2 * (b - a) > 0 or b - a < hmin:
-            return _newton(row, a, b, fa, fb, da, db)
-    elif interval_bound(fa, fb, da, db, b - a, B2) < 0 or b - a < hmin:
-        return None
-    m = 0.5 * (a + b)
-    fm, dm = (float(z) for z in row(m))
-    if fm >= 0:
-        return _search_row(row, B2, hmin, a, m, fa, fm, da, dm)
-    root = _search_row(row, B2, hmin, a, m, fa, fm, da, dm)
-    if root is not None:
-        return root
-    return _search_row(row, B2, hmin, m, b, fm, fb, dm, db)
-
-
 def _leave(f0: float, d0: float, B2: float, horizon: float, row: _Row) -> float:
     """A ``τ > 0`` before which the negated signal ``-f`` (starting at ``-f0`` ≈ 0 rising as ``-d0``) stays < 0."""
     if -f0 < 0 and d0 <= 0:  # away from the surface already: the search starts at 0
@@ -526,9 +506,10 @@ def first_switch(sig: _Signals, horizon: float, on: np.ndarray, chunk: int = 256
             a = float(tau[i])
             late = starts[js] > a  # the interval holding a signal's start: searched from there
             for j in js[late]:
-                root = _search_row(sig.row(j), float(B2[j]), float(hmin[j]), float(starts[j]), float(tau[i + 1]),
-                               *(float(v) for v in sig.row(j)(float(starts[j]))[:1]), float(F[i + 1, j]),
-                               float(sig.row(j)(float(starts[j]))[1]), float(D[i + 1, j]))
+                row = sig.row(j)
+                fs, ds = (float(v) for v in row(float(starts[j])))
+                root = _search(row, float(B2[j]), float(hmin[j]), float(starts[j]), float(tau[i + 1]), fs,
+                               float(F[i + 1, j]), ds, float(D[i + 1, j]), _newton)
                 if root is not None:
                     early = _earliest(sig, B2, hmin, a, float(root), js[~late])
                     return early if early is not None else (float(root), int(j))
@@ -560,8 +541,8 @@ def _many(sig: _Signals, B2, hmin, a: float, b: float, js, Fa, Fb, Da, Db) -> tu
     if js.size == 1 or b - a < hmin[js].min():
         best = None
         for k, j in enumerate(js):
-            root = _search_row(sig.row(j), float(B2[j]), float(hmin[j]), a, b, float(Fa[k]), float(Fb[k]), float(Da[k]),
-                           float(Db[k]))
+            root = _search(sig.row(j), float(B2[j]), float(hmin[j]), a, b, float(Fa[k]), float(Fb[k]), float(Da[k]),
+                           float(Db[k]), _newton)
             if root is not None and (best is None or root < best[0]):
                 best = (float(root), int(j))
         return best
