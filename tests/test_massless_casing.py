@@ -11,6 +11,8 @@ Newton's law, the schema and the files refuse or keep the casing as documented.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from test_massless import bilinear_period
@@ -163,3 +165,28 @@ def test_the_animation_says_contact_for_the_massless_model_and_impact_for_newton
     (fam,) = bc.nonsmooth_mode(s, 1, (5.0, 2 * np.pi + 0.01))
     assert _massless(fam.orbits[1])
     assert not _massless(bc.orbit_1ipp(bc.chain(2, k=1.0, m=0.5, gap=1.0), 6.0))
+
+
+@pytest.mark.parametrize("casing", [1e5, 1e7])
+def test_a_soft_casing_on_a_stiff_plate_still_grows_its_mode(casing):
+    """A casing far softer than the blade (the plate's static stiffness at its contact: 2.3e7 N/m) puts the
+    closing residual's root within 1e-7 of its pole at half the linear period: the branch's first point is then
+    bracketed beside the pole (before, Newton from T1/2 went astray and the branch was the grazing orbit alone —
+    no family at all in a study)."""
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_verdict import MASSLESS_PLATE
+
+    from bladecase.nsm.massless.orbits import follow_from_grazing
+    from bladecase.study.schema import loads
+    from bladecase.study.stages import build_contact, build_mesh, build_model, build_reduced
+
+    study = loads(MASSLESS_PLATE.replace("[contact]\n", f"[contact]\ncasing_stiffness = {casing}\n"), source="<p>")
+    model = build_model(study, build_mesh(study))
+    s = build_reduced(study, model, build_contact(study, model)).system
+    T1 = 2 * np.pi / s.open.omega[0]
+    branch = follow_from_grazing(s, 0.8 * T1, max_points=60)
+    assert len(branch) == 60                                   # measured before the fix: 1 (the grazing orbit)
+    assert all(o.T <= T1 * (1 + 1e-9) for o in branch) and branch[-1].T < branch[0].T
+    assert abs(branch[0].T / T1 - 1) < 1e-5                     # it starts at grazing

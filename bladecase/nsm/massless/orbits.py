@@ -253,6 +253,52 @@ def _correct(system: MasslessSystem, z: np.ndarray, scale: float = 1.0) -> tuple
     return z, False, 10
 
 
+def _grazing_start(system: MasslessSystem, w: float) -> np.ndarray:
+    """The first point ``(α, β₀)`` of the branch by bracketing: ``r(α, β₀)`` has a pole at about half the linear
+    period and its root beside it, closer the softer the contact's spring (a soft casing: within 1e-7 of ``π/ω``
+    at 1e7 N/m on a stiff plate, where Newton from ``π/ω`` goes astray). ``α`` approaches the pole from each side
+    geometrically, a sign change with ``|r|`` small at the refined root is the start; ``β₀`` grows tenfold while
+    none is found."""
+    from scipy.optimize import brentq
+
+    o, c, P = system.open, system.closed, system.transfer
+
+    def det(alpha: float, beta: float) -> float:  # the mid-open amplitudes' matrix (closing_residual's L)
+        co, so = np.cos(o.omega * alpha), np.sin(o.omega * alpha)
+        cc, sc = np.cos(c.omega * beta), np.sin(c.omega * beta)
+        L = -(sc * c.omega)[:, None] * (P * co) - cc[:, None] * (P * (o.omega * so))
+        sign, logdet = np.linalg.slogdet(L)
+        return float(sign)
+
+    half = np.pi / w
+    for beta in np.array([1e-6, 1e-5, 1e-4, 1e-3]) / w:
+        lo, hi = 0.9 * half, 1.1 * half  # the pole: where L is singular, beside half the linear period
+        grid = np.linspace(lo, hi, 401)
+        s = np.array([det(x, beta) for x in grid])
+        flips = np.flatnonzero(s[:-1] != s[1:])
+        if not flips.size:
+            continue
+        k = flips[np.argmin(np.abs(grid[flips] - half))]
+        a0, a1 = grid[k], grid[k + 1]
+        for _ in range(200):  # bisection on the determinant's sign to the last bit
+            m = 0.5 * (a0 + a1)
+            if m in (a0, a1):
+                break
+            a0, a1 = (m, a1) if det(m, beta) == s[k] else (a0, m)
+        pole = 0.5 * (a0 + a1)
+        eps = pole * np.logspace(-2, -15, 261)
+        for side in (-1.0, 1.0):
+            a = pole + side * eps
+            r = np.array([closing_residual(system, x, beta)[1] for x in a])
+            for k in np.flatnonzero(np.isfinite(r[:-1]) & np.isfinite(r[1:]) & (np.sign(r[:-1]) != np.sign(r[1:]))):
+                root = brentq(lambda x, b=beta: closing_residual(system, x, b)[1], min(a[k], a[k + 1]),
+                              max(a[k], a[k + 1]), xtol=1e-15 * pole, rtol=4 * np.finfo(float).eps)
+                if abs(closing_residual(system, root, beta)[1]) <= 1e-8 * system.gap:
+                    return np.array([root, beta])
+    raise ValueError("no grazing orbit found from the linear mode: the closing residual has no root beside its "
+                     "pole at half the linear period (the contact does not see this mode?)")
+
+
 def follow_from_grazing(system: MasslessSystem, T_min: float, mode: int = 0, ds: float = 1e-3,
                         ds_max: float = 0.02, max_points: int = 2000) -> list[SymmetricOrbit]:
     """The branch grown from the linear open-phase mode ``mode`` at grazing, followed while ``T >= T_min``.
@@ -283,6 +329,9 @@ def follow_from_grazing(system: MasslessSystem, T_min: float, mode: int = 0, ds:
         while lam > 1e-12 and abs(closing_residual(system, z[0] - lam * step, z[1])[1]) >= abs(r):
             lam /= 2
         z[0] -= lam * step
+    r = closing_residual(system, *z)[1]
+    if not (abs(r) <= 1e-8 * system.gap and 0.5 * np.pi / w < z[0] < 1.5 * np.pi / w):
+        z = _grazing_start(system, w)  # Newton missed the root beside the pole (a soft casing): bracket it
     out: list[SymmetricOrbit] = []
     tangent, h, ds_max = None, ds * L, ds_max * L
     while len(out) < max_points:
