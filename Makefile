@@ -39,6 +39,8 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_ccx.py
 	$(BIN)/python benchmarks/bench_executor.py
 	$(BIN)/python benchmarks/bench_simulate.py
+	$(BIN)/python benchmarks/bench_rub.py
+	$(BIN)/python benchmarks/bench_nodal_modes.py
 
 clean:
 	rm -rf $(VENV) results build *.egg-info
