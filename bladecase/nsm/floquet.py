@@ -154,14 +154,21 @@ def _fixed_vectors(Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return f - (e @ f) * e, e
 
 
-def _deflate(Y: np.ndarray, f: np.ndarray, e: np.ndarray, tol: float) -> tuple[float, float, np.ndarray]:
-    """Trivial multipliers ``(a, c)`` and the non-trivial block of ``Y`` in the basis ``[f̂, U, ê]``."""
+def split_trivial(Y: np.ndarray, f: np.ndarray, e: np.ndarray) -> np.ndarray:
+    """``Y`` in the orthonormal basis ``[f̂, U, ê]`` (``Y f = f`` and ``eᵀY = eᵀ`` at a periodic orbit of a
+    conservative system: the flow direction ``f`` and the energy gradient ``e``): ``B[0, 0]`` and ``B[-1, -1]`` are
+    the trivial multipliers, ``B[1:-1, 1:-1]`` the non-trivial block."""
     fh, eh = f / np.linalg.norm(f), e / np.linalg.norm(e)
     fh = fh - (eh @ fh) * eh
     fh /= np.linalg.norm(fh)
     U = sla.null_space(np.vstack([fh, eh]))
     Q = np.column_stack([fh, U, eh])
-    B = Q.T @ Y @ Q
+    return Q.T @ Y @ Q
+
+
+def _deflate(Y: np.ndarray, f: np.ndarray, e: np.ndarray, tol: float) -> tuple[float, float, np.ndarray]:
+    """Trivial multipliers ``(a, c)`` and the non-trivial block of ``Y`` (:func:`split_trivial`), checked."""
+    B = split_trivial(Y, f, e)
     scale = max(1.0, float(np.linalg.norm(Y, 2)))  # backward error: exact for a matrix within tol·‖Y‖ of Y
     a, c = float(B[0, 0]), float(B[-1, -1])
     leak = max(float(np.abs(B[1:, 0]).max()), float(np.abs(B[-1, :-1]).max()))

@@ -91,6 +91,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ... import log
+from ..floquet import split_trivial
 from .nodes import NodalFlight, NodalSystem, lcp, simulate_nodes
 
 __all__ = ["FAMILY_RTOL", "FLOQUET_TOL", "MAX_PHASES", "METHODS", "RESONANCE_SHARE", "NodalFamily", "NodalOrbit",
@@ -472,14 +473,9 @@ def _polish(sig, grid: np.ndarray, i: int, j: int, sign: float) -> float:
 
 
 def _deflate(Y: np.ndarray, f: np.ndarray, e: np.ndarray) -> tuple[float, float, np.ndarray]:
-    """Trivial multipliers ``(a, c)`` (flow and energy directions) and the non-trivial block of ``Y`` in the
-    orthonormal basis ``[f̂, U, ê]`` (``Y f = f`` and ``eᵀY = eᵀ`` at a periodic orbit, ``eᵀf = 0``)."""
-    eh = e / np.linalg.norm(e)
-    fh = f - (eh @ f) * eh
-    fh /= np.linalg.norm(fh)
-    U = sla.null_space(np.vstack([fh, eh]))
-    Q = np.column_stack([fh, U, eh])
-    B = Q.T @ Y @ Q
+    """Trivial multipliers ``(a, c)`` (flow and energy directions) and the non-trivial block of ``Y``
+    (:func:`bladecase.nsm.floquet.split_trivial`, unchecked: the caller reports them)."""
+    B = split_trivial(Y, f, e)
     return float(B[0, 0]), float(B[-1, -1]), B[1:-1, 1:-1]
 
 
