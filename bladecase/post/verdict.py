@@ -650,7 +650,9 @@ class _Verdict:
                 else "while the mean stays within it")
         limits.append(f"the contact is the mean of the face{face}: {x['nodes_beyond']} of its {x['nodes']} nodes pass "
                       f"the clearance (node {x.get('node_id', x.get('node'))} by {_length(x['node_max_m'])} {mean}), "
-                      "so where the tip rubs is not resolved.")
+                      "so where the tip rubs is not resolved"
+                      + (" here — the mode with every node a contact is reported below." if self.s.get("nodal_modes")
+                         else ' ([contact] points = "nodes" resolves it).'))
 
     # --- line 3: what to do next
 
