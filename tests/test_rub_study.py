@@ -126,3 +126,29 @@ def test_stiffness_per_area_gives_each_node_its_share(tmp_path):
     # the tip section's area: a NACA 4-digit profile of thickness t and chord c has about 0.685 t c² (2412, 35 mm:
     # 100.7 mm²); the meshed tip face gives 103.2 mm²
     assert area.sum() == pytest.approx(0.685 * 0.12 * 0.035**2, rel=0.05)
+
+
+def test_a_speed_the_simulation_refuses_is_reported_and_the_others_go_on(monkeypatch):
+    """A ValueError of the simulation at one speed (e.g. a grazing switch) is that speed's result, not the end of
+    the sweep: the other speeds are computed, the failed one is listed with its reason."""
+    from bladecase.study import rub as stage
+    from bladecase.study.executor import SerialExecutor
+    from bladecase.study.stages import build_contact, build_mesh, build_model
+
+    real = stage.rub_response
+
+    def flaky(system, speed, *args, **kwargs):
+        if abs(speed * 60 / (2 * np.pi) - 1450) < 1e-6:
+            raise ValueError("grazing switch: a contact signal does not leave its switching surface")
+        return real(system, speed, *args, **kwargs)
+
+    monkeypatch.setattr(stage, "rub_response", flaky)
+    study = loads(_study(rub=RUB.replace("speeds = [1450, 1650]", "speeds = [1450, 1650, 1660]")), source="<rub>")
+    model = build_model(study, build_mesh(study))
+    s = stage.rub_stage(study, model, build_contact(study, model), executor=SerialExecutor())
+    assert [r["speed"] for r in s["rows"]] == [1650.0, 1660.0]
+    assert s["failed_speeds"] == [{"speed": 1450.0, "reason": "grazing switch: a contact signal does not leave its "
+                                                              "switching surface"}]
+    from bladecase.post.rub_report import rub_report
+
+    assert any("No result at 1450 rpm" in line for line in rub_report(s))

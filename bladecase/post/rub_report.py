@@ -73,6 +73,9 @@ def rub_report(section: dict | None) -> list[str]:
                      + f": a casing with {section['lobes']} lobes excites them at "
                      + ", ".join(f"{lo * 60 / section['lobes']:.6g}–{hi * 60 / section['lobes']:.6g} rpm"
                                  for lo, hi in bands) + " (shaded on `rub.png`).")
+    for f in section.get("failed_speeds") or []:
+        lines.append(f"- **No result at {f['speed']:.6g} {unit}**: the simulation was refused there ({f['reason']}); "
+                     "the other speeds are unaffected.")
     unsettled = section.get("unsettled_speeds") or []
     if unsettled:
         lines.append(f"- **Not settled** at {len(unsettled)} of {len(rows)} speeds ("

@@ -115,8 +115,10 @@ def _rub_point(speed: float, *, model, contact: Contact, interior: np.ndarray, s
     state = spin(model, speed, axis, static=static)
     hot = _running(model, contact, state.displacement, speed)
     reduced = nodal_model(state.model, hot, size, factor=state.factor, casing=casing, interior=interior, residual=True)
-    r = rub_response(reduced.system, speed, lobes, amplitude, angles, damping, revolutions, window)
-    out = r.as_dict()
+    try:
+        out = rub_response(reduced.system, speed, lobes, amplitude, angles, damping, revolutions, window).as_dict()
+    except ValueError as exc:  # the simulation refused this speed (e.g. a grazing switch): the others go on
+        out = {"error": str(exc), "nodes": list(reduced.system.nodes)}
     out["open_hz"] = (reduced.system.modes[0][:6] / (2 * np.pi)).tolist()
     out["clearances_m"] = reduced.system.gap.tolist()
     return out
@@ -182,6 +184,7 @@ def rub_stage(study, model, contact: Contact, *, families=None, executor=None, p
     except ValueError as exc:
         raise StudyError(f"[rub] speeds: {exc}") from None
     section = _summary(study, speeds, points, families, contact, model)
+    points = [p for p in points if "error" not in p]  # aligned with the rows
     if folder is not None:
         section["files"] = _write(Path(folder), section, points, figures, title)
         if "vtu" in study["output"]["formats"]:
@@ -224,20 +227,28 @@ def _summary(study, speeds: np.ndarray, points: list[dict], families, contact: C
     r, k = study["rub"], study["casing"]
     unit = r["speed_unit"]
     scale = SPEED_UNITS[unit.lower()]
-    rows = []
+    rows, failed = [], []
     for given, w, p in zip(r["speeds"], speeds, points):
+        if "error" in p:
+            failed.append({"speed": float(given), "reason": p["error"]})
+            continue
         frac = np.array(p["contact_fraction"])
         rows.append({"speed": float(given), "speed_rad_s": float(w),
                      "tip_displacement_mm": 1e3 * max(p["peak_displacement"]),
                      "contact_force_n": max(p["peak_force"]), "contact_fraction": float(frac.max()),
                      "penetration_mm": 1e3 * max(p["penetration"]), "nodes_touching": int((frac > 0).sum()),
                      "switches": p["switches"], "settled": bool(p["settled"])})
+    if not rows:
+        raise StudyError(f"[rub] speeds: the simulation was refused at every speed; at {failed[0]['speed']:.6g} "
+                         f"{unit}: {failed[0]['reason']}")
+    good = [p for p in points if "error" not in p]
     worst = int(np.argmax([row["tip_displacement_mm"] for row in rows]))
-    p = points[worst]
+    p = good[worst]
     touching = [i for i, f in enumerate(p["contact_fraction"]) if f > 0]
     where = _along_tip(model, contact, touching)
-    open_hz = np.array([q["open_hz"] for q in points])
-    resonances = _resonances(speeds, open_hz, k["lobes"]) if speeds.size > 1 else []
+    ok = np.array(["error" not in q for q in points])
+    open_hz = np.array([q["open_hz"] for q in good])
+    resonances = _resonances(speeds[ok], open_hz, k["lobes"]) if ok.sum() > 1 else []
     for res in resonances:
         res["speed"] = res["speed_rad_s"] / scale
     return {
@@ -246,9 +257,10 @@ def _summary(study, speeds: np.ndarray, points: list[dict], families, contact: C
                                            else {"rayleigh": r["rayleigh"]}),
         "nodes": [int(n) for n in points[0]["nodes"]],
         "rows": rows,
-        "worst": {**rows[worst], "touching_nodes": [int(points[worst]["nodes"][i]) for i in touching],
+        "worst": {**rows[worst], "touching_nodes": [int(p["nodes"][i]) for i in touching],
                   "touching_along_tip": where},
         "unsettled_speeds": [row["speed"] for row in rows if not row["settled"]],
+        "failed_speeds": failed,
         "resonances": resonances,
         "open_hz": open_hz[:, :3].tolist(),
         "nonsmooth_bands_hz": _bands(families),
