@@ -183,7 +183,7 @@ def rub_stage(study, model, contact: Contact, *, families=None, executor=None, p
                               progress=progress)
     except ValueError as exc:
         raise StudyError(f"[rub] speeds: {exc}") from None
-    section = _summary(study, speeds, points, families, contact, model)
+    section = _summary(study, speeds, points, families, contact, model, casing)
     points = [p for p in points if "error" not in p]  # aligned with the rows
     if folder is not None:
         section["files"] = _write(Path(folder), section, points, figures, title)
@@ -223,7 +223,8 @@ def _write_vtu(path: Path, model, contact: Contact, section: dict, points: list[
     return path.name
 
 
-def _summary(study, speeds: np.ndarray, points: list[dict], families, contact: Contact, model) -> dict:
+def _summary(study, speeds: np.ndarray, points: list[dict], families, contact: Contact, model,
+             casing: np.ndarray) -> dict:
     r, k = study["rub"], study["casing"]
     unit = r["speed_unit"]
     scale = SPEED_UNITS[unit.lower()]
@@ -266,8 +267,7 @@ def _summary(study, speeds: np.ndarray, points: list[dict], families, contact: C
         "nonsmooth_bands_hz": _bands(families),
         "bands_at": _bands_at(study),
         "model": {"size": r["size"], "contact_nodes": len(contact.nodes),
-                  "casing_n_per_m": None if np.isinf(_node_stiffness(study, model, contact)).all()
-                  else float(_node_stiffness(study, model, contact).sum())},
+                  "casing_n_per_m": None if np.isinf(casing).all() else float(casing.sum())},
     }
 
 

@@ -313,8 +313,7 @@ class _Phase:
             self._psi = None
         self.LVx = L @ self.Vx
         self.nu = nu
-        gp = s.gap if fl.D is None else s.gap
-        self.const = L @ self.q_eq + P @ gp
+        self.const = L @ self.q_eq + P @ s.gap
         self.E0 = (L @ self.X + (P @ fl.D if fl.D is not None else 0)) if nu > 0 else np.zeros(m, complex)
         self.lam2 = np.abs(self.lam) ** 2
 
@@ -586,10 +585,12 @@ class NodalFlight:
 
     def gap(self, t) -> np.ndarray:
         """The clearances at the times ``t``: ``(m,)`` or ``(m, k)``."""
+        d = self.system.gap
         if self.D is None:
-            return self.system.gap if np.ndim(t) == 0 else np.repeat(self.system.gap[:, None], np.size(t), 1)
-        return self.system.gap[:, None] + (np.multiply.outer(self.D, np.exp(1j * self.nu * np.atleast_1d(t)))).real \
-            if np.ndim(t) else self.system.gap + (self.D * np.exp(1j * self.nu * t)).real
+            return d if np.ndim(t) == 0 else np.repeat(d[:, None], np.size(t), 1)
+        if np.ndim(t) == 0:
+            return d + (self.D * np.exp(1j * self.nu * t)).real
+        return d[:, None] + np.multiply.outer(self.D, np.exp(1j * self.nu * np.atleast_1d(t))).real
 
     def gap_rate(self, t: float) -> np.ndarray:
         if self.D is None:
