@@ -1,4 +1,4 @@
-"""The demo blade's first nonsmooth mode against a compliant casing: does it converge? (issue 11)
+"""The demo blade's first nonsmooth mode against a compliant casing: does it converge?
 
 The massless contact on the area-weighted tip face (the demo's) in series with a casing of stiffness ``k_casing``
 (``[contact] casing_stiffness``; ``inf`` = rigid). For each casing stiffness, each mesh (the demo's ``[geometry]
@@ -9,7 +9,7 @@ method, 8, 16, 32, 64): the first open frequency f₁, the grazing energy ``E_g 
 so that a narrow internal-resonance tongue elsewhere on the branch does not hide it; whether it is admissible
 (proved), and its contact fraction of the period. Then the relative changes between the two largest sizes (per
 mesh) and between the two finest meshes (largest size), of admissible orbits only, with the observed order
-where three meshes are monotone, and the verdict against the issue's goal: < 1 % between the two finest.
+where three meshes are monotone, and the verdict against the convergence goal: < 1 % between the two finest.
 
 Run: OPENBLAS_NUM_THREADS=1 nice .venv/bin/python benchmarks/bench_blade_casing.py [--fine] [--quick]
      [--casing 1e6,inf] [--ratios 0.995,0.99,0.98] [--scales 0.7,0.5,0.35,0.25] [--json FILE]

@@ -1,4 +1,4 @@
-"""Does the demo blade's massless nonsmooth mode converge? Three meshes × reduced sizes 8, 16, 32, 64 (issue 11).
+"""Does the demo blade's massless nonsmooth mode converge? Three meshes × reduced sizes 8, 16, 32, 64.
 
 For three mesh sizes of the demo blade (its ``[geometry] size`` and ``tip_size`` scaled by 1.4, 1, 0.7) the demo
 study (massless contact on the area-weighted tip face, ``[search] ipp = [1]``, periods [0.95, 1.0001] T1) is run as
@@ -14,7 +14,7 @@ admissible energy at three common periods inside every grazing arc, as E/E_g −
 linear mode's; every one-phase orbit of the period is found by a scan of the contact time), the number of
 one-phase orbits at the middle period, and the branch's orbit at 0.999, 0.99, 0.97 T1 (energy, admissible or
 not). Then the relative changes between successive sizes and between meshes (largest size), the observed order
-where three values are monotone, and the verdict against the issue's goal: < 1 % change between the two finest.
+where three values are monotone, and the verdict against the convergence goal: < 1 % change between the two finest.
 Newton's law on the tip node (lanczos-si, same sizes, 1 ipp) follows for contrast. T1: each mesh's FE period.
 
 Run: OPENBLAS_NUM_THREADS=1 nice .venv/bin/python benchmarks/bench_blade_convergence.py [--quick] [--out DIR]

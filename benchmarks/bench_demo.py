@@ -1,4 +1,4 @@
-"""The demo study end to end (``bladecase demo``), stage by stage, against the issue's aim of about a minute.
+"""The demo study end to end (``bladecase demo``), stage by stage, against the aim of about a minute.
 
     .venv/bin/python benchmarks/bench_demo.py [--out DIR]
 

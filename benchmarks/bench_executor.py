@@ -1,4 +1,4 @@
-"""The study executors on a 16-point grid (issue 14): serial vs local processes vs a Dask LocalCluster.
+"""The study executors on a 16-point grid: serial vs local processes vs a Dask LocalCluster.
 
 Tasks (``--task``):
 

@@ -1,4 +1,4 @@
-"""FE front end, stage by stage, SuperLU against the faster factorisation backend (issue 14).
+"""FE front end, stage by stage, SuperLU against the faster factorisation backend.
 
 For each blade size (twisted, tapered NACA 0012 blade of ``bench_fem.py``; mesh sizes 5.5 / 2.5 / 1.4 mm give
 5 490 / 26 316 / 110 424 P2 dofs) and each backend (``superlu`` and the best available, e.g. ``cholmod``),
@@ -11,7 +11,7 @@ one fresh process (so that its peak memory is its own) runs, timed with ``time.p
     along the span.
 
 After each stage the process's peak resident memory (``ru_maxrss``) is recorded.  The table gives the stage
-times per backend, the ratio SuperLU / new, and the target of issue 14 at the largest size: mesh to reduced
+times per backend, the ratio SuperLU / new, and the performance target at the largest size: mesh to reduced
 model and 20 frequencies in at most 30 s and 1.5 GB (1.5e9 bytes = 1431 MiB).  Single-threaded BLAS
 (``OPENBLAS_NUM_THREADS=1`` is set for the children unless already set).  Exit status 0 whatever the times;
 ``--json FILE`` writes every figure.
@@ -38,7 +38,7 @@ from bench_core import line, machine, verdict
 
 #: Mesh sizes (m) of the three blades: ~5k, ~26k, ~110k P2 dofs.
 SIZES = (0.0055, 0.0025, 0.0014)
-#: Issue 14's target at the largest size: seconds from mesh to reduced model, and peak memory (MiB).
+#: The performance target at the largest size: seconds from mesh to reduced model, and peak memory (MiB).
 TARGET_SECONDS, TARGET_MIB = 30.0, 1.5e9 / 2**20
 STAGES = ("mesh", "assemble", "factor", "frequencies", "reduce")
 
@@ -141,7 +141,7 @@ def main(argv: list[str] | None = None) -> int:
 
     sizes = [float(s) for s in args.sizes.split(",") if not (args.skip_110k and float(s) <= 0.0014)]
     backends = args.backends.split(",") if args.backends else list(dict.fromkeys(["superlu", available_backends()[0]]))
-    print("bladecase FE pipeline benchmark: mesh, assemble, factorise, frequencies, reduce (issue 14)")
+    print("bladecase FE pipeline benchmark: mesh, assemble, factorise, frequencies, reduce")
     info = {"machine": machine(), "backends": backends, "runs": []}
     results: dict[float, dict[str, dict]] = {}
     for size in sizes:

@@ -4,7 +4,7 @@ For each contact — Newton's law on the tip node (the demo), massless tip node,
 weights) — and reduced sizes 8, 16, 32, 64: the admissible stretch of the branch grown from the first mode, and at
 T = 0.99, 0.97, 0.95 T₁ the orbit's energy, whether it is admissible, and its drift and contact count after one
 period in the reference model (4 × the largest size; bladecase.study.reference). The last column says, in words,
-whether the energy converges (relative change between sizes 32 and 64 < 1 %: the issue's goal).
+whether the energy converges (relative change between sizes 32 and 64 < 1 %: the convergence goal).
 
 Run: .venv/bin/python benchmarks/bench_massless_blade.py [--quick]     (about a minute; --quick: sizes 8, 16)
 """

@@ -1,4 +1,4 @@
-"""How the cost of each solver stage grows (issue 14, "scale on paper"): measured points and fitted exponents.
+"""How the cost of each solver stage grows: measured points and fitted exponents.
 
 Every figure is the CPU time of this process (``time.process_time``, ``OPENBLAS_NUM_THREADS=1``), so a loaded
 machine changes it less than the wall time.  The cost of a stage is fitted as ``t = c · x^p`` by least squares

@@ -13,8 +13,8 @@ System (the seed paper's Fig. 9): ``chain(5, k=1, m=1/5, gap=1)``, ``C = αK`` w
 
 Printed: wall times (best of ``--repeat``), the ratio, the number of impacts, and each method's largest
 impact-time error against the reference over the reference's horizon.  Siconos (Moreau–Jean) is timed too when
-``siconos`` imports (it is not a dependency; issue 14 measured it at 19–1500× slower than bladecase, first
-order).
+``siconos`` imports (it is not a dependency; it was measured at 19–1500× slower than bladecase,
+first order).
 
 Run: ``.venv/bin/python benchmarks/bench_simulate.py [--periods 500] [--period 5.5] [--repeat 3]``.
 """
@@ -132,7 +132,7 @@ def main(argv=None) -> None:
     try:
         import siconos  # noqa: F401
     except ImportError:
-        print("siconos: not importable here (optional; issue 14 measured Moreau–Jean 19–1500× slower, first order)")
+        print("siconos: not importable here (optional; Moreau–Jean was measured 19–1500× slower, first order)")
 
 
 if __name__ == "__main__":

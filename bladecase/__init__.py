@@ -106,4 +106,4 @@ __all__ = [
     # study
     "RunResult", "Study", "StudyError", "demo_study", "load_study", "run",
 ]
-__version__ = "0.1.0"
+__version__ = "0.5.0"

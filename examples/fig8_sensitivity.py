@@ -1,4 +1,4 @@
-"""Seed paper, Fig. 8 and issue 13: nonsmooth modes are sensitive to the number of dofs.
+"""Seed paper, Fig. 8, and the admissible periods against the number of dofs: nonsmooth modes are sensitive to it.
 
 System: the paper's chain of Sec. 2 ("in all the computations, k = 1, m = 1/N and d = 1"):
 ``bladecase.chain(n, k=1, m=1/n, gap=1)``, Newton's impact law on the last mass.

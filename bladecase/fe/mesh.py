@@ -190,7 +190,13 @@ _ABAQUS_EXTRA = {
 
 def load_mesh(path: str | os.PathLike, require: Sequence[str] = (), unit: str = "m",
               file_format: str | None = None) -> Mesh:
-    """Read a simplex mesh and its named groups from any file meshio reads.
+    """Read a mesh and its named groups from any file meshio reads.
+
+    The body is ONE cell type (:data:`~bladecase.fe.cells.BODY_TYPES`), of first or second order: in 3-D
+    tetrahedra (``tetra``, ``tetra10``), hexahedra (``hexahedron``, ``hexahedron20``, ``hexahedron27``) or wedges
+    (``wedge``, ``wedge15``, ``wedge18``); in 2-D triangles (``triangle``, ``triangle6``) or quadrilaterals
+    (``quad``, ``quad8``, ``quad9``).  Other body cells (e.g. pyramids) and several body cell types in one mesh
+    (e.g. tetrahedra beside hexahedra or wedges) are refused.
 
     Parameters
     ----------
@@ -216,10 +222,11 @@ def load_mesh(path: str | os.PathLike, require: Sequence[str] = (), unit: str = 
     Raises
     ------
     ValueError
-        Unreadable file (the path and meshio's reason), no tetrahedra nor
-        triangles, non-simplex body cells, mixed element orders, a 2-D mesh
-        off the plane ``z = 0``, degenerate or inverted elements (count and
-        first offender), a required group missing or empty.
+        Unreadable file (the path and meshio's reason); no body cells of an
+        accepted type (above: the message lists them); several body cell types
+        (the counts, and the valid bodies) or mixed element orders; a 2-D mesh
+        off the plane ``z = 0``; degenerate, inverted, twisted or collapsed
+        elements (count and first offender); a required group missing or empty.
 
     Examples
     --------
@@ -248,6 +255,14 @@ def load_mesh(path: str | os.PathLike, require: Sequence[str] = (), unit: str = 
     Traceback (most recent call last):
         ...
     ValueError: mesh .../mixed.vtu has 80 inverted triangle element(s) (negative area); first: element 0, ...
+
+    Hexahedra (and wedges, quadrilaterals) are bodies too, not simplices only:
+
+    >>> import meshio
+    >>> cube = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1.0]])
+    >>> meshio.write(f"{folder.name}/cube.vtu", meshio.Mesh(cube, [("hexahedron", np.arange(8)[None])]))
+    >>> load_mesh(f"{folder.name}/cube.vtu").body_type
+    'hexahedron'
     >>> folder.cleanup()
     """
     import meshio

@@ -56,10 +56,25 @@ def to_rad_s(value: float, unit: str = "rad/s") -> float:
 
 @dataclass(frozen=True)
 class RotationAxis:
-    """The rotation axis: a point ``origin`` and a ``direction`` (normalised here).
+    """The rotation axis: a point ``origin`` and a ``direction`` (normalised here); 2 numbers are ``(x, y)``, the
+    ``z`` component 0.
+
+    A 2-D (plane) model lies in the plane ``z = 0`` and moves in it only: it can spin about an axis only if the
+    centrifugal load stays in its plane, i.e. about an axis perpendicular to the plane (direction ``(0, 0, ±1)``,
+    the blade turning in its own plane; the origin's ``z`` does not matter: it only slides the point along the
+    axis) or an axis in the plane (direction ``(dx, dy, 0)``) through it (origin ``z = 0``: the plane holds the
+    axis, like a meridional section).  Any other axis, tilted or offset out of the plane, would load the model
+    out of its plane, which it cannot carry: :meth:`check_plane` refuses it (``ValueError`` naming the axis and
+    the valid ones) instead of dropping the out-of-plane part; :func:`spin` and :func:`coriolis_matrix` call it.
 
     >>> RotationAxis((0, 0, 0), (0, 0, 2)).direction.tolist()
     [0.0, 0.0, 1.0]
+    >>> RotationAxis((0, 0, 0.1), (1, 0, 0)).check_plane(2)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: a 2-D (plane) model lies in the plane z = 0 and cannot spin about an axis offset out of it: ...
+    >>> RotationAxis((0, 0, 0.1), (0, 0, 1)).check_plane(2).origin.tolist()   # perpendicular: any origin
+    [0.0, 0.0, 0.1]
     """
 
     origin: np.ndarray = (0.0, 0.0, 0.0)
@@ -80,6 +95,30 @@ class RotationAxis:
                              f"{self.direction!r}")
         object.__setattr__(self, "origin", o)
         object.__setattr__(self, "direction", d / norm)
+
+    def check_plane(self, dim: int, scale: float = 1.0) -> RotationAxis:
+        """This axis if a model of dimension ``dim`` can spin about it, else ``ValueError`` (see the class): a 3-D
+        model about any axis; a 2-D (plane) model, lying in ``z = 0``, about an axis perpendicular to its plane
+        (any origin) or in its plane through it (origin ``z = 0``, to ``1e-12 scale``; ``scale``: the model's
+        size, m).  A tilted axis or one offset out of the plane would put part of the centrifugal load out of the
+        plane, where a plane model has no displacement to carry it."""
+        if dim != 2:
+            return self
+        d, o = self.direction, self.origin
+        normal = max(abs(d[0]), abs(d[1])) <= 1e-12
+        in_plane = abs(d[2]) <= 1e-12
+        valid = ("a 2-D model spins about an axis perpendicular to its plane (direction (0, 0, 1), any origin) or "
+                 "about an axis in its plane through it (direction (dx, dy, 0) with origin z = 0)")
+        direction = f"({', '.join(f'{x:.6g}' for x in d)})"
+        if not (normal or in_plane):
+            raise ValueError(f"a 2-D (plane) model lies in the plane z = 0 and cannot spin about a tilted axis: "
+                             f"direction {direction} (normalised) is neither perpendicular to the plane nor in "
+                             f"it, and would load the model out of its plane; {valid}")
+        if in_plane and abs(o[2]) > 1e-12 * max(float(scale), float(np.abs(o).max()), 1e-300):
+            raise ValueError(f"a 2-D (plane) model lies in the plane z = 0 and cannot spin about an axis offset out "
+                             f"of it: origin z = {o[2]:.6g} with a direction in the plane {direction} puts its "
+                             f"centrifugal load out of the plane; {valid}")
+        return self
 
     def projector(self, dim: int) -> np.ndarray:
         """``P⊥ = I − a aᵀ`` on the model's ``dim`` displacement components."""
@@ -145,6 +184,7 @@ class _Operators:
         if dim * basis.N != model.dofs.n_total:
             raise ValueError(f"the model's dof numbering ({model.dofs.n_total} dofs) is not its mesh's "
                              f"({dim * basis.N}): rebuild the model from its mesh")
+        axis.check_plane(dim, float(np.abs(points).max(initial=0.0)))
         self.basis, self.dim, self.free = basis, dim, model.dofs.fe_index
         self.depth = model.thickness if dim == 2 else 1.0
         self.lam, self.mu = model.material.lame(model.plane if dim == 2 else None)
@@ -233,8 +273,9 @@ def spin(model: FEModel, speed: float, axis: RotationAxis | None = None, *, soft
     Raises
     ------
     ValueError
-        A speed that is negative or not finite; a speed at which ``K − Ω² M⊥`` is no longer positive
-        definite (the blade diverges under spin softening: the message gives the speed).
+        An axis a 2-D (plane) model cannot spin about (tilted, or in the plane but offset out of it: see
+        :class:`RotationAxis`); a speed that is negative or not finite; a speed at which ``K − Ω² M⊥`` is no
+        longer positive definite (the blade diverges under spin softening: the message gives the speed).
 
     Examples
     --------

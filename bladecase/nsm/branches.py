@@ -224,7 +224,14 @@ class Branch:
 
     def orbit_at(self, T: float) -> list[PeriodicOrbit]:
         """The branch's orbits of period ``T`` (one per crossing of ``T`` by the curve),
-        each re-solved exactly from the interpolated neighbours.
+        each re-solved exactly from the interpolated neighbours; ``[]`` where the branch does not reach ``T``.
+
+        Newton's contact: the impact times interpolated, then Newton at ``T``.  The massless contact model
+        (a branch of :func:`~bladecase.nsm.massless.branches.massless_modes` or
+        :func:`~bladecase.nsm.massless.branches.massless_mode`): the contact half-time or the half-phase
+        durations interpolated, then Newton at ``T``, through changes of the number of contact phases
+        (:func:`~bladecase.nsm.massless.branches.massless_orbit_at`).  ``T`` on a computed point gives that
+        orbit once.
 
         >>> from bladecase.nsm import chain, nonsmooth_mode
         >>> families = nonsmooth_mode(chain(2, k=1.0, m=0.5, gap=1.0), 2, (13.2, 13.75), scan=2)
@@ -236,7 +243,7 @@ class Branch:
         if getattr(system, "contact_model", "newton") == "massless":
             from .massless.branches import massless_orbit_at
 
-            return massless_orbit_at(system, self.orbits, float(T))
+            return massless_orbit_at(system, self.orbits, T)
         out = []
         Ts = self.T
         T = check_period(system, T)
@@ -248,8 +255,12 @@ class Branch:
             a = (T - Ts[i]) / (Ts[i + 1] - Ts[i])
             guess = (1 - a) * a_orb.impact_times / Ts[i] + a * b_orb.impact_times / Ts[i + 1]
             sol = solve_times(ModalKernel.of(system, T), guess * T, system.gap)
-            if sol is not None:
-                out.append(make_orbit(system, T, *sol))
+            if sol is None:
+                continue
+            orbit = make_orbit(system, T, *sol)
+            if not any(o.impact_times.shape == orbit.impact_times.shape and
+                       np.allclose(orbit.impact_times, o.impact_times, rtol=0, atol=1e-9 * T) for o in out):
+                out.append(orbit)  # T on a computed point: the pairs on both sides give it
         return out
 
     def _arc_through(self, at: float | None) -> Arc | None:
@@ -380,7 +391,14 @@ class Branch:
 
     def table(self, points: bool | None = None) -> str:
         """Human-readable summary: a header line, one row per point (``points``; default: for scans),
-        then the admissible arcs."""
+        then the admissible arcs.
+
+        Newton's contact speaks of impacts (times and impulses); the massless contact model of contact phases
+        (the instants the contact closes, ``∫λ dt`` over each phase, the number of phases per period).
+        """
+        if getattr(self.system, "contact_model", None) == "massless" or any(
+                getattr(o, "contact_model", None) == "massless" for o in self.orbits if o is not None):
+            return self._massless_table(points)
         k, T = self.k, self.T
         lines = [f"{k}-ipp family, {len(self.orbits)} orbits ({self.source}), T in [{T.min():.8g}, {T.max():.8g}]"]
         if points if points is not None else self.source == "scan":
@@ -403,6 +421,33 @@ class Branch:
             lines.append(f"no admissible arc: no admissible {k}-ipp orbit in the {self.source}")
         return "\n".join(lines)
 
+    def _massless_table(self, points: bool | None) -> str:
+        """:meth:`table` of a branch of the massless contact model: contact phases, not impacts."""
+        T = self.T
+        lines = [f"nonsmooth mode (massless contact), {len(self.orbits)} orbits ({self.source}), T in [{T.min():.8g}, "
+                 f"{T.max():.8g}], {_phases(self.orbits)} per period"]
+        if points if points is not None else self.source == "scan":
+            lines.append(f"{'T':>14} {'1/T':>12} {'energy':>12} {'phases':>6} {'contact closes at':>36} "
+                         f"{'∫λ dt per phase':>30} admissible")
+            for Tp, o in zip(T, self.orbits):
+                if o is None:
+                    lines.append(f"{Tp:14.8g} {1 / Tp:12.6g} {'resonant':>12}")
+                    continue
+                times = " ".join(f"{t:.6g}" for t in o.impact_times)
+                imp = " ".join(f"{x:.5g}" for x in o.impulses)
+                lines.append(f"{Tp:14.8g} {1 / Tp:12.6g} {o.energy:12.6g} {o.k:>6} {times:>36} {imp:>30} "
+                             f"{'yes' if o.admissible else 'no'}")
+        lines.append("")
+        if self.arcs:
+            lines.append("admissible intervals of T:")
+            for a in self.arcs:
+                lines.append(f"  admissible arc: T in [{a.T_lo:.12g}, {a.T_hi:.12g}]   "
+                             f"1/T in [{1 / a.T_hi:.8g}, {1 / a.T_lo:.8g}]   (points {a.start}..{a.stop}; "
+                             f"{_phases(self.orbits[a.start: a.stop + 1])} per period)")
+        else:
+            lines.append(f"no admissible arc: no admissible orbit in the {self.source}")
+        return "\n".join(lines)
+
     def stability(self, tol: float | None = None, where=None) -> np.ma.MaskedArray:
         """Floquet verdict of every point: ``True`` (linearly stable) / ``False``, masked where there is no orbit
         or no verdict (:func:`~bladecase.nsm.floquet.branch_stability`; saltation matrices at impacts);
@@ -422,6 +467,15 @@ class Branch:
         from ..post.plots import frequency_energy
 
         return frequency_energy([self], ax=ax, **kwargs)
+
+
+def _phases(orbits: list) -> str:
+    """``"1 contact phase"`` / ``"1 to 3 contact phases"``: the range of the orbits' numbers of contact phases."""
+    counts = sorted({int(o.k) for o in orbits if o is not None})
+    if not counts:
+        return "no contact phase"
+    lo, hi = counts[0], counts[-1]
+    return f"{lo} contact phase{'s' if lo > 1 else ''}" if lo == hi else f"{lo} to {hi} contact phases"
 
 
 def _interval_arc(iv: dict, periods: list[float], orbits: list) -> Arc:

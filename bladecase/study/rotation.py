@@ -36,11 +36,17 @@ def _section(study: Study) -> dict | None:
     return r if r and (r.get("speeds") or r.get("speed") is not None) else None
 
 
-def rotation_axis(study: Study) -> RotationAxis:
-    """``[rotation] axis`` as a :class:`~bladecase.fe.rotation.RotationAxis`."""
+def rotation_axis(study: Study, model=None) -> RotationAxis:
+    """``[rotation] axis`` as a :class:`~bladecase.fe.rotation.RotationAxis`; with ``model``, checked against it:
+    a 2-D (plane) model spins only about an axis perpendicular to its plane or in its plane through it
+    (:meth:`~bladecase.fe.rotation.RotationAxis.check_plane`: a tilted axis, or one offset out of the plane, is a
+    ``StudyError`` naming the axis and the valid ones, never silently flattened)."""
     axis = _section(study)["axis"]
     try:
-        return RotationAxis(axis["origin"], axis["direction"])
+        out = RotationAxis(axis["origin"], axis["direction"])
+        if model is not None:
+            out.check_plane(model.dim, float(np.abs(model.mesh.points).max(initial=0.0)))
+        return out
     except ValueError as exc:
         raise StudyError(f"[rotation] axis: {exc}") from None
 
@@ -88,7 +94,7 @@ def operating_point(study: Study, model, contact, factor=None):
     omega = operating_speed(study)
     if omega is None:
         return model, contact, factor, None
-    axis = rotation_axis(study)
+    axis = rotation_axis(study, model)
     try:
         state = spin(model, omega, axis, static=_section(study).get("static", "auto"))
     except ValueError as exc:
@@ -145,7 +151,7 @@ def campbell_stage(study: Study, model, contact, executor, progress: bool = Fals
     "speed"``, the running clearance at the operating speed plus the closure there: see :func:`operating_point`)."""
     r = _section(study)
     w = speeds(study)
-    axis = rotation_axis(study)
+    axis = rotation_axis(study, model)
     count = min(int(r.get("modes", 6)), model.n_dofs - 1)
     points = executor.map(_speed_point, list(w), shared={"study": study, "model": model, "contact": contact,
                                                          "axis": axis, "count": count,
