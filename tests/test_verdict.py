@@ -281,8 +281,9 @@ def test_failed_checks_say_so_with_their_numbers(demo):
     s["files"]["animations"][0]["reference_check"].update(survives=False, drift=0.4, contacts=2)
     v = verdict(s)
     assert "reference_failed" in v["reasons"] and v["trust"].startswith("Do not trust it yet:")
-    assert (f"the orbit at T = {a['T']:.8g} s did not survive in the reference model massless (37 dofs): it drifts "
-            "by 40% in one period (energy norm), with 2 contact(s) for 1") in v["trust"]
+    assert a["reference_check"]["reference"] == "massless+krylov (36 dofs)"  # 4 × the 9 dofs of the massless 8 model
+    assert (f"the orbit at T = {a['T']:.8g} s did not survive in the reference model massless+krylov (36 dofs): it "
+            "drifts by 40% in one period (energy norm), with 2 contact(s) for 1") in v["trust"]
     assert f"Treat the orbit at T = {a['T']:.8g} s as an artefact of the massless 8 model" in v["next"]
     assert "`[reduction] sizes = [8, 32]`" in v["next"] and not OTHER_MODEL.search(v["next"])
 

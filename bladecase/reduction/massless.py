@@ -306,15 +306,48 @@ def massless_model(model: FEModel, contact: Contact, size: int | None = None,
             V_i = phi / np.sqrt(np.einsum("ij,i,ij->j", phi, masses[split.i], phi))
         else:
             V_i = _m_orthonormal(_interior_modes(split, masses, size, fac), attach, masses[split.i])
-        V = np.zeros((split.w.size, V_i.shape[1]))
-        V[split.i], V[split.c] = V_i, split.slave(V_i)
-        M_r = V_i.T @ (masses[split.i][:, None] * V_i)
-    S_r = split.schur() if size is None else V.T @ (split.K @ V)
+        return _reduced(split, masses, V_i, model, contact, BASES[basis], size)
+    S_r = split.schur()
+    system = MasslessSystem(np.asarray(M_r), 0.5 * (S_r + S_r.T), np.asarray(V.T @ split.w),
+                            series_stiffness(split.kc, contact.casing), contact.gap, casing=contact.casing)
+    return MasslessReducedModel("massless", size, system, V, model, contact, closed_shape=split.closed_shape(),
+                                masses=masses)
+
+
+def _reduced(split: _Split, masses: np.ndarray, V_i: np.ndarray, model: FEModel, contact: Contact, method: str,
+             size: int) -> MasslessReducedModel:
+    """The massless model on the interior basis ``V_i`` (the contact rows slaved: ``V_full``)."""
+    V = np.zeros((split.w.size, V_i.shape[1]))
+    V[split.i], V[split.c] = V_i, split.slave(V_i)
+    M_r = V_i.T @ (masses[split.i][:, None] * V_i)
+    S_r = V.T @ (split.K @ V)
     system = MasslessSystem(0.5 * (M_r + M_r.T), 0.5 * (S_r + S_r.T), np.asarray(V.T @ split.w),
                             series_stiffness(split.kc, contact.casing), contact.gap, casing=contact.casing)
-    method = "massless" if size is None else BASES[basis]
     return MasslessReducedModel(method, size, system, V, model, contact, closed_shape=split.closed_shape(),
                                 masses=masses)
+
+
+def _interior_operator(split: _Split, masses: np.ndarray, fac: SPDFactor):
+    """``X_i -> (K⁻¹ M X)_i`` with ``M`` the redistributed masses (zero on the contact): blocks ``(n_i, k)``."""
+    def apply(X: np.ndarray) -> np.ndarray:
+        full = np.zeros((split.w.size,) + X.shape[1:])
+        full[split.i] = (masses[split.i] * X.T).T
+        return fac.solve(full)[split.i]
+    return apply
+
+
+def extend_massless(reduced: MasslessReducedModel, count: int, fac: SPDFactor) -> MasslessReducedModel:
+    """:func:`bladecase.reduction.extension.krylov_extension` of a massless model: the interior basis extended
+    by the block Krylov sequence of the massless structure (its interior columns and the attachment vector's)."""
+    from .extension import FRONTIER, SUFFIX, extend_basis
+
+    split = _split(reduced.model, reduced.contact)
+    m_i = reduced.masses[split.i]
+    V_i = extend_basis(np.asarray(reduced.basis)[split.i], fac.solve(split.w)[split.i],
+                       _interior_operator(split, reduced.masses, fac), lambda X: (m_i * X.T).T,
+                       min(count, split.i.size - 1), FRONTIER.get(reduced.method))
+    return _reduced(split, reduced.masses, V_i, reduced.model, reduced.contact, reduced.method + SUFFIX,
+                    V_i.shape[1])
 
 
 def _exact_basis(split: _Split) -> sp.csr_array:
@@ -349,24 +382,11 @@ def _krylov(split: _Split, masses: np.ndarray, size: int, fac: SPDFactor) -> np.
     contact), ``j < size``, ``M_ii``-orthonormalised with full re-orthogonalisation (twice); the vectors from
     ``u_1`` on carry the slaved contact rows (their load vanishes on the contact). Stops early, with fewer
     vectors, when the space is exhausted (an invariant subspace to round-off)."""
+    from .extension import extend_basis
+
     m_i = masses[split.i]
-    Q = np.zeros((split.i.size, size + 1))
-    u = fac.solve(split.w)
-    count = 0
-    for _ in range(size + 1):
-        q = u[split.i].copy()
-        size0 = np.sqrt(q @ (m_i * q))
-        for _ in range(2):
-            q -= Q[:, :count] @ (Q[:, :count].T @ (m_i * q))
-        norm = np.sqrt(q @ (m_i * q))
-        if norm <= 1e-10 * size0:
-            break
-        Q[:, count] = q / norm
-        count += 1
-        full = np.zeros(split.w.size)
-        full[split.i] = masses[split.i] * Q[:, count - 1]
-        u = fac.solve(full)
-    return Q[:, :count]
+    return extend_basis(np.zeros((split.i.size, 0)), fac.solve(split.w)[split.i],
+                        _interior_operator(split, masses, fac), lambda X: (m_i * X.T).T, size + 1)
 
 
 def _m_orthonormal(phi: np.ndarray, extra: np.ndarray, m: np.ndarray) -> np.ndarray:

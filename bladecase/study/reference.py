@@ -2,9 +2,18 @@
 
 The event-driven check of :mod:`bladecase.nsm.verify` re-simulates an orbit in the model that produced it, so it
 cannot see a reduction artefact (an orbit whose energy sits in a mesh-scale Ritz mode). Here the orbit is
-expanded to the FE model's free dofs, projected onto a *reference* model — a reduced model of another method and
-at least :data:`REFERENCE_FACTOR` times the size (or the full model when it is small enough) — and simulated
-there for one period from a state in an open phase. The drift between where it starts and where it is one period
+expanded to the FE model's free dofs, projected onto a *reference* model and simulated there for one period from
+a state in an open phase. The reference has :data:`REFERENCE_FACTOR` times the model's dofs and is built one of
+two ways (:data:`REFERENCE_BASES`):
+
+- ``"krylov"`` (the default): the model's own basis extended by the block Krylov sequence of its factorisation
+  (:func:`bladecase.reduction.krylov_extension`): it contains the model, so the orbit is represented exactly and
+  what the check measures is what the added dofs — the part of the contact's load the model misses, from the
+  lowest frequencies up — change. No second eigen-solve: one solve per added dof with the factorisation the
+  model was built with, a fraction of the model's own cost;
+- ``"independent"``: a reduced model of another method (:data:`REFERENCE_METHODS`; the same method for the
+  massless contact model) from its own eigen-solve — independent of the model's basis, and several times the
+  cost of the model it checks. The drift between where it starts and where it is one period
 later, in the reference's energy norm, says whether the orbit survives:
 
     drift = ‖z(T) − z(0)‖_E / ‖z(0)‖_E,   ‖(x, v)‖²_E = xᵀK x + vᵀM v.
@@ -16,11 +25,12 @@ of order one when the orbit does not exist in the structure.
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 
 from .. import log
 from ..fe import FEModel
 from ..linalg import SPDFactor
-from ..reduction import METHODS, Contact, ReducedModel, reduce
+from ..reduction import METHODS, Contact, ReducedModel, krylov_extension, reduce
 
 #: The reference model is at least this many times larger than the model it checks.
 REFERENCE_FACTOR = 4
@@ -32,9 +42,34 @@ SURVIVAL_RTOL = 0.05
 REFERENCE_METHODS = {"newton": ("modal", "craig-bampton", "lanczos-si"), "massless": ("massless",)}
 
 
+#: How a reference model is built (module docstring).
+REFERENCE_BASES = ("krylov", "independent")
+
+
+def study_basis(study) -> str:
+    """The study's ``[output] reference_basis``, ``"auto"`` resolved: ``"independent"`` in a study that compares
+    reduced models (the yardstick of the comparison is built from none of them), ``"krylov"`` otherwise."""
+    basis = study["output"]["reference_basis"]
+    if basis == "auto":
+        return "independent" if study["reduction"]["compare"] else "krylov"
+    return basis
+
+
 def reference_model(model: FEModel, contact: Contact, reduced: ReducedModel,
-                    factor: SPDFactor | None = None) -> ReducedModel:
-    """A reduced model of another method (when the contact model offers one) and ``REFERENCE_FACTOR`` × the size."""
+                    factor: SPDFactor | None = None, basis: str = "krylov") -> ReducedModel:
+    """The reference model of ``reduced``: ``REFERENCE_FACTOR`` × its dofs (module docstring).
+
+    ``basis="krylov"``: ``reduced`` extended by the Krylov sequence of ``factor`` (made when ``None``);
+    ``"independent"``: a reduced model of another method (when the contact model offers one), ``REFERENCE_FACTOR``
+    × the size, from its own eigen-solve. A model that keeps every dof gets the independent kind (nothing to
+    extend).
+    """
+    if basis not in REFERENCE_BASES:
+        raise ValueError(f"basis must be one of {', '.join(map(repr, REFERENCE_BASES))}, got {basis!r}")
+    interior = model.n_dofs - int(np.count_nonzero(contact.w(model))) if reduced.method.startswith("massless") \
+        else model.n_dofs
+    if basis == "krylov" and not sp.issparse(reduced.basis) and reduced.n < interior - 1:
+        return krylov_extension(reduced, REFERENCE_FACTOR * reduced.n, factor)
     contact_model = getattr(reduced.system, "contact_model", "newton")
     methods = [m for m in REFERENCE_METHODS[contact_model] if m in METHODS]
     method = next((m for m in methods if m != reduced.method), methods[0])

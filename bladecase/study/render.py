@@ -24,7 +24,7 @@ from ..reduction import MasslessReducedModel, ReducedModel
 from .choose import Choice, choose_orbits, frame_times
 from .documents import orbit_stability
 from .publish import output_folder, publish, release, staging_dir
-from .reference import check_in_reference, log_check, reference_model
+from .reference import check_in_reference, log_check, reference_model, study_basis
 from .schema import Study
 from .stages import period_unit
 
@@ -227,7 +227,9 @@ def animate_families(study: Study, reduced: ReducedModel, families: list[Branch]
     out = output_folder(study, out)
     staging = staging_dir(out, ("animations", "vtk"))
     try:
-        reference = reference_model(reduced.model, reduced.contact, reduced) if study["output"]["reference"] else None
+        o = study["output"]
+        reference = (reference_model(reduced.model, reduced.contact, reduced, basis=study_basis(study))
+                     if o["reference"] else None)
         entries = render_all(study, reduced, families, staging, progress, reference)
         publish(staging, out, ("animations", "vtk"))
     except BaseException:

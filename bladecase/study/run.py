@@ -31,7 +31,7 @@ from .documents import contact_summary, families_document, family_summary, model
 from .executor import Executor, make_executor
 from .forcing import forced_response, forced_scene
 from .publish import RUN_RESULTS, check_inputs, output_folder, publish, release, staged_names, staging_dir
-from .reference import reference_model
+from .reference import reference_model, study_basis
 from .render import orbit_engineering, render_all
 from .rotation import campbell_stage, operating_point
 from .schema import Study, load_study
@@ -223,11 +223,14 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         log.info("reduced model: %s", reduced)
         log.info("contact stiffness: %s", _stiffness_words(reduced, fe))
         t0 = time.perf_counter()
-        reference = reference_model(model, contact, reduced, factor) if o["reference"] else None
+        reference = (reference_model(model, contact, reduced, factor, study_basis(study)) if o["reference"]
+                     else None)
         build_s.append(time.perf_counter() - t0)
         models_bar.close()
         if reference is not None:
-            log.info("reference model for the orbits' check: %s", reference)
+            log.info("reference model for the orbits' check: %s, %d dofs (%s)", reference.method, reference.n,
+                     "the reduced model extended by the Krylov sequence of its factorisation"
+                     if reference.method.endswith("+krylov") else "from its own eigen-solve")
         # a comparison study compares the reference of the verification too, through the same search
         known = {(r.method, r.size) for r in [reduced, *compares]}
         extra = compares and reference is not None and (reference.method, reference.size) not in known

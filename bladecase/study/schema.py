@@ -190,14 +190,17 @@ SCHEMA: dict[str, dict[str, Key]] = {
                             "one at [rotation] speed ('speed').", _one_of("cold", "speed")),
     },
     "reduction": {
-        "method": Key(_STR, "lanczos-si", f"Reduced model: {', '.join(METHODS)}.", _one_of(*METHODS)),
-        "size": Key(_INT, 20, "Modes / Lanczos steps / fixed-interface modes kept (ignored by 'full').",
-                    _int_between(1, LIMITS["size"])),
+        "method": Key(_STR, "lanczos-si", f"Reduced model: {', '.join(METHODS)}; not set with 'methods': the first "
+                      "of them.", _one_of(*METHODS)),
+        "size": Key(_INT, 20, "Modes / Lanczos steps / fixed-interface modes kept (ignored by 'full'); not set with "
+                    "'sizes': the largest of them.", _int_between(1, LIMITS["size"])),
         "compare": Key(_LIST, [], "Other reduced models run through the same search for comparison: "
                        "[{method = 'modal', size = 20}, …].", _reduction_list),
         "methods": Key(_LIST, [], "A comparison grid: these methods × 'sizes' (default: [method]), each run "
-                       "through the same search, compared in comparison.csv and the report.", _method_names),
-        "sizes": Key(_LIST, [], "Sizes of the comparison grid (default: [size]), e.g. [8, 16, 32, 64].",
+                       "through the same search, compared in comparison.csv and the report; without 'method', the "
+                       "main model's method is the first of them.", _method_names),
+        "sizes": Key(_LIST, [], "Sizes of the comparison grid (default: [size]), e.g. [8, 16, 32, 64]; without "
+                     "'size', the main model's size is the largest of them (no model outside the grid is built).",
                      _size_list),
         "compare_periods": Key(_LIST, [0.9, 0.95, 0.99], "Periods (× the FE model's first period) at which the "
                                "comparison reads each model's energy, e.g. [0.99999, 0.999999] for arcs next to "
@@ -226,9 +229,15 @@ SCHEMA: dict[str, dict[str, Key]] = {
                        "widest admissible arcs, one per family.", _int_between(0, LIMITS["animate"])),
         "orbits": Key(_LIST, [], "Orbits to animate: [{ipp = 1, T = 0.95}, …], T in search.period_unit "
                       "(the nearest admissible orbit of a family of that ipp).", _orbit_list),
-        "reference": Key(_BOOL, True, "Check each chosen orbit in a reference model (another reduction method, "
-                         "4 times the size): an orbit that does not survive there is not animated (unless named "
-                         "in 'orbits', then it is flagged), and the report says so."),
+        "reference": Key(_BOOL, True, "Check each chosen orbit in a reference model (4 times the reduced model's "
+                         "dofs, see 'reference_basis'): an orbit that does not survive there is not animated (unless "
+                         "named in 'orbits', then it is flagged), and the report says so."),
+        "reference_basis": Key(_STR, "auto", "How the reference model is built: 'krylov' (the reduced model's "
+                               "basis extended by the Krylov sequence of its own factorisation: no second "
+                               "eigen-solve), 'independent' (a reduced model of another method from its own "
+                               "eigen-solve, several times the cost) or 'auto' ('independent' in a study that "
+                               "compares reduced models — the yardstick is built from none of them —, 'krylov' "
+                               "otherwise).", _one_of("auto", "krylov", "independent")),
         "frames": Key(_INT, 40, "Frames per period of the animations and VTK time series.",
                       _int_between(2, LIMITS["frames"])),
         "scale": Key((str, int, float), "auto", "Amplitude scale of the animations, or 'auto' (largest "
@@ -479,9 +488,30 @@ def validate(raw: dict, source: str = "<string>", base: str | os.PathLike | None
                 if spec.default is REQUIRED:
                     raise StudyError(f"[{section}] {key}: required ({spec.doc})")
                 out[key] = list(spec.default) if isinstance(spec.default, list) else spec.default
+        if section == "reduction":
+            _grid_main_model(out, given)
         config[section] = out
     cross_checks(config, model=model)
     return Study(config=config, source=source, base=Path(base) if base is not None else Path.cwd())
+
+
+def _grid_main_model(r: dict, given: dict) -> None:
+    """The main model of a comparison grid whose study does not name it: ``method`` not set → the first of
+    ``methods``, ``size`` not set → the largest of ``sizes`` (the grid's most converged model, the one every
+    later stage then uses), so that the grid builds no model the study did not ask for (the schema's defaults,
+    lanczos-si and 20, would add one).
+
+    >>> r = {"method": "lanczos-si", "size": 20, "methods": ["modal"], "sizes": [8, 32, 16]}
+    >>> _grid_main_model(r, {"methods": ["modal"], "sizes": [8, 32, 16]}); (r["method"], r["size"])
+    ('modal', 32)
+    >>> r = {"method": "lanczos-si", "size": 10, "methods": [], "sizes": [8, 16]}
+    >>> _grid_main_model(r, {"size": 10, "sizes": [8, 16]}); (r["method"], r["size"])   # given: kept
+    ('lanczos-si', 10)
+    """
+    if "method" not in given and r["methods"]:
+        r["method"] = r["methods"][0]
+    if "size" not in given and r["sizes"]:
+        r["size"] = max(r["sizes"])
 
 
 #: Largest study file read (bytes): a study is a few kilobytes; a bigger file is not a study (a mesh, a log).
