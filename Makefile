@@ -37,6 +37,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_fe_pipeline.py --skip-110k
 	$(BIN)/python benchmarks/bench_solvers.py --skip-110k
 	$(BIN)/python benchmarks/bench_ccx.py
+	$(BIN)/python benchmarks/bench_reference.py
 	$(BIN)/python benchmarks/bench_executor.py
 	$(BIN)/python benchmarks/bench_simulate.py
 	$(BIN)/python benchmarks/bench_rub.py

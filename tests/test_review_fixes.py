@@ -262,8 +262,11 @@ def test_version_is_the_changelogs_latest():
     import re
     import tomllib
 
-    version = tomllib.loads((_ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]["version"]
+    project = tomllib.loads((_ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    # one place: the package metadata's version is bladecase.__version__ (setuptools' dynamic attr)
+    assert "version" not in project["project"] and "version" in project["project"]["dynamic"]
+    assert project["tool"]["setuptools"]["dynamic"]["version"] == {"attr": "bladecase.__version__"}
     changelog = (_ROOT / "CHANGELOG.md").read_text(encoding="utf-8")
     top = re.search(r"^## \[([^\]]+)\]", changelog, flags=re.M).group(1)
-    assert top == version == bc.__version__ != "0.1.0"
+    assert top == bc.__version__ != "0.1.0"
     assert "still says 0.1.0" not in changelog
