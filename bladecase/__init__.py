@@ -19,75 +19,124 @@ Every public name is re-exported here:
 (True, 0.602841)
 """
 
-from .fe import (
-    BladeGeometry,
-    DofMap,
-    FEModel,
-    Material,
-    Mesh,
-    PlateGeometry,
-    assemble,
-    blade_mesh,
-    load_mesh,
-    natural_frequencies,
-    save_mesh,
-    select_nodes,
-    stiffness_factor,
-)
-from .nsm import (
-    Arc,
-    Backbone,
-    Branch,
-    Damping,
-    Family,
-    Floquet,
-    ForcedTrajectory,
-    Interval,
-    LinearSystem,
-    MasslessSystem,
-    PeriodicOrbit,
-    PhasedOrbit,
-    Spectrum,
-    SweepPoint,
-    Trajectory,
-    backbone,
-    bar,
-    chain,
-    floquet,
-    forced_point,
-    forced_sweep,
-    impact_matrices,
-    make_orbit,
-    massless_mode,
-    nonsmooth_mode,
-    orbit_1ipp,
-    orbits_kipp,
-    simulate,
-    simulate_forced,
-    simulate_forced_massless,
-    verify,
-)
-from .reduction import (
-    FULL_LIMIT,
-    METHODS,
-    Contact,
-    EngineOrderLoad,
-    LanczosChain,
-    MassFactor,
-    PerDofDefect,
-    ReducedModel,
-    SymmetryBasis,
-    engine_order_load,
-    lanczos_chain,
-    mass_factor,
-    nodal_load,
-    per_dof_defect,
-    pressure_load,
-    project_load,
-    radial_normal,
-    reduce,
-)
-from .study import RunResult, Study, StudyError, demo_study, load_study, run
+import importlib
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # what a type checker and an IDE see; at run time each name is imported on first use
+    from .fe import (
+        BladeGeometry,
+        DofMap,
+        FEModel,
+        Material,
+        Mesh,
+        PlateGeometry,
+        assemble,
+        blade_mesh,
+        load_mesh,
+        natural_frequencies,
+        save_mesh,
+        select_nodes,
+        stiffness_factor,
+    )
+    from .nsm import (
+        Arc,
+        Backbone,
+        Branch,
+        Damping,
+        Family,
+        Floquet,
+        ForcedTrajectory,
+        Interval,
+        LinearSystem,
+        MasslessSystem,
+        PeriodicOrbit,
+        PhasedOrbit,
+        Spectrum,
+        SweepPoint,
+        Trajectory,
+        backbone,
+        bar,
+        chain,
+        floquet,
+        forced_point,
+        forced_sweep,
+        impact_matrices,
+        make_orbit,
+        massless_mode,
+        nonsmooth_mode,
+        orbit_1ipp,
+        orbits_kipp,
+        simulate,
+        simulate_forced,
+        simulate_forced_massless,
+        verify,
+    )
+    from .reduction import (
+        FULL_LIMIT,
+        METHODS,
+        Contact,
+        EngineOrderLoad,
+        LanczosChain,
+        MassFactor,
+        PerDofDefect,
+        ReducedModel,
+        SymmetryBasis,
+        engine_order_load,
+        lanczos_chain,
+        mass_factor,
+        nodal_load,
+        per_dof_defect,
+        pressure_load,
+        project_load,
+        radial_normal,
+        reduce,
+    )
+    from .study import RunResult, Study, StudyError, demo_study, load_study, run
+
+#: Where each public name lives: it is imported from there on first use (a fast ``import bladecase``).
+_EXPORTS = {
+    "fe": (
+        "BladeGeometry", "DofMap", "FEModel", "Material", "Mesh", "PlateGeometry", "assemble", "blade_mesh",
+        "load_mesh", "natural_frequencies", "save_mesh", "select_nodes", "stiffness_factor",
+    ),
+    "nsm": (
+        "Arc", "Backbone", "Branch", "Damping", "Family", "Floquet", "ForcedTrajectory", "Interval", "LinearSystem",
+        "MasslessSystem", "PeriodicOrbit", "PhasedOrbit", "Spectrum", "SweepPoint", "Trajectory", "backbone", "bar",
+        "chain", "floquet", "forced_point", "forced_sweep", "impact_matrices", "make_orbit", "massless_mode",
+        "nonsmooth_mode", "orbit_1ipp", "orbits_kipp", "simulate", "simulate_forced", "simulate_forced_massless",
+        "verify",
+    ),
+    "reduction": (
+        "FULL_LIMIT", "METHODS", "Contact", "EngineOrderLoad", "LanczosChain", "MassFactor", "PerDofDefect",
+        "ReducedModel", "SymmetryBasis", "engine_order_load", "lanczos_chain", "mass_factor", "nodal_load",
+        "per_dof_defect", "pressure_load", "project_load", "radial_normal", "reduce",
+    ),
+    "study": (
+        "RunResult", "Study", "StudyError", "demo_study", "load_study", "run",
+    ),
+}
+_WHERE = {name: module for module, names in _EXPORTS.items() for name in names}
+
+#: The subpackages and modules reachable as attributes (``bladecase.fe``), imported on first use.
+_SUBMODULES = frozenset({"fe", "reduction", "nsm", "post", "study", "cli", "linalg", "checks", "io", "log",
+                         "progress", "registry"})
+
+
+def __getattr__(name: str):
+    """Import a public name (or a subpackage) the first time it is used (PEP 562)."""
+    if name in _WHERE:
+        value = getattr(importlib.import_module(f".{_WHERE[name]}", __name__), name)
+    elif name in _SUBMODULES:
+        value = importlib.import_module(f".{name}", __name__)
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__) | _SUBMODULES)
+
 
 __all__ = [
     # fe
