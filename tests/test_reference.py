@@ -64,6 +64,10 @@ def test_run_animates_no_orbit_that_fails_and_says_why(tmp_path):
     assert s["files"]["animations"] == [] and s["reference"]["method"] != s["reduction"]["method"]
     report = (result.directory / "report.md").read_text()
     assert "No orbit animated" in report and "artefacts of the reduced model" in report
+    tried = s["reference"]["rejected"]  # every orbit tried, with the figures of its failed check
+    assert tried and all(not c["survives"] and (c["drift"] is None or c["drift"] > SURVIVAL_RTOL) for c in tried)
+    assert f"T = {tried[0]['T']:.8g} s" in report and "unless `[output] animate = 0`" not in report
+    assert "unless `[output] animate = 0`" not in " ".join(v for v in s["verdict"].values() if isinstance(v, str))
     log = (result.directory / "run.log").read_text()
     assert "do not survive in the reference model" in log
     assert not np.isnan(s["reference"]["reduced_dofs"])
@@ -109,3 +113,14 @@ def test_massless_study_keys_go_together():
         loads(PLATE.replace('method = "modal"', 'method = "massless"'), base=ROOT)
     with pytest.raises(StudyError, match=r"\[contact\] model"):
         loads(PLATE.replace("[contact]\n", '[contact]\nmodel = "penalty"\n'), base=ROOT)
+
+
+def test_no_orbit_tried_is_said_as_such(tmp_path):
+    """With `[output] animate = 0` nothing is checked: the report and the verdict say no orbit was tried, not that
+    the orbits tried failed."""
+    st = loads(MASSLESS_PLATE.replace("frames = 6", "frames = 6\nanimate = 0"), base=ROOT)
+    s = run(st, out=tmp_path / "out", progress=False).summary
+    assert s["files"]["animations"] == [] and s["reference"]["rejected"] == []
+    report = (tmp_path / "out" / "report.md").read_text()
+    assert "**No orbit animated:** no orbit was tried (`[output] animate = 0`" in report
+    assert "artefacts" not in report.split("## Files")[0]

@@ -8,7 +8,14 @@ from .casing import casing_report
 from .nodal_report import nodal_report
 from .rotation_report import rotation_report
 from .rub_report import rub_report
-from .verdict import NARROW_RTOL, massless_summary, narrow_words, orbit_words, verdict  # noqa: F401 (re-exported)
+from .verdict import (  # noqa: F401 (re-exported)
+    NARROW_RTOL,
+    massless_summary,
+    narrow_words,
+    orbit_words,
+    rejected_words,
+    verdict,
+)
 
 
 def engineering_words(a: dict, massless: bool) -> str:
@@ -125,9 +132,17 @@ def report(summary: dict) -> str:
                   "top says why)."]
     elif summary.get("reference") and not files.get("animations"):
         ref = summary["reference"]
-        lines += ["", f"**No orbit animated:** unless `[output] animate = 0`, no admissible orbit of the {r['method']} "
-                  f"model that was tried survives in the reference model {ref['method']} ({ref['reduced_dofs']} dofs) "
-                  "— the families above are artefacts of the reduced model (run.log names the orbits)."]
+        words = rejected_words(summary)
+        if words is None:
+            lines += ["", f"**No orbit animated:** unless `[output] animate = 0`, no admissible orbit of the "
+                      f"{r['method']} model that was tried survives in the reference model {ref['method']} "
+                      f"({ref['reduced_dofs']} dofs) — the families above are artefacts of the reduced model (run.log "
+                      "names the orbits)."]
+        elif ref["rejected"]:
+            lines += ["", f"**No orbit animated:** {words} — the families above are artefacts of the reduced "
+                      f"model ({r['method']})."]
+        else:
+            lines += ["", f"**No orbit animated:** {words}."]
     lines += ["", "## Files", ""]
     if "frequency_energy_plot" in files:
         lines += [f"![frequency–energy]({files['frequency_energy_plot']})", ""]

@@ -126,6 +126,29 @@ def verdict(summary: dict, modes: dict | str | os.PathLike | None = None) -> dic
     return _Verdict(summary, _modes(modes)).result()
 
 
+def rejected_words(summary: dict) -> str | None:
+    """Why no orbit was animated although a reference check ran, from ``summary["reference"]["rejected"]``: the
+    orbits tried and their figures, or that none was tried; ``None`` when the summary does not say (no
+    reference model, or a summary written before it recorded them)."""
+    ref = summary.get("reference") or {}
+    if "rejected" not in ref:
+        return None
+    tried = ref["rejected"]
+    where = f"the reference model {ref['method']} ({ref['reduced_dofs']} dofs)"
+    if not tried:
+        return ("no orbit was tried (`[output] animate = 0`, or no orbit named in `[output] orbits` was found), so "
+                f"{where} checked none")
+
+    def one(c: dict) -> str:
+        why = (f"drifts by {c['drift']:.1e} in one period" if c.get("drift") is not None
+               else c.get("reason", "cannot start in an open phase"))
+        contacts = ("" if c.get("contacts") in (None, c.get("ipp")) or c.get("drift") is None
+                    else f", {c['contacts']} contact(s) for {c['ipp']}")
+        return f"T = {c['T']:.8g} s ({c['frequency_hz']:.5g} Hz) {why}{contacts}"
+    shown = "; ".join(one(c) for c in tried[:4]) + (f"; and {len(tried) - 4} more" if len(tried) > 4 else "")
+    return f"{_plural(len(tried), 'orbit')} tried, none survives in {where}: {shown}"
+
+
 def narrow_words(summary: dict) -> str | None:
     """Where the widest admissible arc lies, when it is narrower than :data:`NARROW_RTOL` (``None`` otherwise): in
     words that hold for both contact models — next to grazing, or a narrow stretch some way above the linear
@@ -701,7 +724,8 @@ class _Verdict:
             if self._switch_advised(bool(lost)):
                 at, lo, hi = self.scatter()
                 tried = ("the orbits tried do not survive in the reference model" if lost else
-                         "no orbit was animated (none survived the reference check, unless `[output] animate = 0`)")
+                         rejected_words(s) or "no orbit was animated (none survived the reference check, unless "
+                         "`[output] animate = 0`)")
                 steps.append(f"With Newton's impact law the orbits depend on the reduced model here: {tried}, and "
                              f"the energies at {at} range from {lo:.3g} to {hi:.3g} J across the compared models; the "
                              "massless contact model ([contact] model = \"massless\", docs/massless.md) has no "
@@ -711,10 +735,14 @@ class _Verdict:
                         + ", ".join(f"{a['T']:.8g}" for a in lost) + " s")
                 steps.append(f"Treat {what} as {'an artefact' if len(lost) == 1 else 'artefacts'} of the {model} "
                              f"model until a larger model shows {'it' if len(lost) == 1 else 'them'}{grid}.")
+            elif (words := rejected_words(s)) is not None and not s["reference"]["rejected"]:
+                steps.append(f"No orbit was animated, so nothing confirms the arcs: {words}; set `[output] animate` "
+                             "to check the arcs' orbits in the reference model.")
             else:
-                steps.append("No orbit was animated, so nothing confirms the arcs: unless `[output] animate = 0`, "
-                             f"every orbit tried failed the reference check (run.log names them) and the arcs are "
-                             f"artefacts of the {model} model until a larger model shows them{grid}.")
+                tried = (f"{words}; " if words else "unless `[output] animate = 0`, every orbit tried failed the "
+                         "reference check (run.log names them) and ")
+                steps.append(f"No orbit was animated, so nothing confirms the arcs: {tried}the arcs are artefacts of "
+                             f"the {model} model until a larger model shows them{grid}.")
         elif self.anims and s.get("reference") is None and not self.comparison_rows():
             steps.append("Check it in a larger model: `[output] reference = true` re-simulates the animated orbits in "
                          "a model four times larger" + (f", and `[reduction] sizes = [{size}, {4 * size}]` compares "

@@ -189,17 +189,24 @@ def _energy_split(orbit, reference: ReducedModel | None) -> dict:
 
 
 def render_all(study: Study, reduced: ReducedModel, families: list[Branch], folder: Path,
-               progress: bool = False, reference: ReducedModel | None = None) -> list[dict]:
+               progress: bool = False, reference: ReducedModel | None = None,
+               rejected: list | None = None) -> list[dict]:
     """Choose the orbits (:func:`~bladecase.study.choose.choose_orbits`; with a ``reference`` model, only
-    orbits that survive there) and render each."""
+    orbits that survive there) and render each. ``rejected``, a list, receives the check of every orbit tried
+    that did not survive (``T``, ``frequency_hz``, ``ipp`` and :func:`check_in_reference`'s figures)."""
     unit, _ = period_unit(study, reduced.system)
-    rejected: list = []
+    rejected = [] if rejected is None else rejected
 
     def survives(orbit) -> bool:
-        ok = check_in_reference(orbit, reduced, reference)["survives"]
-        if not ok:
-            rejected.append(orbit)
-        return ok
+        check = check_in_reference(orbit, reduced, reference)
+        if not check["survives"]:
+            drift = check["drift"] if np.isfinite(check["drift"]) else None  # None: it started beyond the casing
+            rejected.append({"T": float(orbit.T), "frequency_hz": float(1.0 / orbit.T), "ipp": int(orbit.k),
+                             **{k: v for k, v in check.items() if k != "reference"}, "drift": drift})
+            log.info("orbit T = %.8g s does not survive in the reference model %s: drift %.1e (energy norm), %d "
+                     "contact(s) for %d%s", orbit.T, check["reference"], check["drift"], check["contacts"],
+                     orbit.k, f" ({check['reason']})" if check.get("reason") else "")
+        return check["survives"]
 
     chosen = choose_orbits(study, families, unit, accept=None if reference is None else survives)
     if rejected:

@@ -268,7 +268,8 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         with stage("campbell"):
             campbell = _campbell(study, rest_model, cold_contact, executor, progress, staging, files)
     with stage("render"):
-        files["animations"] = render_all(study, reduced, families, staging, progress, reference)
+        rejected: list = []
+        files["animations"] = render_all(study, reduced, families, staging, progress, reference, rejected)
     forcing = None
     if study["forcing"]["amplitude"] is not None:
         with stage("forcing"):
@@ -311,7 +312,7 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         "rotation": rotation,
         "campbell": campbell,
         "reduction": reduced_summary(reduced, f_fe, fe),
-        "reference": None if reference is None else reduced_summary(reference, f_fe),
+        "reference": None if reference is None else dict(reduced_summary(reference, f_fe), rejected=rejected),
         "compare": [dict(reduced_summary(r, f_fe), families=[family_summary(f) for f in fams])
                     for r, fams in zip(compares, compare_families)],
         "search": {**study["search"], "period_unit_s": unit},
