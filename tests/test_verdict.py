@@ -213,17 +213,21 @@ def test_a_stiff_compliant_casing_and_a_newton_narrow_arc(rigid):
 
 
 def test_orbits_rejected_by_the_reference_model(newton):
-    """The Newton plate with the reference check: arcs, but no orbit animated — "Unchecked", and the report's
+    """The Newton plate with the reference check: arcs, but every orbit tried fails the check — "Do not trust it
+    yet", naming the orbits tried and their drifts (from summary.json's reference.rejected), and the report's
     "No orbit animated" paragraph (only because the family table is not empty) with no advice about the other
     contact model, which the study's data do not call for."""
     summary, text = newton
     v = summary["verdict"]
     _check(v)
     assert summary["files"]["animations"] == [] and any(f["admissible_arcs"] for f in summary["families"])
-    assert {"mode_found", "not_animated"} <= set(v["reasons"]) and "switch_contact_model" not in v["reasons"]
-    assert v["trust"].startswith("Unchecked:")
+    assert {"mode_found", "not_animated", "reference_failed"} <= set(v["reasons"])
+    assert "switch_contact_model" not in v["reasons"]
+    tried = summary["reference"]["rejected"]
+    assert v["trust"].startswith("Do not trust it yet:") and f"{len(tried)} orbits tried, none survives" in v["trust"]
     assert f"reference model {summary['reference']['method']} ({summary['reference']['reduced_dofs']} dofs)" \
            in v["trust"]
+    assert f"T = {tried[0]['T']:.8g} s" in v["trust"] and f"drifts by {tried[0]['drift']:.1e}" in v["trust"]
     assert "one impact per period" in v["found"] and "impulses up to" in v["found"]
     assert "No orbit animated" in text and "artefacts of the reduced model" in text
     assert "| family | ipp |" in text

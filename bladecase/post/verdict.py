@@ -68,7 +68,8 @@ REASONS = {
     "verified": "every animated orbit re-simulates to itself (files.animations[*].verification.ok)",
     "verification_failed": "an animated orbit does not re-simulate to itself (verification.ok false)",
     "reference_survived": "every animated orbit survives in the reference model (reference_check.survives)",
-    "reference_failed": "an animated orbit does not survive in the reference model (reference_check.survives false)",
+    "reference_failed": "an animated orbit does not survive in the reference model (reference_check.survives false), "
+                        "or no orbit was animated because every orbit tried failed the check (reference.rejected)",
     "not_animated": "admissible arcs, but no orbit animated: nothing was re-simulated or checked",
     "no_reference_check": "no reference model ([output] reference = false: summary reference is null)",
     "reduced_model_matches_fe": "the reduced model's frequencies match the FE model's within FREQUENCY_RTOL "
@@ -482,10 +483,20 @@ class _Verdict:
             else:
                 self.code("not_animated")
                 ref = self.s.get("reference")
-                doubts.append("no orbit was animated, so none was re-simulated"
-                              + (f" or checked in the reference model {ref['method']} ({ref['reduced_dofs']} dofs) "
-                                 "— summary.json keeps no record of orbits the reference check rejected (run.log "
-                                 "names them)" if ref else ""))
+                words = rejected_words(self.s)
+                if ref and words and ref["rejected"]:
+                    self.code("reference_failed")
+                    bad = True
+                    facts_or_doubts = f"no orbit was animated: {words}"
+                elif ref and words:
+                    facts_or_doubts = f"no orbit was animated, so none was re-simulated; {words}"
+                elif ref:
+                    facts_or_doubts = (f"no orbit was animated, so none was re-simulated or checked in the reference "
+                                       f"model {ref['method']} ({ref['reduced_dofs']} dofs) — this summary keeps no "
+                                       "record of orbits the reference check rejected (run.log names them)")
+                else:
+                    facts_or_doubts = "no orbit was animated, so none was re-simulated"
+                doubts.append(facts_or_doubts)
         self._reduced_vs_fe(facts, doubts)
         self._comparison(facts, doubts)
         self._tip(limits)
