@@ -42,6 +42,15 @@ def nodal_report(section: dict | None) -> list[str]:
              f"{top['max_penetration_mm'] * 1e3:.0f} µm"
              + ("" if stable is None else f"; {stable:.0%} of the orbits are linearly stable") + ".",
              f"- The family ends: {section['stop']}."]
+    ref = section.get("reference")
+    if ref and ref.get("checked"):
+        bad = ref["checked"] - ref["survived"]
+        lines.append(f"- Checked: {ref['checked']} orbits, evenly spread over the family, re-simulated for one period "
+                     f"in the reference model {ref['model']} (the model extended by the Krylov sequence of its "
+                     f"factorisation): " + (f"all come back within {ref['max_drift']:.1e} (energy norm)." if not bad
+                                            else f"**{bad} do not come back** (drift up to {ref['max_drift']:.1e}): "
+                                            "those orbits are artefacts of the reduced model; enlarge "
+                                            "`[reduction] size`."))
     fm = section.get("face_mean")
     if fm and fm.get("energy_j"):
         e = np.asarray(fm["energy_j"])

@@ -27,6 +27,7 @@ fine mesh has no converged limit: the results then depend on the mesh (as for an
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -40,7 +41,7 @@ from .contact import Contact
 from .massless import _HINT, _K, _check_lumped, _interior_modes, _Split, massless_masses
 from .model import ReducedModel
 
-__all__ = ["NodalReducedModel", "nodal_model"]
+__all__ = ["NodalReducedModel", "nodal_extension", "nodal_model"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -58,6 +59,7 @@ class NodalReducedModel(ReducedModel):
     masses: np.ndarray = field(default=None, repr=False)  # type: ignore[assignment]
     normal_map: sp.csr_array = field(default=None, repr=False)  # type: ignore[assignment]
     interior: np.ndarray = field(default=None, repr=False)  # type: ignore[assignment]
+    residual: bool = False
 
     def free_dofs(self, x_r, gap=None) -> np.ndarray:
         """Free-dof displacements of reduced states, each pressed node's correction included."""
@@ -184,7 +186,44 @@ def nodal_model(model: FEModel, contact: Contact, size: int, factor: SPDFactor |
     k = _node_casing(contact, m, casing)
     system = NodalSystem(M_r, S_r, V.T @ Wfull, Hs, d, k, nodes=tuple(model.mesh.node_id(k) for k in nodes))
     return NodalReducedModel("massless-nodes", size, system, V, model, contact, closed_shapes=closed,
-                             masses=masses, normal_map=N, interior=V_i)
+                             masses=masses, normal_map=N, interior=V_i, residual=residual)
+
+
+def nodal_extension(nodal: NodalReducedModel, count: int, factor: SPDFactor | None = None) -> NodalReducedModel:
+    """``nodal`` extended to ``count`` interior dofs by the block Krylov sequence of the massless structure started
+    from the nodes' attachment vectors (:func:`bladecase.reduction.extension.extend_basis`; the interior modes are
+    not applied again, they are invariant), rebuilt by :func:`nodal_model` on that interior with the same casing and residual choice —
+    a richer model containing ``nodal``, for checking its orbits, from the same factorisation and no eigen-solve.
+
+    >>> from skfem import MeshTri
+    >>> from bladecase.fe import Mesh, assemble
+    >>> t = MeshTri.init_tensor(np.linspace(0, 0.1, 21), np.linspace(0, 0.02, 5))
+    >>> p = np.c_[t.p.T, np.zeros(t.p.shape[1])]
+    >>> strip = Mesh(p, {"triangle": t.t.T}, dim=2, groups={"root": np.flatnonzero(p[:, 0] == 0),
+    ...                                                     "tip": np.flatnonzero(p[:, 0] == 0.1)})
+    >>> model = assemble(strip, "steel", order=1, thickness=0.002, mass="lumped")
+    >>> nodal = nodal_model(model, Contact.face(model, "tip", (1.0, 0.0), 1e-4, weights="area"), 6, residual=True)
+    >>> nodal_extension(nodal, 24).system
+    NodalSystem(n=24, m=5 contacts, gap 0.0001–0.0001 m, rigid)
+    """
+    from .extension import SUFFIX, extend_basis
+    from .massless import _interior_operator
+
+    model, contact = nodal.model, nodal.contact
+    count = integer("count", count, nodal.n, note=f" (at least the model's {nodal.n} dofs)")
+    factor = check_factor(factor, model.K, "this model's K", "bladecase.fe.stiffness_factor(model)")
+    fac = factor if factor is not None else spd_factor(model.K, _K, hint=_HINT)
+    N = nodal.normal_map
+    c = np.flatnonzero(np.asarray(abs(N).sum(axis=0)).ravel())
+    i = np.setdiff1d(np.arange(model.n_dofs), c)
+    split = _Split(np.zeros(model.n_dofs), c, i, sp.csr_array(model.K), None, None)  # what the operator needs
+    m_i = nodal.masses[i]
+    V_i = extend_basis(nodal.interior, fac.solve(N.T.toarray())[i], _interior_operator(split, nodal.masses, fac),
+                       lambda X: (m_i * X.T).T, min(count, i.size - 1),
+                       frontier=() if nodal.residual else range(nodal.size, nodal.interior.shape[1]))
+    out = nodal_model(model, contact, nodal.size, fac, casing=nodal.system.casing, interior=V_i,
+                      residual=nodal.residual)
+    return dataclasses.replace(out, method=nodal.method + SUFFIX, size=V_i.shape[1])
 
 
 def _node_casing(contact: Contact, m: int, casing) -> np.ndarray:

@@ -6,7 +6,9 @@ clearance while the tip's corners may run far past it. With ``points = "nodes"``
 massless contact per face node (:func:`bladecase.reduction.nodes.nodal_model`, the residual correction, ``[reduction]
 size`` modes) and its nonsmooth mode is followed from the first node's grazing
 (:func:`bladecase.nsm.massless.nodal_modes.nodal_family`): each orbit's frequency, energy, the nodes that touch,
-each node's peak force, contact fraction and casing yield, its Floquet verdict. Outputs: ``nodal_modes.csv`` (one
+each node's peak force, contact fraction and casing yield, its Floquet verdict; with ``[output] reference``, up to
+:data:`REFERENCE_CHECKS` orbits, evenly spread, re-simulated for one period in the nodal model's Krylov extension
+(four times its dofs, :func:`bladecase.reduction.nodes.nodal_extension`). Outputs: ``nodal_modes.csv`` (one
 row per orbit), ``nodal_modes.png`` (frequency–energy of both models, and the largest penetration over the face's
 nodes against energy), ``summary.json["nodal_modes"]``, a section of the report.
 """
@@ -20,12 +22,13 @@ import numpy as np
 from .. import log
 from ..io import save_figure, write_text
 from ..nsm.massless.nodal_modes import nodal_family
-from ..reduction.nodes import nodal_model
+from ..reduction.nodes import nodal_extension, nodal_model
+from .reference import REFERENCE_FACTOR, check_nodal_in_reference
 
 __all__ = ["nodal_stage"]
 
 COLUMNS = ("frequency_hz", "period_s", "energy_j", "nodes_touching", "touching_nodes", "max_force_n",
-           "max_contact_fraction", "max_penetration_mm", "max_tip_mm", "stable", "residual")
+           "max_contact_fraction", "max_penetration_mm", "max_tip_mm", "stable", "residual", "reference_drift")
 
 
 def _face_penetration(reduced, contact, model, family) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -47,6 +50,34 @@ def _face_penetration(reduced, contact, model, family) -> tuple[np.ndarray, np.n
     return np.array(energies), np.array(beyond), np.array(freqs)
 
 
+#: Orbits of the family checked in the reference model (evenly spread, both ends included).
+REFERENCE_CHECKS = 5
+
+
+def _reference_checks(study, nodal, orbits, factor) -> dict | None:
+    """Up to :data:`REFERENCE_CHECKS` orbits checked in the nodal model's Krylov extension (``REFERENCE_FACTOR`` ×
+    its dofs; :func:`~bladecase.study.reference.check_nodal_in_reference`), when ``[output] reference``."""
+    if not study["output"]["reference"] or not orbits:
+        return None
+    reference = nodal_extension(nodal, REFERENCE_FACTOR * nodal.n, factor)
+    picked = np.unique(np.linspace(0, len(orbits) - 1, min(REFERENCE_CHECKS, len(orbits))).round().astype(int))
+    drifts, survived, name = {}, [], f"{reference.method} ({reference.n} dofs)"
+    for n in picked:
+        check = check_nodal_in_reference(orbits[n], nodal, reference)
+        if check["survives"] is None:
+            continue
+        drifts[int(n)] = check["drift"]
+        survived.append(check["survives"])
+        if not check["survives"]:
+            log.warning("every face node a contact: the orbit at %.6g Hz does NOT survive in the reference model %s: "
+                        "drift %.1e (energy norm) in one period", orbits[n].frequency, name, check["drift"])
+    worst = max(drifts.values(), default=None)
+    log.info("every face node a contact: %d of %d orbits checked survive in the reference model %s (drift up to "
+             "%s)", sum(survived), len(survived), name, "—" if worst is None else f"{worst:.1e}")
+    return {"model": name, "checked": len(survived), "survived": int(sum(survived)), "max_drift": worst,
+            "drifts": drifts}
+
+
 def nodal_stage(study, model, contact, families, reduced, *, factor=None, folder: str | Path | None = None,
                 figures: bool = True, title: str | None = None) -> dict:
     """The nonsmooth mode with one contact per face node of ``contact`` on ``model`` (module docstring), beside
@@ -56,8 +87,9 @@ def nodal_stage(study, model, contact, families, reduced, *, factor=None, folder
     nodal = nodal_model(model, contact, size, factor=factor, residual=True)
     fam = nodal_family(nodal.system, 0)
     orbits = fam.orbits
+    checks = _reference_checks(study, nodal, orbits, factor)
     rows = []
-    for o in orbits:
+    for n, o in enumerate(orbits):
         pen = np.asarray(o.penetration)
         rows.append({"frequency_hz": float(o.frequency), "period_s": float(o.T), "energy_j": float(o.energy),
                      "nodes_touching": int(len(o.touching_nodes)),
@@ -65,7 +97,8 @@ def nodal_stage(study, model, contact, families, reduced, *, factor=None, folder
                      "max_force_n": float(np.max(o.peak_force)),
                      "max_contact_fraction": float(np.max(o.contact_fraction)),
                      "max_penetration_mm": float(np.max(pen)) * 1e3 if np.isfinite(pen).all() else 0.0,
-                     "max_tip_mm": float(o.max_tip) * 1e3, "stable": bool(o.stable()), "residual": float(o.residual)})
+                     "max_tip_mm": float(o.max_tip) * 1e3, "stable": bool(o.stable()), "residual": float(o.residual),
+                     "reference_drift": (checks["drifts"].get(n) if checks else None)})
     stable = [r["stable"] for r in rows]
     section = {
         "size": size, "contact_nodes": nodal.system.m, "reduced_dofs": nodal.system.n,
@@ -75,6 +108,7 @@ def nodal_stage(study, model, contact, families, reduced, *, factor=None, folder
         "stable_fraction": float(np.mean(stable)) if stable else None,
         "first_touch_nodes": next((r["touching_nodes"].split() for r in rows if r["touching_nodes"]), []),
         "most_nodes_touching": max((r["nodes_touching"] for r in rows), default=0),
+        "reference": None if checks is None else {k: v for k, v in checks.items() if k != "drifts"},
         "rows": rows,
     }
     face = [f for f in families if f.arcs]
@@ -89,15 +123,22 @@ def nodal_stage(study, model, contact, families, reduced, *, factor=None, folder
              ", ".join(section["first_touch_nodes"]), section["frequency_range_hz"][1] if rows else np.nan, fam.stop)
     if folder is not None:
         folder = Path(folder)
-        lines = [",".join(COLUMNS)] + [",".join(f"{r[c]:.9g}" if isinstance(r[c], float) and not isinstance(
-            r[c], bool) else str(r[c]).lower() if isinstance(r[c], bool) else str(r[c]) for c in COLUMNS)
-            for r in rows]
+        lines = [",".join(COLUMNS)] + [",".join(_cell(r[c]) for c in COLUMNS) for r in rows]
         write_text(folder / "nodal_modes.csv", "\n".join(lines) + "\n")
         section["files"] = {"csv": "nodal_modes.csv"}
         if figures and rows:
             save_figure(_figure(section, title), folder / "nodal_modes.png")
             section["files"]["figure"] = "nodal_modes.png"
     return section
+
+
+def _cell(value) -> str:
+    """A CSV cell: floats to 9 digits, booleans lower-case, ``None`` (not checked) empty."""
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return str(value).lower()
+    return f"{value:.9g}" if isinstance(value, float) else str(value)
 
 
 def _figure(section: dict, title: str | None):

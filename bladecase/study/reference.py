@@ -133,3 +133,44 @@ def log_check(check: dict, k: int, T: float) -> None:
         log.warning("orbit T = %.8g s does NOT survive in the reference model %s: drift %.1e (energy norm), %d "
                     "contact(s) for %d — an artefact of the reduced model", T, check["reference"], check["drift"],
                     check["contacts"], k)
+
+
+def check_nodal_in_reference(orbit, nodal, reference) -> dict:
+    """The check of :func:`check_in_reference` for an orbit with one contact per node (a
+    :class:`~bladecase.nsm.massless.nodal_modes.NodalOrbit` of ``nodal.system``): from the middle of its longest
+    phase with every node open, projected onto ``reference`` (:func:`bladecase.reduction.nodes.nodal_extension`),
+    one period of :func:`~bladecase.nsm.massless.nodes.simulate_nodes` there.
+
+    Returns ``{"reference", "drift", "switches"`` (in the reference) ``, "expected"`` (the orbit's phase changes
+    per period) ``, "survives"}``; an orbit with no phase where every node is open is not checked (``"survives":
+    None`` and a ``"reason"``). It survives when its drift is at most :data:`SURVIVAL_RTOL`: with many nodes, the
+    count of switches is no test of its own (nodes that switch together in the orbit may switch a round-off apart
+    in the reference, a grazing node may touch there), so it is given, not judged.
+    """
+    from ..nsm.massless.nodes import simulate_nodes
+
+    name = f"{reference.method} ({reference.n} dofs)"
+    open_ = np.flatnonzero(~orbit.active.any(axis=1))
+    if not open_.size:
+        return {"reference": name, "drift": None, "switches": 0, "expected": int(len(orbit.starts)),
+                "survives": None, "reason": "no phase of the orbit has every node open"}
+    j = open_[np.argmax(orbit.durations[open_])]
+    t0 = orbit.starts[j] + 0.5 * orbit.durations[j]
+    x_r, v_r = (z[:, 0] for z in orbit.state(np.array([t0])))
+    V, Mdiag = np.asarray(reference.basis), reference.masses
+    MV = Mdiag[:, None] * V
+    G = V.T @ MV
+    q0 = np.linalg.solve(G, MV.T @ np.asarray(nodal.basis @ x_r))
+    p0 = np.linalg.solve(G, MV.T @ np.asarray(nodal.basis @ v_r))
+    s = reference.system
+    traj = simulate_nodes(s, q0, p0, orbit.T)
+    xT, vT = (z[:, 0] for z in traj.state(np.array([orbit.T])))
+
+    def norm2(x, v):
+        return float(x @ (s.S @ x) + v @ (s.M @ v))
+
+    drift = float(np.sqrt(norm2(xT - q0, vT - p0) / norm2(q0, p0)))
+    A = orbit.active
+    expected = int(np.count_nonzero(np.any(A != np.roll(A, 1, axis=0), axis=1))) if len(A) > 1 else 0
+    return {"reference": name, "drift": drift, "switches": int(traj.starts.size - 1), "expected": expected,
+            "survives": bool(drift <= SURVIVAL_RTOL)}
