@@ -192,8 +192,9 @@ def nodal_model(model: FEModel, contact: Contact, size: int, factor: SPDFactor |
 def nodal_extension(nodal: NodalReducedModel, count: int, factor: SPDFactor | None = None) -> NodalReducedModel:
     """``nodal`` extended to ``count`` interior dofs by the block Krylov sequence of the massless structure started
     from the nodes' attachment vectors (:func:`bladecase.reduction.extension.extend_basis`; the interior modes are
-    not applied again, they are invariant), rebuilt by :func:`nodal_model` on that interior with the same casing and residual choice —
-    a richer model containing ``nodal``, for checking its orbits, from the same factorisation and no eigen-solve.
+    not applied again, they are invariant), rebuilt by :func:`nodal_model` on that interior with the same casing
+    and residual choice — a richer model containing ``nodal``, for checking its orbits, from the same
+    factorisation and no eigen-solve.
 
     >>> from skfem import MeshTri
     >>> from bladecase.fe import Mesh, assemble
