@@ -172,6 +172,12 @@ def _study_commands(sub) -> None:
     asm.add_argument("study", type=Path, metavar="STUDY.toml")
     asm.add_argument("--mesh", type=Path, metavar="FILE", help="use this mesh instead of the study's")
     asm.add_argument("-o", "--output", type=Path, required=True, metavar="MODEL.npz")
+    asm.add_argument("--calculix", type=Path, metavar="DECK.inp",
+                     help="also write the model as a CalculiX deck ([fem] frequencies asked for; with [rotation] "
+                          "the centrifugal static step at the study's speed first), to check the frequencies with "
+                          "ccx")
+    asm.add_argument("--calculix-unit", choices=("m", "mm"), default="m",
+                     help="units of the deck: m (SI) or mm (N, mm, t, s); default m")
     _progress_options(asm)
     asm.set_defaults(func=_cmd_assemble)
 
@@ -302,10 +308,13 @@ def _cmd_assemble(args) -> int:
     from .study.stages import build_mesh, build_model
 
     _setup(args)
-    _check_outputs(args.output)
+    _check_outputs(args.output, args.calculix)
+    if args.calculix is not None and args.calculix.suffix != ".inp":
+        raise ValueError(f"--calculix {args.calculix}: a CalculiX deck is an .inp file, e.g. model.inp")
     study = _study(args.study)
-    _not_onto_inputs({"-o": args.output}, {"STUDY": args.study, "--mesh": args.mesh,
-                                           "[mesh] path": None if study.parametric else study.mesh_path()})
+    _not_onto_inputs({"-o": args.output, "--calculix": args.calculix},
+                     {"STUDY": args.study, "--mesh": args.mesh,
+                      "[mesh] path": None if study.parametric else study.mesh_path()})
     if args.mesh is not None:
         clamp = study["fem"]["clamp"]
         m = study.config.get("mesh") or {}
@@ -314,10 +323,28 @@ def _cmd_assemble(args) -> int:
     else:
         mesh = build_mesh(study)
     model = build_model(study, mesh)
-    f = natural_frequencies(model, min(study["fem"]["frequencies"], model.n_dofs - 1))
+    count = min(study["fem"]["frequencies"], model.n_dofs - 1)
+    deck, speed = None, None
+    if args.calculix is not None:  # before anything is written: a model the deck cannot hold is refused first
+        from .fe.calculix import calculix_deck
+        from .study.rotation import operating_speed, rotation_axis
+
+        speed = operating_speed(study)
+        spin = {} if not speed else {"speed": speed, "axis": rotation_axis(study, model)}
+        deck = calculix_deck(model, count, unit=args.calculix_unit, **spin)
+    f = natural_frequencies(model, count)
     save_model(model, args.output)
     print(f"{args.output}: {model}")
     print("linear frequencies (Hz): " + ", ".join(f"{x:.3f}" for x in f))
+    if deck is not None:
+        from .io import write_text
+
+        write_text(args.calculix, deck)
+        print(f"{args.calculix}: CalculiX deck ({args.calculix_unit}; run: ccx {args.calculix.with_suffix('').name}"
+              + (f"; spinning at {speed:.6g} rad/s: compare with the Campbell diagram, not with the frequencies "
+                 "at rest above" if speed else "")
+              + ("; CalculiX's mass matrix is consistent: compare with [fem] mass = \"consistent\""
+                 if model.mass == "lumped" else "") + ")")
     return 0
 
 

@@ -13,7 +13,8 @@ Modules: :mod:`~bladecase.fe.naca` (sections), :mod:`~bladecase.fe.geometry` (pa
 curved map of quadratic cells through their midside nodes), :mod:`~bladecase.fe.rotation`
 (:func:`~bladecase.fe.rotation.spin`), :mod:`~bladecase.fe.campbell` (frequencies against speed),
 :mod:`~bladecase.fe.eigen` (:func:`natural_frequencies`, :func:`stiffness_factor`),
-:mod:`~bladecase.fe.storage` (stage files).
+:mod:`~bladecase.fe.storage` (stage files), :mod:`~bladecase.fe.calculix` (the model as a CalculiX deck, its
+frequencies back).
 """
 
 from .assembly import assemble
