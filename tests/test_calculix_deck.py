@@ -54,7 +54,6 @@ def test_the_deck_reads_back_as_the_same_mesh_and_clamp(bar, tmp_path):
 def test_bad_input_is_refused(bar, tmp_path):
     mesh, model = bar
     from skfem import MeshHex
-
     from skfem.io.meshio import to_meshio
 
     h = to_meshio(MeshHex.init_tensor(np.linspace(0, 0.1, 5), np.linspace(0, 0.01, 2), np.linspace(0, 0.01, 2)))
