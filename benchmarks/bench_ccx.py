@@ -32,8 +32,8 @@ scikit-fem's default P2 rule (degree 4); on curved cells (and for the mass on an
 discretisation, 4e-5 at 61 704 dofs and 7e-4 at 6 603.  ``--same-rule`` re-solves (untimed) with the 4-point
 rule in bladecase: it then agrees with ccx to the 7 digits ccx prints.
 
-The deck writer (:func:`write_deck`) lives here for now; it would belong in ``bladecase.fe`` (e.g. next to
-:mod:`bladecase.fe.abaqus`).
+The deck is written by :func:`bladecase.fe.calculix.write_calculix` from the model assembled on the gmsh mesh
+(untimed); each side then starts from that file.
 
 Run::
 
@@ -86,37 +86,18 @@ def blade_mesh(size: float):
     return bladecase.blade_mesh(geometry, size=size, order=2)
 
 
-def write_deck(mesh, path: Path, count: int = COUNT, scale: float = 1e3) -> dict:
-    """Write ``mesh`` (``tetra10`` cells, a ``root`` group) as a CalculiX deck in mm (``scale``: m -> mm).
+def write_deck(mesh, path: Path, count: int = COUNT) -> dict:
+    """Write the model of ``mesh`` (``tetra10`` cells, a ``root`` group; Ti-6Al-4V, P2) as a CalculiX deck in mm
+    (:func:`bladecase.fe.calculix.write_calculix`). Returns what was written (nodes, elements, clamped nodes)."""
+    import bladecase
+    from bladecase.fe import Material
+    from bladecase.fe.calculix import write_calculix
+    from bladecase.fe.select import held_nodes
 
-    C3D10 takes VTK's (meshio's, bladecase's) ``tetra10`` node order; nodes and elements numbered from 1.
-    Returns what was written (nodes, elements, root nodes, element type).
-    """
-    import numpy as np
-
-    cells = np.asarray(mesh.cells["tetra10"])
-    pts = np.asarray(mesh.points) * scale
-    # order check: each midside node near the middle of its edge (VTK / C3D10: 01 12 20 03 13 23)
-    edges = [(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)]
-    mid = np.stack([(pts[cells[:, a]] + pts[cells[:, b]]) / 2 for a, b in edges], axis=1)
-    length = np.stack([np.linalg.norm(pts[cells[:, a]] - pts[cells[:, b]], axis=1) for a, b in edges], axis=1)
-    off = float((np.linalg.norm(pts[cells[:, 4:]] - mid, axis=2) / length).max())
-    if off > 0.25:
-        raise ValueError(f"tetra10 node order: a midside node lies {off:.2f} edge lengths off its edge's middle")
-    root = np.asarray(mesh.groups["root"]) + 1
-    out = ["*HEADING", f"bladecase bench_ccx: NACA 0012 blade, {len(cells)} C3D10, units N mm t s",
-           "*NODE, NSET=NALL"]
-    out += [f"{i + 1}, {x:.12g}, {y:.12g}, {z:.12g}" for i, (x, y, z) in enumerate(pts)]
-    out.append("*ELEMENT, TYPE=C3D10, ELSET=EALL")
-    out += [f"{e + 1}, " + ", ".join(map(str, row)) for e, row in enumerate((cells + 1).tolist())]
-    out.append("*NSET, NSET=ROOT")
-    out += [", ".join(map(str, root[i:i + 16])) for i in range(0, len(root), 16)]
-    out += ["*MATERIAL, NAME=TI6AL4V", "*ELASTIC", f"{E_PA / 1e6:.12g}, {NU:g}", "*DENSITY",
-            f"{RHO_SI * 1e-12:.12g}", "*SOLID SECTION, ELSET=EALL, MATERIAL=TI6AL4V",
-            "*BOUNDARY", "ROOT, 1, 3", "*STEP", "*FREQUENCY", f"{count}", "*END STEP"]
-    path.write_text("\n".join(out) + "\n")
-    return {"nodes": len(pts), "elements": len(cells), "root_nodes": len(root), "element": "C3D10",
-            "midside_offset": off, "bytes": path.stat().st_size}
+    model = bladecase.assemble(mesh, Material(E_PA, NU, RHO_SI, "Ti-6Al-4V"), order=2, clamp="root")
+    write_calculix(model, path, count, unit="mm")
+    return {"nodes": len(mesh.points), "elements": len(mesh.cells[mesh.body_type]), "element": "C3D10",
+            "root_nodes": int(held_nodes(mesh, model.clamped).size), "bytes": path.stat().st_size}
 
 
 # ----------------------------------------------------------------------------- one process, measured
