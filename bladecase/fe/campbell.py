@@ -28,13 +28,44 @@ from ..linalg import lowest_modes
 from .model import FEModel
 from .rotation import RotationAxis, spin
 
-__all__ = ["EXTRA_MODES", "Campbell", "campbell", "crossings", "from_modes", "mac", "modes_at_speed", "track"]
+__all__ = ["EXTRA_MODES", "MAC_DOFS", "Campbell", "campbell", "crossings", "from_modes", "mac", "mac_sample",
+           "modes_at_speed", "track"]
 
 #: Candidate modes computed beyond those tracked, so that a mode entering from above is followed by its shape.
 EXTRA_MODES = 4
 
 #: A link between two speeds whose MAC is below this is reported as uncertain (the speeds are too far apart).
 MAC_WARN = 0.8
+
+#: Largest number of dofs a speed's mode shapes keep for the tracking (:func:`mac_sample`): beyond, every k-th
+#: dof, so that a sweep's results stay small (a 1M-dof blade: 80 MB of shapes per speed otherwise).
+MAC_DOFS = 20_000
+
+
+def mac_sample(model: FEModel, limit: int | None = None) -> tuple[np.ndarray | None, object]:
+    """``(dofs, M)`` for tracking modes by MAC on a sample of ``model``'s dofs: ``(None, model.M)`` — every dof,
+    the exact mass-weighted MAC — for at most ``limit`` (:data:`MAC_DOFS`) dofs; else every k-th dof (``limit``
+    of them, evenly spread over the numbering) with the diagonal of ``M`` as weights (the lumped mass: exact for
+    a lumped model, the row-sum lumping of a consistent one), as a test–analysis correlation does on its sensors.
+
+    >>> from skfem import MeshTri
+    >>> from bladecase.fe import Mesh, assemble
+    >>> t = MeshTri.init_tensor(np.linspace(0, 0.1, 21), np.linspace(0, 0.02, 5))
+    >>> strip = Mesh(np.c_[t.p.T, np.zeros(t.p.shape[1])], {"triangle": t.t.T}, dim=2,
+    ...              groups={"root": np.flatnonzero(t.p[0] == 0)})
+    >>> model = assemble(strip, "steel", order=1, thickness=0.002)
+    >>> mac_sample(model)[0] is None, mac_sample(model, 50)[0].size
+    (True, 50)
+    """
+    import scipy.sparse as sp
+
+    limit = MAC_DOFS if limit is None else integer("limit", limit, 1)
+    n = model.n_dofs
+    if n <= limit:
+        return None, model.M
+    dofs = np.unique(np.linspace(0, n - 1, limit).round().astype(np.int64))
+    weights = np.asarray(model.M.sum(axis=1)).ravel()[dofs]  # row sums: the lumped mass of each sampled dof
+    return dofs, sp.diags_array(weights)
 
 
 def mac(a: np.ndarray, b: np.ndarray, M=None) -> np.ndarray:

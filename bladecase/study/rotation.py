@@ -24,7 +24,7 @@ import math
 import numpy as np
 
 from .. import log
-from ..fe.campbell import EXTRA_MODES, Campbell, from_modes, modes_at_speed
+from ..fe.campbell import EXTRA_MODES, Campbell, from_modes, mac_sample, modes_at_speed
 from ..fe.rotation import RotationAxis, SpinState, spin, to_rad_s
 from .schema import Study, StudyError
 
@@ -116,13 +116,14 @@ def operating_point(study: Study, model, contact, factor=None):
 
 
 def _speed_point(omega: float, *, study: Study, model, contact, axis: RotationAxis, count: int,
-                 bands: bool) -> dict:
-    """One speed of the Campbell diagram (module level: an executor ships it to its workers)."""
+                 bands: bool, sample: np.ndarray | None = None) -> dict:
+    """One speed of the Campbell diagram (module level: an executor ships it to its workers); its mode shapes on
+    the ``sample`` dofs only (:func:`~bladecase.fe.campbell.mac_sample`; ``None``: every dof)."""
     from .stages import build_reduced, period_unit, search
 
     n = min(count + EXTRA_MODES, model.n_dofs - 1)
     state, phi, f = modes_at_speed(model, float(omega), axis, n, static=study["rotation"].get("static", "auto"))
-    point = {"shapes": phi, "frequencies_hz": f,
+    point = {"shapes": phi if sample is None else np.ascontiguousarray(phi[sample]), "frequencies_hz": f,
              "clearance": running_clearance(study, model, contact, state, cold=True), "band_hz": None, "note": None}
     d = point["clearance"]["clearance_running_m"]
     if not bands:
@@ -153,11 +154,12 @@ def campbell_stage(study: Study, model, contact, executor, progress: bool = Fals
     w = speeds(study)
     axis = rotation_axis(study, model)
     count = min(int(r.get("modes", 6)), model.n_dofs - 1)
+    sample, M = mac_sample(model)  # a large model's shapes travel back on a sample of its dofs
     points = executor.map(_speed_point, list(w), shared={"study": study, "model": model, "contact": contact,
                                                          "axis": axis, "count": count,
-                                                         "bands": bool(r.get("bands", True))},
+                                                         "bands": bool(r.get("bands", True)), "sample": sample},
                           desc="speeds", progress=progress)
-    c = from_modes(w, [p["shapes"] for p in points], [p["frequencies_hz"] for p in points], model.M, count,
+    c = from_modes(w, [p["shapes"] for p in points], [p["frequencies_hz"] for p in points], M, count,
                    r.get("engine_orders", []))
     bands = [p["band_hz"] for p in points]
     section = c.to_dict()
