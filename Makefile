@@ -33,6 +33,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_fem.py
 	$(BIN)/python benchmarks/bench_demo.py
 	$(BIN)/python benchmarks/bench_search.py --cases chain10,chain20,chain50,demo8
+	$(BIN)/python benchmarks/bench_search_contact.py --cases cb58w
 	$(BIN)/python benchmarks/bench_scaling.py
 	$(BIN)/python benchmarks/bench_fe_pipeline.py --skip-110k
 	$(BIN)/python benchmarks/bench_solvers.py --skip-110k
