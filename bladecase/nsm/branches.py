@@ -396,56 +396,35 @@ class Branch:
         Newton's contact speaks of impacts (times and impulses); the massless contact model of contact phases
         (the instants the contact closes, ``∫λ dt`` over each phase, the number of phases per period).
         """
-        if getattr(self.system, "contact_model", None) == "massless" or any(
-                getattr(o, "contact_model", None) == "massless" for o in self.orbits if o is not None):
-            return self._massless_table(points)
+        massless = getattr(self.system, "contact_model", None) == "massless" or any(
+            getattr(o, "contact_model", None) == "massless" for o in self.orbits if o is not None)
         k, T = self.k, self.T
-        lines = [f"{k}-ipp family, {len(self.orbits)} orbits ({self.source}), T in [{T.min():.8g}, {T.max():.8g}]"]
+        span = f"{len(self.orbits)} orbits ({self.source}), T in [{T.min():.8g}, {T.max():.8g}]"
+        lines = [f"nonsmooth mode (massless contact), {span}, {_phases(self.orbits)} per period" if massless
+                 else f"{k}-ipp family, {span}"]
         if points if points is not None else self.source == "scan":
-            lines.append(f"{'T':>14} {'1/T':>12} {'energy':>12} {'impact times':>36} {'impulses':>30} admissible")
+            lines.append(f"{'T':>14} {'1/T':>12} {'energy':>12} " + (f"{'phases':>6} " if massless else "")
+                         + (f"{'contact closes at':>36} {'∫λ dt per phase':>30}" if massless
+                            else f"{'impact times':>36} {'impulses':>30}") + " admissible")
             for Tp, o in zip(T, self.orbits):
                 if o is None:
                     lines.append(f"{Tp:14.8g} {1 / Tp:12.6g} {'resonant':>12}")
                     continue
                 times = " ".join(f"{t:.6g}" for t in o.impact_times)
                 imp = " ".join(f"{x:.5g}" for x in o.impulses)
-                lines.append(f"{Tp:14.8g} {1 / Tp:12.6g} {o.energy:12.6g} {times:>36} {imp:>30} "
-                             f"{'yes' if o.admissible else 'no'}")
+                lines.append(f"{Tp:14.8g} {1 / Tp:12.6g} {o.energy:12.6g} " + (f"{o.k:>6} " if massless else "")
+                             + f"{times:>36} {imp:>30} {'yes' if o.admissible else 'no'}")
         lines.append("")
         if self.arcs:
-            lines.append(f"admissible intervals of T ({k} impact(s) per period):")
+            lines.append("admissible intervals of T:" if massless else
+                         f"admissible intervals of T ({k} impact(s) per period):")
             for a in self.arcs:
                 lines.append(f"  admissible arc: T in [{a.T_lo:.12g}, {a.T_hi:.12g}]   "
-                             f"1/T in [{1 / a.T_hi:.8g}, {1 / a.T_lo:.8g}]   (points {a.start}..{a.stop})")
+                             f"1/T in [{1 / a.T_hi:.8g}, {1 / a.T_lo:.8g}]   (points {a.start}..{a.stop}"
+                             + (f"; {_phases(self.orbits[a.start: a.stop + 1])} per period)" if massless else ")"))
         else:
-            lines.append(f"no admissible arc: no admissible {k}-ipp orbit in the {self.source}")
-        return "\n".join(lines)
-
-    def _massless_table(self, points: bool | None) -> str:
-        """:meth:`table` of a branch of the massless contact model: contact phases, not impacts."""
-        T = self.T
-        lines = [f"nonsmooth mode (massless contact), {len(self.orbits)} orbits ({self.source}), T in [{T.min():.8g}, "
-                 f"{T.max():.8g}], {_phases(self.orbits)} per period"]
-        if points if points is not None else self.source == "scan":
-            lines.append(f"{'T':>14} {'1/T':>12} {'energy':>12} {'phases':>6} {'contact closes at':>36} "
-                         f"{'∫λ dt per phase':>30} admissible")
-            for Tp, o in zip(T, self.orbits):
-                if o is None:
-                    lines.append(f"{Tp:14.8g} {1 / Tp:12.6g} {'resonant':>12}")
-                    continue
-                times = " ".join(f"{t:.6g}" for t in o.impact_times)
-                imp = " ".join(f"{x:.5g}" for x in o.impulses)
-                lines.append(f"{Tp:14.8g} {1 / Tp:12.6g} {o.energy:12.6g} {o.k:>6} {times:>36} {imp:>30} "
-                             f"{'yes' if o.admissible else 'no'}")
-        lines.append("")
-        if self.arcs:
-            lines.append("admissible intervals of T:")
-            for a in self.arcs:
-                lines.append(f"  admissible arc: T in [{a.T_lo:.12g}, {a.T_hi:.12g}]   "
-                             f"1/T in [{1 / a.T_hi:.8g}, {1 / a.T_lo:.8g}]   (points {a.start}..{a.stop}; "
-                             f"{_phases(self.orbits[a.start: a.stop + 1])} per period)")
-        else:
-            lines.append(f"no admissible arc: no admissible orbit in the {self.source}")
+            lines.append("no admissible arc: no admissible orbit in the " + self.source if massless else
+                         f"no admissible arc: no admissible {k}-ipp orbit in the {self.source}")
         return "\n".join(lines)
 
     def stability(self, tol: float | None = None, where=None) -> np.ma.MaskedArray:
