@@ -197,19 +197,22 @@ def _command_pages() -> list[str]:
 @pytest.fixture(scope="module")
 def page_runs(tmp_path_factory):
     """Every page's Python and commands, started together on two threads (each job its own process and folder):
-    ``{("python" | "commands", page): future of the failure in words or None}``."""
+    ``{("python" | "commands", page): future of the failure in words or None}``.
+
+    The command sequences go first: the README's is the longest job (its commands one after the other), and the
+    Python pages run on the other thread meanwhile, so the file takes about as long as that one sequence."""
     by_page: dict[str, list[str]] = {}
     for page, cmd, runnable in documented_commands():
         if runnable:
             by_page.setdefault(page, []).append(cmd)
     pool = ThreadPoolExecutor(max_workers=2)
     jobs = {}
+    for page, cmds in sorted(by_page.items(), key=lambda item: -len(item[1])):
+        tmp = _workdir(tmp_path_factory.mktemp("commands"))
+        jobs[("commands", page)] = pool.submit(_run_commands, page, cmds, tmp)
     for page in _python_pages():
         tmp = _workdir(tmp_path_factory.mktemp("python"))
         jobs[("python", page)] = pool.submit(_run_python, page, python_source(ROOT / page), tmp)
-    for page, cmds in by_page.items():
-        tmp = _workdir(tmp_path_factory.mktemp("commands"))
-        jobs[("commands", page)] = pool.submit(_run_commands, page, cmds, tmp)
     yield jobs
     pool.shutdown(wait=True)
 

@@ -53,8 +53,9 @@ def _load(name: str):
 
 
 @pytest.fixture(scope="module")
-def ex():
-    return {name: _load(name) for name in NAMES}
+def ex(fig8_example):
+    # fig8_sensitivity: the one instance tests/test_fig8.py checks the numbers of (conftest.py's fig8_example)
+    return {name: fig8_example if name == "fig8_sensitivity" else _load(name) for name in NAMES}
 
 
 @pytest.fixture(scope="module")

@@ -23,7 +23,6 @@ Measured (``examples/fig8_sensitivity.py --low``, chain(n, k=1, m=1/n, d=1)):
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
 import numpy as np
@@ -35,11 +34,10 @@ EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "fig8_sensitivity.p
 
 
 @pytest.fixture(scope="module")
-def f8():
-    spec = importlib.util.spec_from_file_location("bladecase_example_fig8_sensitivity", EXAMPLE)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+def f8(fig8_example):
+    # the example loaded once for the session, its computations shared with tests/test_examples.py's run of it
+    assert Path(fig8_example.__file__) == EXAMPLE
+    return fig8_example
 
 
 @pytest.fixture(scope="module")
