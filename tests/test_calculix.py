@@ -5,15 +5,14 @@ hexahedral steel beam at rest and spinning (``*STATIC`` with ``CENTRIF``, then `
 from __future__ import annotations
 
 import math
-import re
 import shutil
-import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from bladecase.fe import Mesh, assemble
+from bladecase.fe.calculix import run_calculix
 from bladecase.fe.rotation import RotationAxis, spin
 from bladecase.linalg import lowest_modes
 
@@ -50,29 +49,11 @@ def _hex20_beam(nx: int = 12, ny: int = 2, nz: int = 1) -> Mesh:
     return Mesh(points, {"hexahedron20": t}, dim=3, groups={"root": root})
 
 
-def _ccx_frequencies(mesh: Mesh, folder: Path, rpm: float, count: int = 4) -> np.ndarray:
-    lines = ["*NODE"] + [f"{i + 1}, {x:.12g}, {y:.12g}, {z:.12g}" for i, (x, y, z) in enumerate(mesh.points)]
-    lines += ["*ELEMENT, TYPE=C3D20, ELSET=EALL"]
-    for e, cell in enumerate(mesh.cells["hexahedron20"]):
-        ids = [str(n + 1) for n in cell]
-        lines += [f"{e + 1}, " + ", ".join(ids[:15]) + ",", ", ".join(ids[15:])]
-    lines += ["*NSET, NSET=ROOT"] + [", ".join(str(n + 1) for n in mesh.groups["root"][i:i + 16])
-                                    for i in range(0, len(mesh.groups["root"]), 16)]
-    lines += ["*MATERIAL, NAME=STEEL", "*ELASTIC", f"{E:g}, {NU:g}", "*DENSITY", f"{RHO:g}",
-              "*SOLID SECTION, ELSET=EALL, MATERIAL=STEEL", "*BOUNDARY", "ROOT, 1, 3"]
-    if rpm:
-        omega2 = (rpm * 2 * math.pi / 60) ** 2
-        lines += ["*STEP", "*STATIC", "*DLOAD", f"EALL, CENTRIF, {omega2:.12g}, 0., 0., 0., 0., 0., 1.", "*END STEP",
-                  "*STEP, PERTURBATION"]
-    else:
-        lines += ["*STEP"]
-    lines += ["*FREQUENCY", f"{count}", "*END STEP"]
-    (folder / "beam.inp").write_text("\n".join(lines) + "\n")
-    subprocess.run([CCX, "beam"], cwd=folder, capture_output=True, text=True, timeout=300, check=True)
-    text = (folder / "beam.dat").read_text()
-    table = text.split("E I G E N V A L U E   O U T P U T")[-1]
-    rows = re.findall(r"^\s*\d+\s+([-+0-9.Ee]+)\s+([-+0-9.Ee]+)\s+([-+0-9.Ee]+)\s+([-+0-9.Ee]+)", table, re.M)
-    return np.array([float(r[2]) for r in rows[:count]])  # the frequency column (cycles/time)
+def _ccx_frequencies(model, folder: Path, rpm: float, count: int = 4) -> np.ndarray:
+    """CalculiX's ``count`` lowest frequencies of ``model`` (its deck by :mod:`bladecase.fe.calculix`), spun about z
+    through the origin at ``rpm`` (a linear ``*STATIC`` step with ``CENTRIF``, then a ``PERTURBATION`` step)."""
+    spin_ = {"speed": rpm * 2 * math.pi / 60, "axis": RotationAxis((0, 0, 0), (0, 0, 1))} if rpm else {}
+    return run_calculix(model, folder, count, name="beam", **spin_)
 
 
 @pytest.fixture(scope="module")
@@ -92,60 +73,36 @@ def test_frequencies_agree_with_calculix(beam, tmp_path, rpm):
     mesh, model = beam
     state = spin(model, rpm * 2 * math.pi / 60, RotationAxis((0, 0, 0), (0, 0, 1)), static="linear")
     ours = np.sqrt(lowest_modes(state.model.K, state.model.M, 4, factor=state.factor)[0]) / (2 * math.pi)
-    theirs = _ccx_frequencies(mesh, tmp_path, rpm)
+    theirs = _ccx_frequencies(model, tmp_path, rpm)
     # the same mesh and element (20-node hexahedra, 27-point Gauss rule): at rest equal to 1e-7; spinning, they
     # differ by the static states (CalculiX's linear static step has no spin softening): measured 4e-5 at 3000 rpm,
     # 4e-4 at 6000 rpm (f1 2.5 times the one at rest), 1.5e-3 at 12000 rpm, growing as Ω²
     assert ours == pytest.approx(theirs, rel=1e-6 if rpm == 0 else 1e-3), (ours, theirs)
     if rpm:
-        rest = _ccx_frequencies(mesh, tmp_path, 0.0)
+        rest = _ccx_frequencies(model, tmp_path, 0.0)
         assert (theirs[0] / rest[0] - 1) > 0.02  # the speed matters: the check is not at rest in disguise
 
 
 # ----------------------------------------------------------------------------- the demo blade (tetra10) at speed
-
-def _blade_deck(grid, material, folder: Path, rpm: float, nlgeom: bool) -> np.ndarray:
-    """The 4 lowest frequencies of the blade grid (C3D10 = VTK tetra10 order) spinning about x through z = -0.25."""
-    lines = ["*NODE"] + [f"{i + 1}, {x:.12g}, {y:.12g}, {z:.12g}" for i, (x, y, z) in enumerate(grid.points)]
-    lines += ["*ELEMENT, TYPE=C3D10, ELSET=EALL"]
-    lines += [f"{e + 1}, " + ", ".join(str(n + 1) for n in c) for e, c in enumerate(grid.cells["tetra10"])]
-    root = grid.groups["root"]
-    lines += ["*NSET, NSET=ROOT"] + [", ".join(str(n + 1) for n in root[i:i + 16]) for i in range(0, len(root), 16)]
-    lines += ["*MATERIAL, NAME=TI", "*ELASTIC", f"{material.E:g}, {material.nu:g}", "*DENSITY", f"{material.rho:g}",
-              "*SOLID SECTION, ELSET=EALL, MATERIAL=TI", "*BOUNDARY", "ROOT, 1, 3"]
-    if rpm:
-        omega2 = (rpm * 2 * math.pi / 60) ** 2
-        lines += ["*STEP" + (", NLGEOM" if nlgeom else ""), "*STATIC", "*DLOAD",
-                  f"EALL, CENTRIF, {omega2:.12g}, 0., 0., -0.25, 1., 0., 0.", "*END STEP", "*STEP, PERTURBATION"]
-    else:
-        lines += ["*STEP"]
-    lines += ["*FREQUENCY", "4", "*END STEP"]
-    (folder / "blade.inp").write_text("\n".join(lines) + "\n")
-    subprocess.run([CCX, "blade"], cwd=folder, capture_output=True, text=True, timeout=300, check=True)
-    table = (folder / "blade.dat").read_text().split("E I G E N V A L U E   O U T P U T")[-1]
-    rows = re.findall(r"^\s*\d+\s+([-+0-9.Ee]+)\s+([-+0-9.Ee]+)\s+([-+0-9.Ee]+)\s+([-+0-9.Ee]+)", table, re.M)
-    return np.array([float(r[2]) for r in rows[:4]])
-
 
 def test_demo_blade_at_speed_against_calculix(tmp_path):
     """The demo blade (leaned 30 mm: its centrifugal load bends it) on a 0.25 m hub about x, consistent mass:
     at rest equal; at 5000 and 10000 rpm the second-order static state against CalculiX with NLGEOM (large
     deformations in the static step): f1 within 0.1 %, f2 within 1 %; f3, f4 2-4 % apart (measured 2.6/-2.0 % and
     3.9/-1.5 %): the geometry update of large deflections, which a stress-stiffened state does not make."""
-    from bladecase.post.grid import fe_grid
     from bladecase.study.demo import demo_study
     from bladecase.study.stages import build_mesh
 
     mesh = build_mesh(demo_study())
-    model = assemble(mesh, "Ti-6Al-4V", order=2, mass="consistent", clamp="root")
-    grid = fe_grid(model)
+    model = assemble(mesh, "Ti-6Al-4V", order=2, mass="consistent", clamp="root")  # P2 on tetra: straight C3D10
     axis = RotationAxis((0, 0, -0.25), (1, 0, 0))
     rest = np.sqrt(lowest_modes(model.K, model.M, 4)[0]) / (2 * math.pi)
-    assert rest == pytest.approx(_blade_deck(grid, model.material, tmp_path, 0, False), rel=1e-5)
+    assert rest == pytest.approx(run_calculix(model, tmp_path, 4, name="blade"), rel=1e-5)
     for rpm in (5000, 10000):
         state = spin(model, rpm * 2 * math.pi / 60, axis, static="second-order")
         ours = np.sqrt(lowest_modes(state.model.K, state.model.M, 4, factor=state.factor)[0]) / (2 * math.pi)
-        theirs = _blade_deck(grid, model.material, tmp_path, rpm, True)
+        theirs = run_calculix(model, tmp_path, 4, name="blade", speed=rpm * 2 * math.pi / 60, axis=axis,
+                              nlgeom=True)
         assert ours[0] == pytest.approx(theirs[0], rel=2e-3), rpm
         assert ours[1] == pytest.approx(theirs[1], rel=1.2e-2), rpm
         assert ours[2:] == pytest.approx(theirs[2:], rel=5e-2), rpm
