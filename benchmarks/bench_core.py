@@ -81,6 +81,23 @@ def best_of(repeat: int, run: Callable[..., Any], setup: Callable[[], tuple] = t
     return min(times), times, best
 
 
+def in_child(module: str, call: str, env: dict | None = None) -> dict:
+    """``call`` (an expression on the benchmark module ``module``, imported as ``b``) in a fresh interpreter, so
+    that its peak memory is its own; its JSON result (printed after ``RESULT``), or ``{"error": last line}``.
+    One BLAS thread unless ``env`` or the caller's environment says otherwise."""
+    import subprocess
+
+    env = dict(os.environ, **(env or {}))
+    env.setdefault("OPENBLAS_NUM_THREADS", "1")
+    code = (f"import json, sys; sys.path.insert(0, {str(Path(__file__).parent)!r}); import {module} as b; "
+            f"print('RESULT' + json.dumps({call}))")
+    proc = subprocess.run([sys.executable, "-W", "ignore", "-c", code], env=env, capture_output=True, text=True)
+    rows = [r for r in proc.stdout.splitlines() if r.startswith("RESULT")]
+    if proc.returncode or not rows:
+        return {"error": (proc.stderr.strip().splitlines() or ["?"])[-1]}
+    return json.loads(rows[-1][len("RESULT"):])
+
+
 def fmt_time(seconds: float) -> str:
     """A duration with a readable unit."""
     for unit, scale in (("s", 1.0), ("ms", 1e-3), ("µs", 1e-6)):

@@ -27,14 +27,12 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import resource
-import subprocess
 import sys
 import time
 from pathlib import Path
 
-from bench_core import line, machine, verdict
+from bench_core import in_child, line, machine, verdict
 
 #: Mesh sizes (m) of the three blades: ~5k, ~26k, ~110k P2 dofs.
 SIZES = (0.0055, 0.0025, 0.0014)
@@ -78,15 +76,8 @@ def run_one(size: float, count: int, steps: int) -> dict:
 
 def child(size: float, backend: str, count: int, steps: int) -> dict:
     """:func:`run_one` in a fresh interpreter with ``BLADECASE_FACTOR=backend``."""
-    env = dict(os.environ, BLADECASE_FACTOR=backend)
-    env.setdefault("OPENBLAS_NUM_THREADS", "1")
-    code = (f"import json, sys; sys.path.insert(0, {str(Path(__file__).parent)!r}); import bench_fe_pipeline as b; "
-            f"print('RESULT' + json.dumps(b.run_one({size!r}, {count!r}, {steps!r})))")
-    proc = subprocess.run([sys.executable, "-W", "ignore", "-c", code], env=env, capture_output=True, text=True)
-    rows = [r for r in proc.stdout.splitlines() if r.startswith("RESULT")]
-    if proc.returncode or not rows:
-        return {"size": size, "backend": backend, "error": (proc.stderr.strip().splitlines() or ["?"])[-1]}
-    return json.loads(rows[-1][len("RESULT"):])
+    out = in_child("bench_fe_pipeline", f"b.run_one({size!r}, {count!r}, {steps!r})", {"BLADECASE_FACTOR": backend})
+    return {"size": size, "backend": backend, **out} if "error" in out else out
 
 
 def cell(run: dict | None, stage: str, key: str) -> float | None:

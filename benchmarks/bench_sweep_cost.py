@@ -64,7 +64,6 @@ import argparse  # noqa: E402
 import json  # noqa: E402
 import math  # noqa: E402
 import pickle  # noqa: E402
-import subprocess  # noqa: E402
 import sys  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
@@ -72,7 +71,7 @@ import warnings  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
-from bench_core import line, machine  # noqa: E402
+from bench_core import in_child, line, machine  # noqa: E402
 from bench_fe_pipeline import peak_mib  # noqa: E402
 
 #: Mesh sizes (m) of the default blades (~5.5k, ~26k, ~62k P2 dofs) and the one ``--large`` adds (~110k).
@@ -249,15 +248,7 @@ def run_worker(path: str, repeat: int) -> dict:
 
 def child(call: str) -> dict:
     """``call`` (an expression on this module, ``b``) in a fresh interpreter; its JSON result."""
-    env = dict(os.environ)
-    env.setdefault("OPENBLAS_NUM_THREADS", "1")
-    code = (f"import json, sys; sys.path.insert(0, {str(Path(__file__).parent)!r}); import bench_sweep_cost as b; "
-            f"print('RESULT' + json.dumps({call}))")
-    proc = subprocess.run([sys.executable, "-W", "ignore", "-c", code], env=env, capture_output=True, text=True)
-    rows = [r for r in proc.stdout.splitlines() if r.startswith("RESULT")]
-    if proc.returncode or not rows:
-        return {"error": (proc.stderr.strip().splitlines() or ["?"])[-1]}
-    return json.loads(rows[-1][len("RESULT"):])
+    return in_child("bench_sweep_cost", call)
 
 
 def measure(size: float, repeat: int) -> dict:

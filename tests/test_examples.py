@@ -22,7 +22,6 @@ follow the families once, which keeps the file fast.
 
 from __future__ import annotations
 
-import importlib.util
 import subprocess
 import sys
 from pathlib import Path
@@ -34,6 +33,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 import pytest
+from conftest import load_example
 
 import bladecase as bc
 from bladecase.nsm import ModalKernel
@@ -45,17 +45,10 @@ FIVE_T2 = 10 * np.pi / np.sqrt(3 + np.sqrt(5))  # 5 · 2π/ω₂ for chain(2, k=
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
 
-def _load(name: str):
-    spec = importlib.util.spec_from_file_location(f"bladecase_example_{name}", EXAMPLES / f"{name}.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
 @pytest.fixture(scope="module")
 def ex(fig8_example):
     # fig8_sensitivity: the one instance tests/test_fig8.py checks the numbers of (conftest.py's fig8_example)
-    return {name: fig8_example if name == "fig8_sensitivity" else _load(name) for name in NAMES}
+    return {name: fig8_example if name == "fig8_sensitivity" else load_example(name) for name in NAMES}
 
 
 @pytest.fixture(scope="module")
