@@ -16,9 +16,11 @@ has contact phases of finite duration instead of impacts. One module per step:
 - :mod:`~bladecase.nsm.massless.nodes` — several contacts, one per contact node (:class:`NodalSystem`): the
   complementarity of their forces, the phases (sets of closed contacts) and the exact event-driven simulator
   (:func:`simulate_nodes`), damped and against an out-of-round casing (:class:`Rub`);
+- :mod:`~bladecase.nsm.massless.nodal_orbit` — a period's flow of a :class:`NodalSystem` with its exact Jacobian
+  (:func:`flow_map`) and the periodic orbits it closes, with their Floquet multipliers (:class:`NodalOrbit`);
 - :mod:`~bladecase.nsm.massless.nodal_modes` — the nonsmooth modes of a :class:`NodalSystem`: periodic orbits by
   shooting with exact sensitivities, a family followed from the first node's grazing through changes of the set of
-  touching nodes, Floquet multipliers (:func:`nodal_family`, :class:`NodalFamily`, :class:`NodalOrbit`);
+  touching nodes (:func:`nodal_family`, :class:`NodalFamily`);
 - :mod:`~bladecase.nsm.massless.rub` — the rub response of a turning blade at one speed and over speeds
   (:func:`rub_response`, :func:`rub_sweep`);
 - :mod:`~bladecase.nsm.massless.forced` — forced and damped simulation (:func:`simulate_forced_massless`;
