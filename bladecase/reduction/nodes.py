@@ -61,6 +61,11 @@ class NodalReducedModel(ReducedModel):
     interior: np.ndarray = field(default=None, repr=False)  # type: ignore[assignment]
     residual: bool = False
 
+    @property
+    def mass_matrix(self) -> sp.dia_array:
+        """The model's (lumped, redistributed) mass matrix on the free dofs."""
+        return sp.diags_array(self.masses)
+
     def free_dofs(self, x_r, gap=None) -> np.ndarray:
         """Free-dof displacements of reduced states, each pressed node's correction included."""
         x = super().free_dofs(x_r)

@@ -157,11 +157,7 @@ def check_nodal_in_reference(orbit, nodal, reference) -> dict:
     j = open_[np.argmax(orbit.durations[open_])]
     t0 = orbit.starts[j] + 0.5 * orbit.durations[j]
     x_r, v_r = (z[:, 0] for z in orbit.state(np.array([t0])))
-    V, Mdiag = np.asarray(reference.basis), reference.masses
-    MV = Mdiag[:, None] * V
-    G = V.T @ MV
-    q0 = np.linalg.solve(G, MV.T @ np.asarray(nodal.basis @ x_r))
-    p0 = np.linalg.solve(G, MV.T @ np.asarray(nodal.basis @ v_r))
+    q0, p0 = _project(reference, np.column_stack([nodal.basis @ x_r, nodal.basis @ v_r])).T  # open: no λ term
     s = reference.system
     traj = simulate_nodes(s, q0, p0, orbit.T)
     xT, vT = (z[:, 0] for z in traj.state(np.array([orbit.T])))
