@@ -23,7 +23,8 @@ callers keep using :class:`SPDFactor` (``solve``, ``operator``, ``ldlt``).
 
 Eigen-solver: :func:`lowest_modes` uses ARPACK's shift-invert Lanczos, or the block shift-invert Lanczos of
 :mod:`bladecase.linalg_block` when the factor solves blocks of right-hand sides much faster than one at a time
-(scikit-sparse's CHOLMOD; not cvxopt's, which solves column by column) and ``K`` has at least
+(scikit-sparse's CHOLMOD; cvxopt's is twice as fast per column in blocks, not enough to pay for the block
+Lanczos's extra columns) and ``K`` has at least
 :data:`BLOCK_MIN_DOFS` rows (110k dofs, 20 modes: 2.7 s vs 3.7 to 7.5 s).
 
 Reuse: a factor can be computed once and passed on (``factor=``) to :func:`lowest_modes`,

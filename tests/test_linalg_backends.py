@@ -202,8 +202,13 @@ def test_cvxopt_solves_like_superlu(cvxopt_forced, monkeypatch):
     assert x.shape == (1331,)
     np.testing.assert_allclose(x, X[:, 1], rtol=0, atol=1e-14)
     np.testing.assert_allclose(f.solve(np.asfortranarray(B)), X, rtol=0, atol=0)
-    np.testing.assert_allclose(f.solve(sp.csr_array(B[:, :2])), X[:, :2], rtol=0, atol=0)  # sparse right-hand side
-    np.testing.assert_allclose(f.operator() @ B[:, 0], X[:, 0], rtol=0, atol=0)
+    # two columns are solved one by one, five by CHOLMOD's block solve (``spsolve``): the same to round-off
+    np.testing.assert_allclose(f.solve(sp.csr_array(B[:, :2])), X[:, :2], rtol=0, atol=1e-14)  # sparse right-hand side
+    np.testing.assert_allclose(f.solve(sp.csr_array(B[:, :2])), f.solve(B[:, :2]), rtol=0, atol=0)
+    np.testing.assert_allclose(f.operator() @ B[:, 1], x, rtol=0, atol=0)
+    Z = B.copy()
+    Z[:, 3] = 0.0  # a zero column in a block: zeros back
+    assert not np.any(f.solve(Z)[:, 3]) and f.solve(Z[:, 2:5]).shape == (1331, 3)
     monkeypatch.setenv(BACKEND_ENV, "superlu")
     reference = spd_factor(K, "K").solve(B)
     assert np.abs(X - reference).max() <= 1e-10 * np.abs(reference).max()

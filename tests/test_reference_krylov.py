@@ -112,6 +112,31 @@ def test_the_extension_solves_once_per_added_dof(strip, method, most):
     assert V.shape[1] == 24 and counting.columns <= most
 
 
+def test_a_modal_model_is_extended_in_blocks_of_four_the_same_on_every_run(strip, monkeypatch):
+    """A modal model's extension runs in blocks of 4 right-hand sides (the attachment vector's sequence and three
+    seeded random directions smoothed twice), which a sparse Cholesky factor solves at about half the cost per
+    column; the same basis on every run; a Krylov model (lanczos-si) continues its single sequence."""
+    from bladecase.reduction.extension import WIDEN, WIDEN_SMOOTHING
+
+    model, contact, factor = strip
+    modal = reduce(model, contact, "modal", 6, factor=factor)
+    lanczos = reduce(model, contact, "lanczos-si", 6, factor=factor)
+    first = krylov_extension(modal, 28, factor)
+    widths, inner = [], factor._solve
+
+    def recording(b):
+        widths.append(1 if b.ndim == 1 else b.shape[1])
+        return inner(b)
+    monkeypatch.setattr(factor, "_solve", recording)
+    ext = krylov_extension(modal, 28, factor)
+    assert WIDEN["modal"] == 3 and widths[:1 + WIDEN_SMOOTHING] == [1, 3, 3] and set(widths[1 + WIDEN_SMOOTHING:]) == {4}
+    assert sum(widths) <= 28 - 6 + 1 + WIDEN_SMOOTHING * 3
+    np.testing.assert_array_equal(first.basis, ext.basis)
+    widths.clear()
+    krylov_extension(lanczos, 24, factor)
+    assert set(widths[1:]) == {1}
+
+
 def test_a_massless_model_is_extended_in_its_interior(strip):
     """The massless model (lumped mass, contact dofs massless and slaved): its extension keeps the contact's
     stiffness k_c and the contact rows slaved, contains the model, and is the massless-lanczos model of the same

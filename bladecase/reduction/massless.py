@@ -339,13 +339,13 @@ def _interior_operator(split: _Split, masses: np.ndarray, fac: SPDFactor):
 def extend_massless(reduced: MasslessReducedModel, count: int, fac: SPDFactor) -> MasslessReducedModel:
     """:func:`bladecase.reduction.extension.krylov_extension` of a massless model: the interior basis extended
     by the block Krylov sequence of the massless structure (its interior columns and the attachment vector's)."""
-    from .extension import FRONTIER, SUFFIX, extend_basis
+    from .extension import FRONTIER, SUFFIX, WIDEN, extend_basis
 
     split = _split(reduced.model, reduced.contact)
     m_i = reduced.masses[split.i]
     V_i = extend_basis(np.asarray(reduced.basis)[split.i], fac.solve(split.w)[split.i],
                        _interior_operator(split, reduced.masses, fac), lambda X: (m_i * X.T).T,
-                       min(count, split.i.size - 1), FRONTIER.get(reduced.method))
+                       min(count, split.i.size - 1), FRONTIER.get(reduced.method), widen=WIDEN.get(reduced.method, 0))
     return _reduced(split, reduced.masses, V_i, reduced.model, reduced.contact, reduced.method + SUFFIX,
                     V_i.shape[1])
 
