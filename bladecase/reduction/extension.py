@@ -136,15 +136,17 @@ def extend_basis(V: np.ndarray, start: np.ndarray, operator: Callable[[np.ndarra
         """Orthonormalise the columns of ``block`` against ``Q`` and each other; return those kept."""
         nonlocal m
         first = m
-        for x in block.T:
+        X = np.array(block, dtype=float, order="F")
+        sizes0 = np.sqrt(np.maximum(np.einsum("ij,ij->j", X, mass(X).reshape(X.shape)), 0.0))
+        for _ in range(2):  # twice is enough (Kahan–Parlett), the whole block at once; M Q kept
+            X -= Q[:, :m] @ (MQ[:, :m].T @ X)
+        for x, size0 in zip(X.T, sizes0):
             if m == count:
                 break
-            x = x.copy()
-            size0 = np.sqrt(max(float(x @ mass(x)), 0.0))
             if size0 == 0.0:
                 continue
-            for _ in range(2):  # twice is enough (Kahan–Parlett); M Q kept, no product with M here
-                x -= Q[:, :m] @ (MQ[:, :m].T @ x)
+            for _ in range(2):  # against the columns taken from this block
+                x -= Q[:, first:m] @ (MQ[:, first:m].T @ x)
             Mx = mass(x)
             size = np.sqrt(max(float(x @ Mx), 0.0))
             if size <= rtol * size0:
