@@ -18,8 +18,16 @@ def _text(points: str = "nodes", model: str = "massless") -> str:
                                                                                                  "animate = 0")
 
 
-def test_every_tip_node_a_contact(tmp_path):
-    res = run(loads(_text(), source="<nodes>"), tmp_path, progress=False)
+@pytest.fixture(scope="module")
+def nodal_run(tmp_path_factory):
+    """The demo with every tip node a contact and the nodal orbits checked in the reference: one run, two tests."""
+    out = tmp_path_factory.mktemp("nodes")
+    text = _text().replace("animate = 0", "animate = 0\nreference = true")
+    return run(loads(text, source="<nodes>"), out, progress=False), out
+
+
+def test_every_tip_node_a_contact(nodal_run):
+    res, tmp_path = nodal_run
     s = res.summary["nodal_modes"]
     # measured: 18 orbits from grazing at 210.4996 Hz to 215.499 Hz (an 8:1 internal resonance with mode 3 ends
     # it), up to 18 of the 26 tip nodes touching, every orbit stable, closing residuals ~1e-15
@@ -44,13 +52,12 @@ def test_nodes_need_the_massless_model():
         loads(text, source="<nodes>")
 
 
-def test_nodal_orbits_are_checked_in_the_krylov_reference(tmp_path):
+def test_nodal_orbits_are_checked_in_the_krylov_reference(nodal_run):
     """Five orbits of the demo's every-node family, ends included, re-simulated for one period in the nodal model's
     Krylov extension (32 dofs): measured drifts 4e-11 (grazing) to 4e-4 — they survive, and the report says so."""
     from bladecase.study.reference import SURVIVAL_RTOL
 
-    text = _text().replace("animate = 0", "animate = 0\nreference = true")
-    res = run(loads(text, source="<nodes>"), tmp_path, progress=False)
+    res, tmp_path = nodal_run
     s = res.summary["nodal_modes"]
     ref = s["reference"]
     assert ref["model"] == "massless-nodes+krylov (32 dofs)" and ref["checked"] == 5 == ref["survived"]
