@@ -439,6 +439,62 @@ def _check_start_grid(system, k: int, T: float, scan: int, resolution: int | Non
         log.warning("%s (a smaller [search] resolution or scan shortens it)", what)
 
 
+#: Seconds per resonance of the contact in the period range × reduced dof of a k-ipp search — for estimates
+#: only.  Each resonance ``T = 2πm/ω_j`` cuts the families into pieces; measured (2-ipp, CPU): the demo's 16
+#: and 32 Lanczos vectors, 190 and 684 resonances, 12.5 and 82 s (4.1e-3, 3.7e-3); a 58-dof Craig–Bampton model
+#: of a 16-node face, modes up to 6 700 ω₁ and 12 349 resonances in [0.9, 0.9999] T₁: 59 s for the 0.2 % of
+#: the range that holds ~250 of them (4.1e-3), the whole range past 300 s and 23 GB; chains are faster
+#: (chain(50): 203, 6.4 s).
+RESONANCE_SECONDS = 4e-3
+
+#: Estimated seconds of a k-ipp search above which the study warns, and above which it refuses.
+SEARCH_WARN_S, SEARCH_REFUSE_S = 60.0, 1800.0
+
+
+def resonance_count(system, T_range: tuple[float, float]) -> int:
+    """Resonances ``T = 2πm/ω_j`` (``m ≥ 1``, ``ω_j`` the modes the contact sees) in ``T_range``.
+
+    >>> import bladecase as bc
+    >>> system = bc.chain(3, k=1.0, m=1.0, gap=1.0)
+    >>> T1 = 2 * np.pi / system.spectrum.omega[0]
+    >>> resonance_count(system, (0.5 * T1, T1))  # ω/ω₁ = 1, 2.8, 4.05: m = 1; 2; 3, 4
+    4
+    """
+    omega = system.spectrum.contact_modes[0]
+    lo, hi = (omega * T / (2 * np.pi) for T in T_range)
+    return int(np.sum(np.floor(hi) - np.floor(lo)))
+
+
+def _search_estimate(system, T_range: tuple[float, float]) -> float:
+    return RESONANCE_SECONDS * resonance_count(system, T_range) * system.n
+
+
+def _check_resonances(system, k: int, T_range: tuple[float, float], label: str = "") -> None:
+    """Announce (or refuse) a k-ipp search whose period range holds a great many resonances of the contact."""
+    if not hasattr(system, "spectrum"):
+        return
+    est = _search_estimate(system, T_range)
+    if est <= SEARCH_WARN_S:
+        return
+    omega = system.spectrum.contact_modes[0]
+    ratio = float(omega.max() / system.spectrum.omega[0])
+    what = (f"{label + ': ' if label else ''}{k}-ipp search: the contact sees modes up to {ratio:.0f} × the lowest "
+            f"frequency ({omega.max() / (2 * np.pi):.4g} Hz) and {resonance_count(system, T_range)} resonances "
+            f"T = 2πm/ω_j lie in the period range [{T_range[0]:.6g}, {T_range[1]:.6g}] s, each cutting the families "
+            f"into pieces: estimated {est / 60:.{1 if est < 600 else 0}f} min on {system.n} dofs")
+    if est > SEARCH_REFUSE_S:
+        hi, top = T_range[0], T_range[1]  # the longest range from T_lo estimated within SEARCH_REFUSE_S
+        for _ in range(60):
+            mid = 0.5 * (hi + top)
+            hi, top = (mid, top) if _search_estimate(system, (T_range[0], mid)) <= SEARCH_REFUSE_S else (hi, mid)
+        raise StudyError(f"[search] periods: {what}, with thousands of families to hold in memory; valid: a range "
+                         f"estimated within {SEARCH_REFUSE_S / 60:.0f} min (from {T_range[0]:.6g} s: up to "
+                         f"{hi:.6g} s), a reduced model without the contact's stiffest modes (a Craig–Bampton model "
+                         "of a contact face keeps the face's local modes), or the massless contact model ([contact] "
+                         "model = \"massless\")")
+    log.warning("%s (a narrower [search] periods shortens it)", what)
+
+
 def _lowest_omega(system) -> float:
     return float(system.open.omega[0] if hasattr(system, "open") else system.spectrum.omega[0])
 
@@ -460,6 +516,7 @@ def search(study: Study, system: LinearSystem, progress: bool = False, unit: flo
                          f"{T_top:.6g} s; valid: at most {100 * T_top:.6g} s")
     families: list[Branch] = []
     for k in s["ipp"]:
+        _check_resonances(system, k, T_range, label)
         _check_start_grid(system, k, T_range[1], s["scan"], s["resolution"], label)
         t0 = time.perf_counter()
         found = nonsmooth_mode(system, k, T_range, scan=s["scan"], step=s["step"], max_points=s["max_points"],

@@ -1,0 +1,59 @@
+"""A k-ipp search whose period range holds a great many resonances of the contact is announced, or refused with
+the range that would do, before it starts (a Craig–Bampton model of a contact face went past 300 s and 23 GB)."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+import bladecase as bc
+from bladecase.study import stages
+from bladecase.study.demo import demo_text
+from bladecase.study.keys import StudyError
+from bladecase.study.schema import loads
+from bladecase.study.stages import RESONANCE_SECONDS, SEARCH_REFUSE_S, SEARCH_WARN_S, _check_resonances, resonance_count
+
+
+def _range(system, lo=0.9, hi=0.9999):
+    T1 = 2 * np.pi / system.spectrum.omega[0]
+    return lo * T1, hi * T1
+
+
+def test_the_resonances_are_counted_one_by_one():
+    system = bc.chain(50, k=1.0, m=1 / 50, gap=1.0)
+    T_range = _range(system)
+    brute = sum(1 for w in system.spectrum.contact_modes[0] for m in range(1, 200)
+                if T_range[0] < 2 * np.pi * m / w <= T_range[1])
+    assert resonance_count(system, T_range) == brute == 203  # the figure bench_search prints for chain50
+
+
+def test_a_long_search_is_announced_and_a_runaway_one_refused_with_the_range_that_would_do(caplog):
+    quick = bc.chain(50, k=1.0, m=1 / 50, gap=1.0)
+    slow = bc.chain(100, k=1.0, m=1 / 100, gap=1.0)
+    with caplog.at_level("WARNING", logger="bladecase"):
+        _check_resonances(quick, 2, _range(quick), "chain 50")
+        assert not caplog.text
+        _check_resonances(slow, 2, _range(slow), "chain 100")
+    est = RESONANCE_SECONDS * resonance_count(slow, _range(slow)) * 100
+    assert SEARCH_WARN_S < est < SEARCH_REFUSE_S
+    assert re.search(rf"chain 100: 2-ipp search: the contact sees modes up to \d+ × the lowest frequency .* "
+                     rf"\d+ resonances T = 2πm/ω_j lie in the period range .* estimated {est / 60:.1f} min on 100 "
+                     r"dofs \(a narrower \[search\] periods shortens it\)", caplog.text)
+
+    runaway = bc.chain(300, k=1.0, m=1 / 300, gap=1.0)
+    text = demo_text().replace('model = "massless"', 'model = "newton"').replace("casing_stiffness = 1e6 ",
+                                                                                 "# casing_stiffness = 1e6 ")
+    text = text.replace('method = "massless" ', 'method = "lanczos-si" ').replace("ipp = [1] ", "ipp = [2] ")
+    study = loads(text, source="<guard>")
+    with pytest.raises(StudyError, match=r"\[search\] periods: 2-ipp search: .* estimated \d+ min on 300 dofs, with "
+                                         r"thousands of families .*valid: a range estimated within 30 min") as err:
+        stages.search(study, runaway)  # refused before any search
+    lo, hi = (float(x) for x in re.search(r"\(from (\S+) s: up to (\S+) s\)", str(err.value)).groups())
+    unit = stages.period_unit(study, runaway)[0]
+    assert lo == pytest.approx(study["search"]["periods"][0] * unit, rel=1e-5)
+    within = RESONANCE_SECONDS * resonance_count(runaway, (lo, hi)) * 300
+    beyond = RESONANCE_SECONDS * resonance_count(runaway, (lo, hi * 1.001)) * 300
+    assert within <= SEARCH_REFUSE_S < beyond
+    assert "massless contact model" in str(err.value)
