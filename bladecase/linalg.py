@@ -23,9 +23,9 @@ callers keep using :class:`SPDFactor` (``solve``, ``operator``, ``ldlt``).
 
 Eigen-solver: :func:`lowest_modes` uses ARPACK's shift-invert Lanczos, or the block shift-invert Lanczos of
 :mod:`bladecase.linalg_block` when the factor solves blocks of right-hand sides much faster than one at a time
-(scikit-sparse's CHOLMOD; cvxopt's is twice as fast per column in blocks, not enough to pay for the block
-Lanczos's extra columns) and ``K`` has at least
-:data:`BLOCK_MIN_DOFS` rows (110k dofs, 20 modes: 2.7 s vs 3.7 to 7.5 s).
+(either CHOLMOD: scikit-sparse's in blocks of 8, cvxopt's in blocks of 4) and ``K`` has at least
+:data:`BLOCK_MIN_DOFS` rows (110k dofs, 20 modes: 2.7 s vs 3.7 to 7.5 s; cvxopt at 61.7k dofs: 1.7 s vs 2.1 to
+3.1 s).
 
 Reuse: a factor can be computed once and passed on (``factor=``) to :func:`lowest_modes`,
 :func:`bladecase.fe.natural_frequencies` and :func:`bladecase.reduction.reduce`;
@@ -70,7 +70,8 @@ BACKEND_ENV = "BLADECASE_FACTOR"
 
 #: Smallest ``K`` for which :func:`lowest_modes` (``method="auto"``) uses the block Lanczos with a factor that
 #: solves blocks fast (CHOLMOD).  20 modes of the blade, block vs ARPACK: 10k dofs 0.17 vs 0.18 s (a tie),
-#: 26k 0.52 vs 0.68 s, 110k 2.7 vs 3.7-7.5 s (ARPACK's single solves suffer most on a busy machine).
+#: 26k 0.52 vs 0.68 s, 110k 2.7 vs 3.7-7.5 s (ARPACK's single solves suffer most on a busy machine); cvxopt,
+#: blocks of 4, CPU: 10k 0.16 vs 0.11 s, 17k 0.34 vs 0.37 s, 26k 0.55 vs 0.66 s.
 BLOCK_MIN_DOFS = 20_000
 
 #: Accepted ``method`` of :func:`lowest_modes`.
@@ -123,9 +124,11 @@ _PREFERENCE = ("cholmod", "cvxopt", "superlu")
 #: Backends that pivot, hence factor indefinite matrices (:func:`symmetric_factor`); the others use SuperLU.
 _PIVOTING = frozenset({"superlu"})
 
-#: Backends whose block solves are much cheaper per right-hand side than single solves (block eigen-solver);
-#: not cvxopt, which solves column by column (20 modes at 110k dofs: block 8.6 s, ARPACK 4.3 s).
-_BLOCK_SOLVES = frozenset({"cholmod"})
+#: Backends whose block solves are much cheaper per right-hand side than single solves (block eigen-solver),
+#: with the block size that suits them: scikit-sparse's CHOLMOD solves 8 columns in about twice the time of
+#: one; cvxopt's (``spsolve``) 4 at a time, at about half the cost per column (20 modes of the 61.7k-dof blade,
+#: CPU: block of 4, 80 columns, 1.7 s against ARPACK's 53-64 columns, 2.1-3.1 s; blocks of 8: 2.2-2.6 s).
+_BLOCK_SOLVES = {"cholmod": BLOCK_SIZE, "cvxopt": 4}
 
 
 @cache
@@ -440,7 +443,7 @@ def _eigen_method(method: str, factor: Factor, n: int) -> str:
 def _sparse_modes(K, M, count: int, factor: Factor, method: str) -> tuple[np.ndarray, np.ndarray]:
     """Shift-invert eigenpairs about 0 with ``factor``: block Lanczos (falls back to ARPACK) or ARPACK."""
     if _eigen_method(method, factor, K.shape[0]) == "block" and count + 2 <= K.shape[0]:
-        block = min(BLOCK_SIZE, K.shape[0] - count)
+        block = min(_BLOCK_SOLVES.get(factor.backend, BLOCK_SIZE), K.shape[0] - count)
         found = block_lanczos(K, M, factor.solve, count, block=block)
         if found is not None:
             return found

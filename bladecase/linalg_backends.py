@@ -6,9 +6,8 @@ CHOLMOD's supernodal Cholesky ``Pᵀ A P = L Lᵀ`` (AMD ordering: cvxopt's CHOL
 on the 110k-dof blade it is 5 to 6 times faster than SuperLU and takes a third of its memory
 (``docs/performance.md``).  cvxopt's ``cholmod.solve`` solves a block of right-hand sides one column at a time;
 a block of :data:`SPSOLVE_MIN_COLUMNS` or more goes through its ``cholmod.spsolve`` instead, CHOLMOD's supernodal
-solve of 4 columns at a time, about twice as fast per column.  :func:`bladecase.linalg.lowest_modes` keeps ARPACK
-with it: the block Lanczos solves twice the columns for 20 modes (112 against 53-64 on the 61.7k-dof blade) and
-measured no faster.
+solve of 4 columns at a time, about twice as fast per column, so :func:`bladecase.linalg.lowest_modes` uses its
+block Lanczos in blocks of 4 on large models.
 
 The backend protocol is :mod:`bladecase.linalg`'s: ``factor(A_csc, name, hint, definite) -> (solve, ldlt,
 fill)``, registered there in ``_SPARSE_BACKENDS`` with its import probe.  A matrix that is not positive definite

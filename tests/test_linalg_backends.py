@@ -261,10 +261,26 @@ def test_cvxopt_ignores_and_keeps_the_users_cholmod_options(cvxopt_forced):
         cholmod.options.clear()
 
 
-def test_cvxopt_factor_gives_the_modes_with_either_eigen_solver_and_auto_takes_arpack(cvxopt_forced):
+def test_cvxopt_factor_gives_the_modes_with_either_eigen_solver_and_auto_takes_blocks_of_four_on_large_models(
+        cvxopt_forced, monkeypatch):
     K, M, f, exact = _laplacian_modes(("arpack", "block", "auto"))
     lam, _ = lowest_modes(K, M, 5)  # factorised here, by the forced backend
     np.testing.assert_allclose(lam, exact[:5], rtol=1e-10, atol=0)
     solve = f.solve
-    assert linalg._eigen_method("auto", Factor("K", BLOCK_MIN_DOFS, "sparse", "cvxopt", solve), BLOCK_MIN_DOFS) \
-        == "arpack"  # cvxopt solves a block column by column: ARPACK's fewer solves win
+    assert linalg._eigen_method("auto", Factor("K", BLOCK_MIN_DOFS - 1, "sparse", "cvxopt", solve),
+                                BLOCK_MIN_DOFS - 1) == "arpack"
+    # at BLOCK_MIN_DOFS rows the block Lanczos, 4 right-hand sides per solve (cvxopt's spsolve chunk)
+    k = 28
+    K = laplacian3(k)  # 21 952 rows
+    f = spd_factor(K, "K")
+    widths, inner = [], f._solve
+
+    def recording(b):
+        widths.append(1 if b.ndim == 1 else b.shape[1])
+        return inner(b)
+    monkeypatch.setattr(f, "_solve", recording)
+    lam, phi = lowest_modes(K, sp.eye_array(k**3, format="csr"), 4, factor=f)
+    assert K.shape[0] >= BLOCK_MIN_DOFS and widths and set(widths) == {4}
+    s = 4 * np.sin(np.arange(1, 4) * np.pi / (2 * (k + 1))) ** 2  # 1-D eigenvalues; the 3-D ones are sums
+    exact = np.sort((s[:, None, None] + s[None, :, None] + s[None, None, :]).ravel())
+    np.testing.assert_allclose(lam, exact[:4], rtol=1e-10, atol=0)
