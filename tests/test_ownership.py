@@ -10,6 +10,7 @@ import signal
 import subprocess
 import sys
 import textwrap
+import time
 from pathlib import Path
 
 import pytest
@@ -375,6 +376,9 @@ _RACER = textwrap.dedent("""
     from bladecase.study import publish as pub
 
     out, tag = Path(sys.argv[1]), sys.argv[2]
+    (out.parent / f"ready-{tag}").touch()  # imported: both racers start together, whatever the machine's load
+    while not (out.parent / "go").exists():
+        time.sleep(0.01)
     try:
         staging = pub.staging_dir(out)
     except pub.OutputInUse as exc:
@@ -393,6 +397,11 @@ def test_two_runs_into_one_folder(tmp_path):
     _results(out, {"modes.json": "old", "report.md": "old", "summary.json": "old"})
     procs = [subprocess.Popen([sys.executable, "-c", _RACER, str(out), tag], stdout=subprocess.PIPE, text=True,
                               cwd=ROOT) for tag in ("first", "second")]
+    deadline = time.monotonic() + 120
+    while not all((tmp_path / f"ready-{tag}").exists() for tag in ("first", "second")):
+        assert time.monotonic() < deadline and all(p.poll() is None for p in procs), "a racer did not start"
+        time.sleep(0.01)
+    (tmp_path / "go").touch()
     outputs = [p.communicate(timeout=120)[0] for p in procs]
     codes = sorted(p.returncode for p in procs)
     assert codes == [0, 3], outputs
