@@ -13,9 +13,10 @@ has contact phases of finite duration instead of impacts. One module per step:
   (:func:`follow_mode`);
 - :mod:`~bladecase.nsm.massless.branches` — the modes as :class:`~bladecase.nsm.branches.Branch` es
   (:func:`massless_modes`, :func:`massless_mode`);
-- :mod:`~bladecase.nsm.massless.nodes` — several contacts, one per contact node (:class:`NodalSystem`): the
-  complementarity of their forces, the phases (sets of closed contacts) and the exact event-driven simulator
-  (:func:`simulate_nodes`), damped and against an out-of-round casing (:class:`Rub`);
+- :mod:`~bladecase.nsm.massless.nodal_system` — several contacts, one per contact node (:class:`NodalSystem`):
+  the complementarity of their forces (:func:`lcp`), the clearances of an out-of-round casing (:class:`Rub`);
+- :mod:`~bladecase.nsm.massless.nodes` — its phases (sets of closed contacts) and the exact event-driven simulator
+  (:func:`simulate_nodes`), damped, each phase's first switch found by :mod:`~bladecase.nsm.massless.nodal_switches`;
 - :mod:`~bladecase.nsm.massless.nodal_orbit` — a period's flow of a :class:`NodalSystem` with its exact Jacobian
   (:func:`flow_map`) and the periodic orbits it closes, with their Floquet multipliers (:class:`NodalOrbit`);
 - :mod:`~bladecase.nsm.massless.nodal_modes` — the nonsmooth modes of a :class:`NodalSystem`: periodic orbits by
