@@ -102,6 +102,11 @@ def test_massless_study_animates_orbits_that_survive_in_the_reference(tmp_path):
     report = (result.directory / "report.md").read_text()
     assert "in contact for t/T in [0.0000, " in report and "Energy: " in report and "Doubtful" not in report
     assert "Stability (Floquet multipliers" in report and "linearly stable (Floquet)" in report
+    ref = result.summary["reference"]
+    assert (f"- Reference model of the orbit check: massless+krylov, {ref['reduced_dofs']} dofs — the reduced model's "
+            "basis extended by the Krylov sequence of its own factorisation (no second eigen-solve); its lowest "
+            f"{len(ref['relative_error_vs_fe'])} frequencies agree with the FE model's to "
+            f"{max(ref['relative_error_vs_fe']):.1e}.") in report
 
 
 def test_massless_study_keys_go_together():

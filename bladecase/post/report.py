@@ -78,7 +78,8 @@ def report(summary: dict) -> str:
              *_static_words(c),
              *rotation_report(summary.get("rotation"), summary.get("campbell")),
              "", "## Reduced model", "",
-             f"- {r['method']} (size {r['size']}): {r['reduced_dofs']} reduced dofs.", "",
+             f"- {r['method']} (size {r['size']}): {r['reduced_dofs']} reduced dofs.",
+             *_reference_model_words(summary.get("reference")), "",
              "| mode | reduced f (Hz) | contact weight b² | FE counterpart (by mode shape) | rel. error |",
              "|---:|---:|---:|---|---:|"]
     fe = m["linear_frequencies_hz"]
@@ -321,6 +322,17 @@ def _counterpart(mt: dict | None) -> str:
         return f"**no FE counterpart** (best MAC {mt['mac']:.2f}, FE mode {mt['best_fe']}): an artefact | —"
     err = mt["relative_error"]
     return f"FE mode {mt['fe_mode']} (MAC {mt['mac']:.3f}) | {'—' if err is None else f'{abs(err):.2e}'}"
+
+
+def _reference_model_words(ref: dict | None) -> list[str]:
+    """The reference model of the orbit check, said once where the models are listed."""
+    if not ref:
+        return []
+    how = ("the reduced model's basis extended by the Krylov sequence of its own factorisation (no second "
+           "eigen-solve)" if str(ref["method"]).endswith("+krylov") else "a model from its own eigen-solve")
+    err = ref.get("relative_error_vs_fe") or []
+    fit = (f"; its lowest {len(err)} frequencies agree with the FE model's to {max(err):.1e}" if err else "")
+    return [f"- Reference model of the orbit check: {ref['method']}, {ref['reduced_dofs']} dofs — {how}{fit}."]
 
 
 def _reference_words(check: dict, k: int) -> str:
