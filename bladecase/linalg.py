@@ -440,11 +440,12 @@ def _eigen_method(method: str, factor: Factor, n: int) -> str:
     return method
 
 
-def _sparse_modes(K, M, count: int, factor: Factor, method: str) -> tuple[np.ndarray, np.ndarray]:
+def _sparse_modes(K, M, count: int, factor: Factor, method: str,
+                  space: list | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Shift-invert eigenpairs about 0 with ``factor``: block Lanczos (falls back to ARPACK) or ARPACK."""
     if _eigen_method(method, factor, K.shape[0]) == "block" and count + 2 <= K.shape[0]:
         block = min(_BLOCK_SOLVES.get(factor.backend, BLOCK_SIZE), K.shape[0] - count)
-        found = block_lanczos(K, M, factor.solve, count, block=block)
+        found = block_lanczos(K, M, factor.solve, count, block=block, space=space)
         if found is not None:
             return found
     # a fixed start vector: the same modes (signs, and the basis of repeated eigenvalues) on every run
@@ -478,7 +479,7 @@ def _check_pencil(K, M, name: str) -> None:
 
 def lowest_modes(
     K, M, count: int, factor: SPDFactor | None = None, *, dense: bool | None = None, name: str = "K", hint: str = "",
-    method: str = "auto",
+    method: str = "auto", space: list | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The ``count`` lowest eigenpairs ``(λ, Φ)`` of ``K φ = λ M φ`` (``K``, ``M`` symmetric positive definite).
 
@@ -505,6 +506,9 @@ def lowest_modes(
         Sparse path: ``"arpack"``, ``"block"``, or ``"auto"`` (block Lanczos for a factor that solves blocks
         fast, CHOLMOD, and at least :data:`BLOCK_MIN_DOFS` rows; ARPACK otherwise).  Both give the frequencies
         to ~1e-10 relative (residuals ``‖Kφ - λMφ‖ / ‖Kφ‖`` ~1e-8).
+    space : list or None
+        When the block Lanczos found the modes, the Ritz vectors of the rest of its Krylov basis are appended
+        to it (``block_lanczos``'s ``space``); nothing is appended otherwise.
 
     Returns
     -------
@@ -551,7 +555,7 @@ def lowest_modes(
             factor = spd_factor(K, name, hint=hint)
         elif not isinstance(factor, Factor) or factor.n != n:
             raise ValueError(f"factor must be a factorisation of {name} ({n} × {n}, from spd_factor), got {factor!r}")
-        lam, phi = _sparse_modes(K, M, count, factor, method)
+        lam, phi = _sparse_modes(K, M, count, factor, method, space)
         norms = np.einsum("ij,ij->j", phi, M @ phi)
         if not np.all(norms > 0):
             raise ValueError(f"M gives mode {int(np.argmin(norms > 0)) + 1} a modal mass {norms.min():.3g} <= 0: M is "

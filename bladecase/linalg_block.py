@@ -60,8 +60,8 @@ def _m_orthonormalise(Y: np.ndarray, V: np.ndarray, MV: np.ndarray, M,
 
 
 def block_lanczos(K, M, solve: Callable[[np.ndarray], np.ndarray], count: int, *, block: int = BLOCK_SIZE,
-                  tol: float = BLOCK_TOL, max_dim: int | None = None,
-                  seed: int = 0) -> tuple[np.ndarray, np.ndarray] | None:
+                  tol: float = BLOCK_TOL, max_dim: int | None = None, seed: int = 0,
+                  space: list | None = None) -> tuple[np.ndarray, np.ndarray] | None:
     """The ``count`` lowest eigenpairs of ``K φ = λ M φ`` by block shift-invert Lanczos (module docstring).
 
     Parameters
@@ -79,6 +79,10 @@ def block_lanczos(K, M, solve: Callable[[np.ndarray], np.ndarray], count: int, *
         Largest basis (columns); default ``min(n, max(4 count, count + 20 block))``.
     seed : int
         Seed of the random start block (the result is reproducible).
+    space : list or None
+        On convergence, the Ritz vectors of the whole Krylov basis beyond the ``count`` returned (``M``-orthonormal,
+        ``(n, m - count)``, lowest eigenvalue first) are appended to it: directions a richer model can reuse
+        without another solve (:func:`bladecase.reduction.krylov_extension`).
 
     Returns
     -------
@@ -113,10 +117,12 @@ def block_lanczos(K, M, solve: Callable[[np.ndarray], np.ndarray], count: int, *
             C = MV[:, :m].T @ W  # (m, block): the new columns of H = VᵀM S M V
             H[:m, m - block:m] = C
             H[m - block:m, :m - block] = C[:m - block].T
-            theta, Z = np.linalg.eigh(0.5 * (H[:m, :m] + H[:m, :m].T))
-            theta, Z = theta[::-1][:count], Z[:, ::-1][:, :count]
+            theta_all, Z_all = np.linalg.eigh(0.5 * (H[:m, :m] + H[:m, :m].T))
+            theta, Z = theta_all[::-1][:count], Z_all[:, ::-1][:, :count]
             Q, MQ, R = _m_orthonormalise(W, V[:, :m], MV[:, :m], M, C)
             if m >= count and np.all(np.linalg.norm(R @ Z[m - block:m], axis=0) <= tol * theta):
+                if space is not None:
+                    space.append(V[:, :m] @ Z_all[:, ::-1][:, count:])
                 return 1.0 / theta, V[:, :m] @ Z
     except np.linalg.LinAlgError:  # an invariant subspace (or a breakdown) before convergence
         return None

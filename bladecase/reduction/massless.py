@@ -81,13 +81,16 @@ class MasslessReducedModel(ReducedModel):
     ``basis`` is ``V_full`` (open-phase displacements of every free dof; sparse for the exact condensation,
     ``size=None``); ``closed_shape`` the free-dof displacement per unit contact force with the interior held
     (``−K_cc⁻¹w_c`` on the contact dofs, zero elsewhere), added ``λ`` times in a closed phase; ``masses`` the
-    redistributed lumped masses of the free dofs (zero on the contact dofs). :meth:`free_dofs` and
+    redistributed lumped masses of the free dofs (zero on the contact dofs); ``spare`` the interior rows of the
+    directions the eigen-solver's Krylov basis holds beyond the modes (Ritz vectors, lowest first; ``None`` when
+    ARPACK found the modes), which the reference model reuses (:func:`extend_massless`). :meth:`free_dofs` and
     :meth:`expand_state` take positions (they add the closed-phase correction); velocities go through
     :meth:`free_velocities` (``λ'`` on the contact dofs), which :meth:`expand` uses.
     """
 
     closed_shape: np.ndarray = field(default=None, repr=False)  # type: ignore[assignment]
     masses: np.ndarray = field(default=None, repr=False)  # type: ignore[assignment]
+    spare: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def mass_matrix(self) -> sp.dia_array:
@@ -299,14 +302,16 @@ def massless_model(model: FEModel, contact: Contact, size: int | None = None,
     else:
         fac = factor if factor is not None else spd_factor(model.K, _K, hint=_HINT)
         attach = fac.solve(split.w)[split.i]
+        space: list = []
         if basis == "krylov":
             V_i = _krylov(split, masses, size, fac)
         elif basis == "modal":
-            phi = _interior_modes(split, masses, size, fac)
+            phi = _interior_modes(split, masses, size, fac, space)
             V_i = phi / np.sqrt(np.einsum("ij,i,ij->j", phi, masses[split.i], phi))
         else:
-            V_i = _m_orthonormal(_interior_modes(split, masses, size, fac), attach, masses[split.i])
-        return _reduced(split, masses, V_i, model, contact, BASES[basis], size)
+            V_i = _m_orthonormal(_interior_modes(split, masses, size, fac, space), attach, masses[split.i])
+        return _reduced(split, masses, V_i, model, contact, BASES[basis], size,
+                        spare=space[0][split.i] if space else None)
     S_r = split.schur()
     system = MasslessSystem(np.asarray(M_r), 0.5 * (S_r + S_r.T), np.asarray(V.T @ split.w),
                             series_stiffness(split.kc, contact.casing), contact.gap, casing=contact.casing)
@@ -315,7 +320,7 @@ def massless_model(model: FEModel, contact: Contact, size: int | None = None,
 
 
 def _reduced(split: _Split, masses: np.ndarray, V_i: np.ndarray, model: FEModel, contact: Contact, method: str,
-             size: int) -> MasslessReducedModel:
+             size: int, spare: np.ndarray | None = None) -> MasslessReducedModel:
     """The massless model on the interior basis ``V_i`` (the contact rows slaved: ``V_full``)."""
     V = np.zeros((split.w.size, V_i.shape[1]))
     V[split.i], V[split.c] = V_i, split.slave(V_i)
@@ -324,7 +329,7 @@ def _reduced(split: _Split, masses: np.ndarray, V_i: np.ndarray, model: FEModel,
     system = MasslessSystem(0.5 * (M_r + M_r.T), 0.5 * (S_r + S_r.T), np.asarray(V.T @ split.w),
                             series_stiffness(split.kc, contact.casing), contact.gap, casing=contact.casing)
     return MasslessReducedModel(method, size, system, V, model, contact, closed_shape=split.closed_shape(),
-                                masses=masses)
+                                masses=masses, spare=spare)
 
 
 def _interior_operator(split: _Split, masses: np.ndarray, fac: SPDFactor):
@@ -338,14 +343,25 @@ def _interior_operator(split: _Split, masses: np.ndarray, fac: SPDFactor):
 
 def extend_massless(reduced: MasslessReducedModel, count: int, fac: SPDFactor) -> MasslessReducedModel:
     """:func:`bladecase.reduction.extension.krylov_extension` of a massless model: the interior basis extended
-    by the block Krylov sequence of the massless structure (its interior columns and the attachment vector's)."""
+    by the block Krylov sequence of the massless structure (its interior columns and the attachment vector's).
+
+    When the model's modes came from the block Lanczos (``spare``), its Krylov space stands for the random
+    directions of :data:`~bladecase.reduction.extension.WIDEN`: the attachment vector's sequence takes the same
+    share of the new dofs (one in ``1 + widen``), the eigen-solver's Ritz vectors the rest, lowest first — no solve
+    beyond the sequence's."""
     from .extension import FRONTIER, SUFFIX, WIDEN, extend_basis
 
     split = _split(reduced.model, reduced.contact)
     m_i = reduced.masses[split.i]
-    V_i = extend_basis(np.asarray(reduced.basis)[split.i], fac.solve(split.w)[split.i],
-                       _interior_operator(split, reduced.masses, fac), lambda X: (m_i * X.T).T,
-                       min(count, split.i.size - 1), FRONTIER.get(reduced.method), widen=WIDEN.get(reduced.method, 0))
+    operator, mass = _interior_operator(split, reduced.masses, fac), lambda X: (m_i * X.T).T
+    count, frontier, widen = min(count, split.i.size - 1), FRONTIER.get(reduced.method), WIDEN.get(reduced.method, 0)
+    V_i = np.asarray(reduced.basis)[split.i]
+    if reduced.spare is not None and widen:  # the contact's own sequence, then the eigen-solver's Krylov space
+        V_i = extend_basis(V_i, fac.solve(split.w)[split.i], operator, mass,
+                           V_i.shape[1] + (count - V_i.shape[1]) // (1 + widen), frontier)
+        frontier = ()
+    V_i = extend_basis(V_i, fac.solve(split.w)[split.i] if reduced.spare is None else reduced.spare, operator, mass,
+                       count, frontier, widen=widen if reduced.spare is None else 0)
     return _reduced(split, reduced.masses, V_i, reduced.model, reduced.contact, reduced.method + SUFFIX,
                     V_i.shape[1])
 
@@ -360,7 +376,8 @@ def _exact_basis(split: _Split) -> sp.csr_array:
     return sp.csr_array((np.r_[np.ones(n_i), X[r, k]], (rows, cols)), shape=(n, n_i))
 
 
-def _interior_modes(split: _Split, masses: np.ndarray, count: int, fac: SPDFactor) -> np.ndarray:
+def _interior_modes(split: _Split, masses: np.ndarray, count: int, fac: SPDFactor,
+                    space: list | None = None) -> np.ndarray:
     """Interior parts of the ``count`` lowest modes of the massless structure, ``M_ii``-normalised.
 
     Sparse: ``K φ = ω² M φ`` on all free dofs with ``M`` zero on the contact (shift-invert about 0 with ``fac``;
@@ -373,7 +390,7 @@ def _interior_modes(split: _Split, masses: np.ndarray, count: int, fac: SPDFacto
         _, phi = sla.eigh(split.schur(), np.diag(m_i), subset_by_index=[0, count - 1])
         return phi
     _, phi = lowest_modes(split.K, sp.diags_array(masses, format="csr"), count, factor=fac, dense=False, name=_K,
-                          hint=_HINT)
+                          hint=_HINT, space=space)
     return phi[split.i]
 
 
