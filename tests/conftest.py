@@ -10,7 +10,8 @@ Reference systems
 
 Engines
 -------
-* ``dask_executor`` — one 2-worker Dask ``LocalCluster`` for the whole session (its start-up is seconds).
+* ``dask_executor`` — one 2-worker Dask ``LocalCluster`` shared by the files that use it (its start-up is
+  seconds), closed when the session moves on to other files.
 
 Independent references (numpy / scipy only, never bladecase) live in ``_util.py``.
 
@@ -27,6 +28,7 @@ executor workers get one BLAS thread removes the variable first; Dask's nanny se
 from __future__ import annotations
 
 import functools
+import gc
 import importlib.util
 import os
 from pathlib import Path
@@ -78,11 +80,20 @@ def random_backbone(random_sys) -> bc.Backbone:
 
 @pytest.fixture(scope="session")
 def dask_executor():
+    """One 2-worker ``LocalCluster``, started at its first ``map`` and closed as soon as this process leaves the
+    files of :data:`DASK_FILES` (:func:`pytest_runtest_teardown`): an idle cluster is not free — its scheduler, two
+    worker processes and their nannies heartbeat, about 10 % of a core, which ran under the rest of the session on a
+    2-core machine.  A later use (another file, or another order of the files) starts it again (the executor
+    starts its cluster lazily)."""
     pytest.importorskip("distributed")
     from bladecase.study import DaskExecutor
 
     with DaskExecutor(workers=2) as ex:
-        yield ex
+        _DASK.append(ex)
+        try:
+            yield ex
+        finally:
+            _DASK.remove(ex)
 
 
 def load_example(name: str):
@@ -91,6 +102,53 @@ def load_example(name: str):
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     return mod
+
+
+def fork_script(script: str | Path, *args, log: Path, cwd: Path | None = None):
+    """``script`` (Python source, or a script file) run as ``__main__`` with the arguments ``args`` in a forked
+    child of this process, where bladecase is already imported: no interpreter starts (about a second of CPU each).
+    For what a script does, not for what importing does (that needs a fresh interpreter).  SIGINT and SIGTERM are
+    handled as in a fresh interpreter, stdout and stderr go to the file ``log``, the working directory is ``cwd``
+    if given.  Returns the started child (``join``, ``is_alive``, ``exitcode``: ``-signum`` when a signal killed
+    it, 1 after an uncaught exception)."""
+    import multiprocessing
+
+    child = multiprocessing.get_context("fork").Process(target=_script_in_child, args=(script, args, log, cwd))
+    child.start()
+    return child
+
+
+def run_forked(script: str | Path, *args, cwd: Path | None = None, timeout: float = 120) -> tuple[int, str]:
+    """:func:`fork_script` to its end: the exit code and the output (stdout and stderr)."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        log = Path(tmp) / "output.txt"
+        child = fork_script(script, *args, log=log, cwd=cwd)
+        child.join(timeout)
+        if child.is_alive():
+            child.kill()
+            child.join()
+            raise TimeoutError(f"the forked script did not finish within {timeout} s")
+        return child.exitcode, log.read_text()
+
+
+def _script_in_child(script: str | Path, args: tuple, log: Path, cwd: Path | None) -> None:
+    import runpy
+    import signal
+    import sys
+
+    signal.signal(signal.SIGINT, signal.default_int_handler)  # an interpreter's own handlers, whatever the parent's
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if cwd is not None:
+        os.chdir(cwd)
+    sys.stdout = sys.stderr = open(log, "w", buffering=1)  # the child's streams until it exits
+    if isinstance(script, Path):
+        sys.argv = [str(script), *map(str, args)]
+        runpy.run_path(str(script), run_name="__main__")
+    else:
+        sys.argv = ["-c", *map(str, args)]
+        exec(script, {"__name__": "__main__"})
 
 
 @pytest.fixture(scope="session")
@@ -122,37 +180,57 @@ HEAVIEST_FIRST = [
     "tests/test_search_speed.py",
     "tests/test_rub_study.py",
     "tests/test_kipp.py",
+    "tests/test_inputs_api.py",  # mostly waiting (time-outs of unreachable schedulers), little CPU
     "tests/test_nodal_modes.py",
-    "tests/test_ownership.py",
-    "tests/test_engineering_outputs.py",
-    "tests/test_nodal_study.py",
     "tests/test_fem.py",
+    "tests/test_engineering_outputs.py",
     "tests/test_forcing_stage.py",
-    "tests/test_nodes.py",
     "tests/test_compare_decides.py",
-    "tests/test_inputs_api.py",
     "tests/test_readme.py",
     "tests/test_casing_sweep.py",
+    "tests/test_nodal_study.py",
+    "tests/test_nodes.py",
     "tests/test_forced_massless.py",
     "tests/test_calculix.py",
     "tests/test_isoparametric.py",
-    "tests/test_scan.py",
-    "tests/test_massless.py",
-    "tests/test_orbits.py",
     "tests/test_hex_blade.py",
-    "tests/test_viz.py",
     "tests/test_tip_excursion.py",
+    "tests/test_scan.py",
+    "tests/test_orbits.py",
+    "tests/test_viz.py",
+    "tests/test_massless.py",
     "tests/test_rotation_study.py",
     "tests/test_rotation.py",
+    "tests/test_ownership.py",
 ]
+
+#: The files that use ``dask_executor`` (one work unit of :data:`SAME_WORKER`) and the session's executor while it
+#: exists.
+DASK_FILES = ("tests/test_executor.py", "tests/test_comparison_study.py")
+_DASK: list = []
+
 
 #: Files that share session fixtures, each group one work unit (run one after the other on one worker, so the
 #: fixture is computed once): the Dask cluster (``dask_executor``: each start spawns and imports two Dask workers,
 #: seconds of CPU) and the Fig. 8 example's computations (``fig8_example``).
 SAME_WORKER = [
-    ("tests/test_executor.py", "tests/test_comparison_study.py"),
+    DASK_FILES,
     ("tests/test_examples.py", "tests/test_fig8.py"),
 ]
+
+
+def pytest_collection_finish(session):
+    """Move what collection built (modules, test items, fixtures' definitions: most of a worker's objects, alive
+    until the end) out of the cyclic garbage collector's reach: its full collections then walk only what the tests
+    create (measured over the suite: about 3 s of full collections per worker, half that with the freeze)."""
+    gc.collect()
+    gc.freeze()
+
+
+def pytest_runtest_teardown(item, nextitem):
+    """Close the Dask cluster once the next test is not in :data:`DASK_FILES` (or there is none)."""
+    if _DASK and (nextitem is None or nextitem.path.name not in {Path(f).name for f in DASK_FILES}):
+        _DASK[0].close()
 
 
 @pytest.hookimpl(optionalhook=True)  # a pytest-xdist hook: no error where xdist is not loaded (-p no:xdist)

@@ -22,8 +22,6 @@ follow the families once, which keeps the file fast.
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import matplotlib
@@ -33,7 +31,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 import pytest
-from conftest import load_example
+from conftest import load_example, run_forked
 
 import bladecase as bc
 from bladecase.nsm import ModalKernel
@@ -108,14 +106,14 @@ print(json.dumps(out))
 
 @pytest.fixture(scope="module")
 def cli_help():
-    """``example.py --help`` of every example, each run as ``__main__`` in one fresh interpreter (one import of
-    bladecase for all of them)."""
+    """``example.py --help`` of every example, each run as ``__main__`` in one forked child of this process
+    (conftest's :func:`run_forked`: bladecase already imported, no interpreter start)."""
     import json
 
     paths = [str(EXAMPLES / f"{name}.py") for name in NAMES]
-    r = subprocess.run([sys.executable, "-c", _HELP_ALL, *paths], capture_output=True, text=True, timeout=120)
-    assert r.returncode == 0, r.stderr
-    return json.loads(r.stdout.strip().splitlines()[-1])
+    code, output = run_forked(_HELP_ALL, *paths)
+    assert code == 0, output
+    return json.loads(output.strip().splitlines()[-1])
 
 
 @pytest.mark.parametrize("name", NAMES)

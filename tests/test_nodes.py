@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
+from scipy.optimize import nnls
 
 from bladecase.nsm import Damping, condense, simulate_massless
 from bladecase.nsm.massless.nodes import NodalFlight, NodalSystem, Rub, lcp, simulate_nodes
@@ -35,18 +36,26 @@ def chain(casing=np.inf, masses=(1.0, 1.5, 0.7)) -> NodalSystem:
 
 def reference(s: NodalSystem, x0, v0, t_end, damping=None, rub=None):
     """solve_ivp (DOP853, rtol 1e-12) on ``M x'' + C x' + S x + W λ(x, t) = 0``, λ from the complementarity
-    problem at every evaluation, restarted at every switch (events on ``λ_j − s_j``, which changes sign at each)."""
+    problem at every evaluation, restarted at every switch (events on ``λ_j − s_j``, which changes sign at each).
+
+    The complementarity problem ``λ >= 0``, ``q + Hλ >= 0``, ``λᵀ(q + Hλ) = 0`` (``H`` positive definite: one
+    solution) is solved here as the bound-constrained least squares ``min |Rλ + R⁻ᵀq|`` over ``λ >= 0``
+    (``H = RᵀR``), with ``R`` and ``R⁻ᵀ`` computed once (tens of thousands of evaluations)."""
     fl = NodalFlight(s, damping, rub)
     Minv = np.linalg.inv(s.M)
     Cq = fl.Cq if fl.Cq is not None else np.zeros((s.n, s.n))
     C = s.M @ fl.phi @ Cq @ fl.phi.T @ s.M
+    R = np.linalg.cholesky(s.H).T
+    R_inv_t = np.linalg.inv(R).T
+    none = np.zeros(s.m)
 
     def lam(t, x):
-        return lcp(fl.gap(t) - s.W.T @ x, s.H)
+        q = fl.gap(t) - s.W.T @ x
+        return none if np.all(q >= 0) else nnls(R, -(R_inv_t @ q), maxiter=50 * s.m)[0]
 
     def rhs(t, z):
         x, v = z[: s.n], z[s.n:]
-        return np.r_[v, Minv @ (-s.S @ x - C @ v - s.W @ lam(t, x))]
+        return np.concatenate((v, Minv @ (-s.S @ x - C @ v - s.W @ lam(t, x))))
 
     def event(j):
         def f(t, z):

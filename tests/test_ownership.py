@@ -8,19 +8,17 @@ import json
 import os
 import signal
 import subprocess
-import sys
 import textwrap
 import time
 from pathlib import Path
 
 import pytest
 from _studies import PLATE, absolute
+from conftest import fork_script, run_forked
 
 from bladecase.cli import main
 from bladecase.study import manifest as mf
 from bladecase.study import publish as pub
-
-ROOT = Path(__file__).resolve().parents[1]
 
 
 def _tree(folder: Path) -> dict[str, bytes | None]:
@@ -302,28 +300,16 @@ _NEW = {"modes.json": "new modes", "report.md": "new report", "summary.json": "n
         "animations/b.gif": "new gif", "vtk/b.pvd": "new pvd"}
 
 
-def _publisher(out: Path, kill_at: int, signum: int) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-c", _PUBLISHER, str(out), str(kill_at), str(int(signum))],
-                          capture_output=True, text=True, timeout=120, cwd=ROOT)
+def _publisher(out: Path, kill_at: int, signum: int) -> tuple[int, str]:
+    """``_PUBLISHER`` on ``out`` in a forked child (conftest's :func:`run_forked`: bladecase already imported, no
+    interpreter start per run), sending itself ``signum`` at its ``kill_at``-th move: its exit code (``-signum``
+    when cut) and output."""
+    return run_forked(_PUBLISHER, out, kill_at, int(signum))
 
 
 def _forked_publisher(out: Path, kill_at: int) -> int:
-    """``_PUBLISHER`` in a forked child of this process (bladecase already imported: no interpreter start per
-    cut), SIGKILLed at its ``kill_at``-th move; its exit code (``-SIGKILL`` when cut)."""
-    import multiprocessing
-
-    ctx = multiprocessing.get_context("fork")
-    child = ctx.Process(target=_publish_in_child, args=(out, kill_at))
-    child.start()
-    child.join(60)
-    return child.exitcode
-
-
-def _publish_in_child(out: Path, kill_at: int) -> None:
-    import sys as _sys
-
-    _sys.argv = ["-c", str(out), str(kill_at), str(int(signal.SIGKILL))]
-    exec(_PUBLISHER, {"__name__": "__main__"})
+    """``_PUBLISHER`` SIGKILLed at its ``kill_at``-th move; its exit code (``-SIGKILL`` when cut)."""
+    return _publisher(out, kill_at, signal.SIGKILL)[0]
 
 
 def _files(out: Path) -> dict[str, str]:
@@ -339,9 +325,9 @@ def test_publishing_cut_by_sigkill_at_every_step_leaves_old_or_new(tmp_path):
     template = tmp_path / "template"
     os.rename(out, template)
     subprocess.run(["cp", "-a", str(template), str(tmp_path / "probe")], check=True)
-    done = _publisher(tmp_path / "probe", 10**6, signal.SIGKILL)  # count the moves of a whole publication
-    assert done.returncode == 0, done.stderr
-    moves = int(done.stdout.split()[-1])
+    code, output = _publisher(tmp_path / "probe", 10**6, signal.SIGKILL)  # count the moves of a whole publication
+    assert code == 0, output
+    moves = int(output.split()[-1])
     assert moves >= 8
     seen = set()
     for k in range(1, moves + 1):
@@ -364,8 +350,8 @@ def test_publishing_cut_by_sigkill_at_every_step_leaves_old_or_new(tmp_path):
 def test_sigterm_or_ctrl_c_while_publishing_waits_for_the_whole_new_set(tmp_path, signum):
     out = tmp_path / "out"
     _results(out, _OLD)
-    cut = _publisher(out, 3, signum)
-    assert cut.returncode in (-signum, 1), cut.stderr  # killed by the signal once the entries are in place
+    code, output = _publisher(out, 3, signum)
+    assert code in (-signum, 1), output  # killed by the signal once the entries are in place
     assert not (out / pub.MARKER).exists()
     assert _files(out) == _NEW
 
@@ -395,15 +381,16 @@ _RACER = textwrap.dedent("""
 def test_two_runs_into_one_folder(tmp_path):
     out = tmp_path / "out"
     _results(out, {"modes.json": "old", "report.md": "old", "summary.json": "old"})
-    procs = [subprocess.Popen([sys.executable, "-c", _RACER, str(out), tag], stdout=subprocess.PIPE, text=True,
-                              cwd=ROOT) for tag in ("first", "second")]
+    procs = [fork_script(_RACER, out, tag, log=tmp_path / f"{tag}.log") for tag in ("first", "second")]
     deadline = time.monotonic() + 120
     while not all((tmp_path / f"ready-{tag}").exists() for tag in ("first", "second")):
-        assert time.monotonic() < deadline and all(p.poll() is None for p in procs), "a racer did not start"
+        assert time.monotonic() < deadline and all(p.is_alive() for p in procs), "a racer did not start"
         time.sleep(0.01)
     (tmp_path / "go").touch()
-    outputs = [p.communicate(timeout=120)[0] for p in procs]
-    codes = sorted(p.returncode for p in procs)
+    for p in procs:
+        p.join(120)
+    outputs = [(tmp_path / f"{tag}.log").read_text() for tag in ("first", "second")]
+    codes = sorted(p.exitcode for p in procs)
     assert codes == [0, 3], outputs
     assert "in use by another bladecase run" in "".join(outputs)
     values = set(_files(out).values())

@@ -122,13 +122,14 @@ def test_bad_rotation_keys(extra, words):
         loads(text + extra, base=ROOT)
 
 
-def test_a_running_clearance_given_at_speed(tmp_path):
+def test_a_running_clearance_given_at_speed(spun, tmp_path):
     """clearance_at = "speed": the clearance is the running one at the operating speed; the Campbell speeds see the
     cold clearance it implies (running + closure there), so the same blade gives the same bands as with cold."""
-    cold = run(_study(), tmp_path / "cold", progress=False).summary
+    cold = spun.summary  # run(_study()): the cold-clearance study, run once for the module
     running = cold["rotation"]["clearance_running_m"]
-    hot = run(_study(ROTATION, PLATE.replace("clearance = 1e-4", f"clearance = {running!r}\nclearance_at = 'speed'")
-                     ), tmp_path / "hot", progress=False).summary
+    hot = run(_study(ROTATION.replace('formats = ["png"]', "formats = []"),  # the numbers only (figures: spun's)
+                     PLATE.replace("clearance = 1e-4", f"clearance = {running!r}\nclearance_at = 'speed'")),
+              tmp_path / "hot", progress=False).summary
     assert hot["rotation"]["clearance_running_m"] == pytest.approx(running, rel=1e-12)
     assert hot["rotation"]["clearance_cold_m"] == pytest.approx(1e-4, rel=1e-9)
     assert hot["campbell"]["running_clearance_m"] == pytest.approx(cold["campbell"]["running_clearance_m"], rel=1e-9)

@@ -48,6 +48,16 @@ def result(tmp_path_factory):
     return run(study, out, progress=False), out
 
 
+@pytest.fixture(scope="module")
+def blade():
+    """The demo blade's FE model at rest, built once for the tests that call the stage itself (the [casing] and [rub]
+    keys they change are not the mesh's or the model's)."""
+    from bladecase.study.stages import build_mesh, build_model
+
+    study = loads(_study(), source="<rub>")
+    return build_model(study, build_mesh(study))
+
+
 def test_rub_outputs(result):
     res, out = result
     for name in ("rub.csv", "rub_nodes.csv", "rub.png", "rub.vtu"):
@@ -96,27 +106,26 @@ def test_rub_input_errors(casing, rub, contact, match):
         loads(_study(casing, rub, **contact), source="<rub>")
 
 
-def test_a_speed_whose_growth_closes_a_clearance_is_named():
+def test_a_speed_whose_growth_closes_a_clearance_is_named(blade):
     from bladecase.study.executor import SerialExecutor
     from bladecase.study.rub import rub_stage
-    from bladecase.study.stages import build_contact, build_mesh, build_model
+    from bladecase.study.stages import build_contact
 
     study = loads(_study(rub=RUB.replace("speeds = [1450, 1650]", "speeds = [1450, 3000]")), source="<rub>")
-    model = build_model(study, build_mesh(study))
+    model = blade
     with pytest.raises(StudyError, match=r"rpm\) the blade's centrifugal growth .* closes the clearance of contact "
                                          r"node \d+ \(0.5 mm cold\)"):
         rub_stage(study, model, build_contact(study, model), executor=SerialExecutor())
 
 
-def test_stiffness_per_area_gives_each_node_its_share(tmp_path):
+def test_stiffness_per_area_gives_each_node_its_share(blade):
     from bladecase.study.rub import _node_stiffness
-    from bladecase.study.stages import build_contact, build_mesh, build_model
+    from bladecase.study.stages import build_contact
 
     text = _study().replace("casing_stiffness = 1e6      # N/m: a thin casing's local radial stiffness; the modes "
                             "converge (docs/massless.md)\n", "casing_stiffness_per_area = 2e9\n")
     study = loads(text, source="<rub>")
-    mesh = build_mesh(study)
-    model = build_model(study, mesh)
+    model = blade
     contact = build_contact(study, model)
     from bladecase.reduction.contact import tributary_areas
 
@@ -128,12 +137,12 @@ def test_stiffness_per_area_gives_each_node_its_share(tmp_path):
     assert area.sum() == pytest.approx(0.685 * 0.12 * 0.035**2, rel=0.05)
 
 
-def test_a_speed_the_simulation_refuses_is_reported_and_the_others_go_on(monkeypatch):
+def test_a_speed_the_simulation_refuses_is_reported_and_the_others_go_on(blade, monkeypatch):
     """A ValueError of the simulation at one speed (e.g. a grazing switch) is that speed's result, not the end of
     the sweep: the other speeds are computed, the failed one is listed with its reason."""
     from bladecase.study import rub as stage
     from bladecase.study.executor import SerialExecutor
-    from bladecase.study.stages import build_contact, build_mesh, build_model
+    from bladecase.study.stages import build_contact
 
     real = stage.rub_response
 
@@ -144,7 +153,7 @@ def test_a_speed_the_simulation_refuses_is_reported_and_the_others_go_on(monkeyp
 
     monkeypatch.setattr(stage, "rub_response", flaky)
     study = loads(_study(rub=RUB.replace("speeds = [1450, 1650]", "speeds = [1450, 1650, 1660]")), source="<rub>")
-    model = build_model(study, build_mesh(study))
+    model = blade
     s = stage.rub_stage(study, model, build_contact(study, model), executor=SerialExecutor())
     assert [r["speed"] for r in s["rows"]] == [1650.0, 1660.0]
     assert s["failed_speeds"] == [{"speed": 1450.0, "reason": "grazing switch: a contact signal does not leave its "
