@@ -43,7 +43,17 @@ demo32 one family fewer; docs/performance.md has the analysis.  Third pass: the 
 then k = 2 fixed-period solves by the scalar equation (``solve_pairs``): interleaved, chain50 12.2 -> 9.9,
 demo8 3.08 -> 2.11, demo32 92 -> 50 (loaded machine).  Fourth pass (families, spans and arcs identical):
 stacked matches in the de-duplication, the corrector's closed-form 3×2 least squares for big stacks, the arc-end
-probe; medians of 5 interleaved runs chain20 4.75 -> 3.99, chain50 9.60 -> 8.41, demo8 2.23 -> 1.98.
+probe; medians of 5 interleaved runs chain20 4.75 -> 3.99, chain50 9.60 -> 8.41, demo8 2.23 -> 1.98.  Fifth
+pass (every orbit and arc bit for bit the same, k = 2, 3, 4): the trace's kernel terms in a scratch space reused
+from evaluation to evaluation (fresh temporaries of a few hundred kB took ~620 000 page faults in a fresh process),
+the first corrector evaluation shared by the chord and the Newton retry, full Newton's Jacobian at its converged
+points kept, no last evaluation for rows that can no longer converge, the chord's pseudo-inverse kept while a step
+is halved; certification by ``newton.certify`` (the grid's powers of a batch of flights at once in reused memory,
+a flight whose grid shows a violation finished there: polished orbits' certification 3x cheaper); vectorised
+acceptance and records of the polished orbits, k = 2 canonical rotations in scalar arithmetic.  CPU medians of 3
+(load 2-3.5, ``--cases chain10,chain20,chain50,demo8``, interleaved): chain10 1.31 -> 1.01, chain20 2.77 -> 2.23,
+chain50 5.73 -> 4.44, demo8 1.42 -> 1.21; ``--cases chain50,demo8`` (chain50 first: the baseline's first run
+6.98-8.1 s, faulting) chain50 5.65 -> 4.28 and 5.60 -> 4.59.
 
 With ``--compare`` each case also reports the arcs of before inside no arc of after (and the reverse) and how
 many middle orbits of the arcs of before lie on no family of after (re-solved from every new family,

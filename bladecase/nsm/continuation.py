@@ -42,6 +42,11 @@ Vector = np.ndarray
 _LSTSQ = getattr(getattr(np.linalg, "_umath_linalg", None), "lstsq", None)
 
 
+#: The machine epsilon, and ``4 ε`` of :func:`roundoff_floor`.
+_EPS = float(np.finfo(float).eps)
+_FOUR_EPS = 4 * _EPS
+
+
 def _always(z) -> bool:
     return True
 
@@ -102,7 +107,7 @@ def roundoff_floor(J: np.ndarray, z: np.ndarray) -> np.ndarray:
     >>> float(roundoff_floor(J, np.array([1.0, 0.5]))) > 1e-10     # no residual below 1e-10 is representable
     True
     """
-    return 4 * np.finfo(float).eps * (np.abs(J) @ np.abs(z)[..., None])[..., 0].max(axis=-1)
+    return _FOUR_EPS * (np.abs(J) @ np.abs(z)[..., None])[..., 0].max(axis=-1)
 
 
 def correct(curve: Curve, zp: Vector, direction: Vector, J: np.ndarray | None = None,
@@ -266,7 +271,7 @@ def lstsq_stack(A: np.ndarray, b: np.ndarray, rcond: float | None = None) -> np.
     [[1.0, 1.0], [2.0, 2.0]]
     """
     count, M, N = A.shape
-    rcond = np.finfo(float).eps * max(M, N) if rcond is None else rcond
+    rcond = _EPS * max(M, N) if rcond is None else rcond
     if _LSTSQ is not None and count:
         try:
             with np.errstate(all="ignore"):
@@ -316,7 +321,7 @@ def lstsq2_stack(A: np.ndarray, b: np.ndarray, min_rows: int = LSTSQ2_MIN_ROWS) 
         x2 = np.where(uu > 0, y2, w[:, 0]) / r22
         x1 = (y[:, 0] - a2[:, 0] * x2) / r11
         out = np.stack([x1, x2], axis=1)
-        weak = ~(np.abs(r22) > 100 * np.finfo(float).eps * np.maximum(np.abs(r11), np.abs(a2[:, 0])))
+        weak = ~(np.abs(r22) > 100 * _EPS * np.maximum(np.abs(r11), np.abs(a2[:, 0])))
     finite = np.isfinite(A).all(axis=(1, 2)) & np.isfinite(b).all(axis=1)
     out[~finite] = np.nan  # as LAPACK leaves them
     weak = finite & (weak | ~np.isfinite(out).all(axis=1))
@@ -343,38 +348,71 @@ def pinv_stack(A: np.ndarray) -> np.ndarray:
     [1.0, 1.0]
     """
     U, sv, Vt = np.linalg.svd(A, full_matrices=False)
-    cut = np.finfo(float).eps * max(A.shape[1:]) * sv[:, :1]
+    cut = _EPS * max(A.shape[1:]) * sv[:, :1]
     inv = np.divide(1.0, sv, out=np.zeros_like(sv), where=sv > cut)
     return np.swapaxes(Vt, 1, 2) @ (inv[:, :, None] * np.swapaxes(U, 1, 2))
 
 
+def chord_pinv(J: np.ndarray, D: np.ndarray) -> np.ndarray:
+    """The pseudo-inverses of the chord method's fixed matrices ``[J; D]`` (:func:`correct_stack`)."""
+    return pinv_stack(np.concatenate([J, D[:, None, :]], axis=1))
+
+
 def correct_stack(curve: BatchCurve, ZP: np.ndarray, D: np.ndarray, idx: np.ndarray, J: np.ndarray | None = None,
-                  maxiter: int = 10) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                  maxiter: int = 10, jacobians: bool = False, start: tuple | None = None,
+                  P: np.ndarray | None = None) -> tuple:
     """:func:`correct` of every row of ``ZP`` (directions ``D``, chord Jacobians ``J`` or ``None`` for full
     Newton) at once.  Returns ``(Z, converged, iterations)``; rows that did not converge are left at ``ZP``
     with ``converged`` false.  The chord method's least-squares step uses the pseudo-inverse of its fixed
-    matrix, computed once."""
+    matrix, computed once.  With ``jacobians`` also ``(Jacobians, known)``: the exact Jacobian at each converged
+    point where the last evaluation (full Newton's residual test) computed it (``known`` true), NaN elsewhere.
+    ``start``: ``curve.evaluate(ZP, idx, True)`` when already known (the first iteration's evaluation); ``P``: the
+    chord method's pseudo-inverse (:func:`chord_pinv` of ``J`` and ``D``) when already known."""
     count = len(ZP)
     out, ok, iters = ZP.copy(), np.zeros(count, dtype=bool), np.full(count, maxiter)
     rows, Z, zp, d, ix = np.arange(count), ZP.copy(), ZP, D, idx
-    P = None if J is None else pinv_stack(np.concatenate([J, D[:, None, :]], axis=1))
+    if J is not None and P is None:
+        P = chord_pinv(J, D)
     checking = np.zeros(count, dtype=bool)
     Jused = J  # the Jacobian of each row's last step (the round-off floor of its residual test)
+    Jout, known = None, np.zeros(count, dtype=bool)
     for it in range(maxiter + 1):
-        R, Jz = curve.evaluate(Z, ix, P is None and it < maxiter)
-        keep = ~checking
-        if checking.any():  # moved less than step_tol at the last iteration: the residual test
+        if it == maxiter:  # the last evaluation serves only the rows moved below step_tol: their residual test
+            if it and checking.any():
+                R = curve.evaluate(Z[checking], ix[checking], False)[0]
+                done = rows[checking]
+                floor = roundoff_floor(Jused[checking], Z[checking])
+                ok[done] = np.abs(R).max(axis=1) < np.maximum(curve.tol, floor)
+                iters[done] = it
+                out[done] = Z[checking]
+            break
+        jacobian = P is None
+        if it == 0 and start is not None:
+            R, Jz = start[0], (start[1] if jacobian else None)
+        else:
+            R, Jz = curve.evaluate(Z, ix, jacobian)
+        leave = checking if it and checking.any() else None  # the rows that stop here
+        if leave is not None:  # moved less than step_tol at the last iteration: the residual test
             done = rows[checking]
             floor = roundoff_floor(Jused[checking], Z[checking])
             ok[done] = np.abs(R[checking]).max(axis=1) < np.maximum(curve.tol, floor)
             iters[done] = it
             out[done] = Z[checking]
+            if jacobians and Jz is not None:
+                if Jout is None:
+                    Jout = np.full((count, *Jz.shape[1:]), np.nan)
+                Jout[done], known[done] = Jz[checking], ok[done]
         r = np.concatenate([R, np.einsum("ij,ij->i", d, Z - zp)[:, None]], axis=1)
-        keep &= np.isfinite(r).all(axis=1)  # undefined residual: no solution along this direction
-        iters[rows[~(keep | checking)]] = it
-        if it == maxiter or not keep.any():
-            break
-        if not keep.all():
+        undefined = ~np.isfinite(r).all(axis=1)  # undefined residual: no solution along this direction
+        if undefined.any():
+            if leave is not None:
+                undefined &= ~leave
+            iters[rows[undefined]] = it
+            leave = undefined if leave is None else leave | undefined
+        if leave is not None:
+            keep = ~leave
+            if not keep.any():
+                break
             rows, Z, zp, d, ix, r = rows[keep], Z[keep], zp[keep], d[keep], ix[keep], r[keep]
             P = None if P is None else P[keep]
             Jz = None if Jz is None else Jz[keep]
@@ -387,8 +425,10 @@ def correct_stack(curve: BatchCurve, ZP: np.ndarray, D: np.ndarray, idx: np.ndar
             A = np.concatenate([Jz, d[:, None, :]], axis=1)
             dz = lstsq2_stack(A, -r) if A.shape[2] == 2 else lstsq_stack(A, -r)
         Z = Z + dz
+        # a failed solve (non-finite step: its max is NaN or inf) is not checked: maxiter iterations, no convergence
         checking = np.abs(dz).max(axis=1) < curve.step_tol
-        checking[~np.isfinite(dz).all(axis=1)] = False  # a failed solve: maxiter iterations, no convergence
+    if jacobians:
+        return out, ok, iters, Jout, known
     return out, ok, iters
 
 
@@ -437,7 +477,8 @@ class Followers:
         J = self.curve.evaluate(Z0, idx, True)[1]
         new = {"Z0": Z0, "Z": Z0.copy(), "tan": tangent_stack(J, directions), "J": J, "idx": np.asarray(idx),
                "travelled": np.zeros(count), "h": np.full(count, self.ds), "step": np.full(count, self.ds),
-               "live": np.ones(count, dtype=bool)}
+               "live": np.ones(count, dtype=bool), "points": np.zeros(count, dtype=int),
+               "P": np.zeros((count, J.shape[2], J.shape[1] + 1)), "P_known": np.zeros(count, dtype=bool)}
         first = len(self.points)
         self._state = new if not self._state else {k: np.concatenate([self._state[k], v]) for k, v in new.items()}
         self.points.extend([] for _ in range(count))
@@ -465,10 +506,15 @@ class Followers:
             return
         Z, tan, step, idx = st["Z"], st["tan"], st["step"], st["idx"]
         ZP = Z[rows] + step[rows, None] * tan[rows]
-        ZC, ok, iters = correct_stack(curve, ZP, tan[rows], idx[rows], st["J"][rows])
+        R0, J0 = curve.evaluate(ZP, idx[rows], True)  # the first iteration of both correctors
+        new = rows[~st["P_known"][rows]]  # the chord's matrix changes with the point, not with the step
+        st["P"][new], st["P_known"][new] = chord_pinv(st["J"][new], tan[new]), True
+        ZC, ok, iters = correct_stack(curve, ZP, tan[rows], idx[rows], st["J"][rows], start=(R0, J0), P=st["P"][rows])
         retry = np.flatnonzero(~ok)  # chord method failed: full Newton
+        known = np.zeros(rows.size, dtype=bool)  # the Jacobian at the corrected point known (full Newton's last)
         if retry.size:
-            ZC[retry], ok[retry], iters[retry] = correct_stack(curve, ZP[retry], tan[rows[retry]], idx[rows[retry]])
+            ZC[retry], ok[retry], iters[retry], Jr, known[retry] = correct_stack(
+                curve, ZP[retry], tan[rows[retry]], idx[rows[retry]], jacobians=True, start=(R0[retry], J0[retry]))
         good = ok.copy()
         if good.any():
             good[good] = curve.valid(ZC[good], idx[rows[good]])
@@ -483,15 +529,25 @@ class Followers:
         if acc.size == 0:
             return
         st["travelled"][acc] += np.linalg.norm(ZC - Z[acc], axis=1)
-        st["J"][acc] = curve.evaluate(ZC, idx[acc], True)[1]
+        if known[good].any():  # the Jacobians full Newton computed at its converged points; the others evaluated
+            lookup = np.full(rows.size, -1)
+            lookup[retry] = np.arange(retry.size)
+            have = known[good]
+            st["J"][acc[have]] = Jr[lookup[np.flatnonzero(good)[have]]]
+            if not have.all():
+                st["J"][acc[~have]] = curve.evaluate(ZC[~have], idx[acc[~have]], True)[1]
+        else:
+            st["J"][acc] = curve.evaluate(ZC, idx[acc], True)[1]
         tan[acc] = tangent_stack(st["J"][acc], tan[acc])
+        st["P_known"][acc] = False
         Z[acc] = ZC
-        for i, z in zip(acc, ZC):
+        for i, z in zip(acc.tolist(), ZC):
             self.points[i].append(z.copy())
+        st["points"][acc] += 1
         closed = (st["travelled"][acc] > 4 * self.ds_max) & (np.linalg.norm(ZC - st["Z0"][acc], axis=1) < step[acc])
         factor = np.where(iters <= 6, 1.5, np.where(iters >= 9, 0.7, 1.0))
         st["h"][acc] = np.minimum(self.ds_max, step[acc] * factor)
-        ended = closed | (np.array([len(self.points[i]) for i in acc]) >= self.max_points)
+        ended = closed | (st["points"][acc] >= self.max_points)
         if self.stop is not None:
             ended |= self.stop(ZC, idx[acc])
         st["live"][acc[ended]] = False

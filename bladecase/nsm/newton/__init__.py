@@ -8,6 +8,8 @@ Newton's law, restitution ``e``). One module per step:
   :func:`newton_times`, :func:`solve_times`;
 - :mod:`~bladecase.nsm.newton.orbits` — :class:`PeriodicOrbit` (a small record; pickles without its system),
   :func:`make_orbit` (certified admissibility), :func:`orbit_1ipp`;
+- :mod:`~bladecase.nsm.newton.certify` — the admissibility proofs of many flights at once, as the k-ipp search
+  runs them (:func:`~bladecase.nsm.newton.certify.certify_flights`);
 - :mod:`~bladecase.nsm.newton.kipp` — every k-ipp orbit at one period: :func:`orbits_kipp`;
 - :mod:`~bladecase.nsm.newton.families` — the k-ipp residual as a curve for :mod:`bladecase.nsm.continuation`
   (:class:`KippCurve`), families followed together (:class:`FamilyTracer`);

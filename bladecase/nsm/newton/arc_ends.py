@@ -16,7 +16,15 @@ from __future__ import annotations
 import numpy as np
 
 from .. import continuation
-from .modal import ModalKernel, check_period, impact_kernels, solve_stack, solve_times, solve_times_stack
+from .modal import (
+    RESONANCE_RTOL,
+    ModalKernel,
+    check_period,
+    impact_kernels,
+    solve_stack,
+    solve_times,
+    solve_times_stack,
+)
 from .orbits import PeriodicOrbit, make_orbit, make_orbits
 
 __all__ = ["bisect_ends"]
@@ -83,7 +91,7 @@ def _midpoints(problems, system, d: float, T0, Zin, Zout, rows) -> tuple[np.ndar
     guess = 0.5 * (Za * t0 / Ta[:, None] + Zb * t0 / Tb[:, None]) * Tm[:, None]  # times/T interpolated at Tm
     Zm = np.full(Za.shape, np.nan)
     fixed = np.flatnonzero(Ta != Tb)
-    fixed = fixed[[_regular(system, T) for T in Tm[fixed]]]
+    fixed = fixed[_regular_many(system, Tm[fixed])]
     for j, sol in zip(fixed, solve_times_stack(system, Tm[fixed], guess[fixed], d)):
         if sol is not None:
             Zm[j] = sol[0] / T0[rows[j]]
@@ -108,12 +116,24 @@ def _regular(system, T: float) -> bool:
     return True
 
 
+def _regular_many(system, T: np.ndarray) -> np.ndarray:
+    """:func:`_regular` of each period of ``T`` (the test of :func:`~bladecase.nsm.newton.modal.check_period`, the
+    same arithmetic, for all of them at once)."""
+    sp = system.spectrum
+    omega = sp.omega[sp.active]
+    with np.errstate(invalid="ignore", over="ignore"):
+        r = np.multiply.outer(T, omega) / (2 * np.pi)
+        m = np.rint(r)
+        bad = ((m >= 1) & (np.abs(r - m) <= RESONANCE_RTOL * r)).any(axis=1)
+    return np.isfinite(T) & (T > 0) & ~bad
+
+
 def _admissible(system, d: float, times: np.ndarray, phase: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Admissibility of the orbits at the impact times ``times`` (rows; impulses ``Λ = d Σ⁻¹1``), certified, a
     violation first looked for at ``phase·T`` (NaN: nowhere; the probe of :func:`_bisect_end`); and where
     (over ``T``) each refuted orbit was seen to violate the constraint (NaN: admissible, or not seen)."""
     omega, b, _ = system.spectrum.contact_modes
-    lam = d * solve_stack(-impact_kernels(omega, b, times)[0], np.ones(times.shape))
+    lam = d * solve_stack(-impact_kernels(omega, b, times, which="g")[0], np.ones(times.shape))
     out, seen = np.zeros(len(times), dtype=bool), np.full(len(times), np.nan)
     rows = np.flatnonzero(np.all(np.isfinite(lam), axis=1) & np.all(np.isfinite(times), axis=1))
     T = times[rows, -1]

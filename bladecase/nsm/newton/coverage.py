@@ -86,8 +86,8 @@ def _crossings(problem: KippCurve, zs, index: _StartIndex, wanted: np.ndarray) -
     :func:`_passed`): ``(period, interpolated impact times, those starts, their impact times)``."""
     if len(zs) < 2:
         return []
-    Ts = np.array([problem.period(z) for z in zs])
-    times = np.array([problem.times(z)[1] for z in zs])
+    times = np.array(zs, dtype=float) * problem.T0  # each point's impact times (KippCurve.times)
+    Ts = times[:, -1]
     lo, hi = np.minimum(Ts[:-1], Ts[1:]), np.maximum(Ts[:-1], Ts[1:])
     crossings = []
     for g in np.flatnonzero((index.periods >= Ts.min()) & (index.periods <= Ts.max())):

@@ -26,8 +26,6 @@ from ..system import LinearSystem
 from .arc_ends import _bisect_end, bisect_ends
 from .modal import (
     ModalKernel,
-    delay_terms,
-    half_period_terms,
     impact_kernels,
     solve_stack,
     solve_times,
@@ -62,6 +60,20 @@ class KippCurves:
         self.T0, self.lam0 = np.atleast_1d(np.asarray(T0, dtype=float)), np.atleast_1d(np.asarray(lam0, dtype=float))
         self.omega, self.b, _ = system.spectrum.contact_modes
         self.scale = float(self.b @ self.b) / 2
+        self._b2, self._sqrt2_scale = self.b**2, np.sqrt(2) * self.scale
+        self._work = np.zeros(0)
+
+    def __getstate__(self) -> dict:
+        return {**self.__dict__, "_work": np.zeros(0)}  # the scratch space is not state
+
+    def _scratch(self, rows: int) -> np.ndarray:
+        """Scratch space ``(4, 2, rows, m)`` for the k = 2 kernel terms, reused from call to call: the
+        evaluations of a trace are many and large, and fresh temporaries of that size each time would cost
+        more in page faults than in arithmetic."""
+        size = 8 * rows * self.omega.size
+        if self._work.size < size:
+            self._work = np.empty(max(size, 2 * self._work.size))
+        return self._work[:size].reshape(4, 2, rows, self.omega.size)
 
     def extend(self, T0, lam0) -> np.ndarray:
         """Add members (scales ``T0``, ``lam0``); their indices."""
@@ -76,31 +88,60 @@ class KippCurves:
 
     def _pair(self, Z, idx, sines: bool = True):
         """k = 2: ``(T0, T, D, c, sin, cos of ωT/2, cos, sin of ω(D - T/2))`` at the one delay
-        ``D = (t₁ - T) mod T`` (``Σ = -[[g(0), g(D)], [g(D), g(0)]]``, ``Π = [[0, s(D)], [-s(D), 0]]``)."""
+        ``D = (t₁ - T) mod T`` (``Σ = -[[g(0), g(D)], [g(D), g(0)]]``, ``Π = [[0, s(D)], [-s(D), 0]]``).
+
+        The terms of :func:`~bladecase.nsm.newton.modal.half_period_terms` and
+        :func:`~bladecase.nsm.newton.modal.delay_terms` (the same arithmetic, so the same values), both angles
+        through one pass of :func:`~bladecase.nsm.signals.sincos_half`'s half-angle formulas, in this object's
+        scratch space (:meth:`_scratch`): views valid until its next evaluation."""
+        return self._terms(Z, idx)[:8] if sines else (*self._terms(Z, idx)[:7], None)
+
+    def _terms(self, Z, idx):
+        """:meth:`_pair`'s terms, then the scratch blocks ``W[1]`` and ``X`` ``(2, B, m)`` left free."""
         T0 = self.T0[idx]
         T = Z[:, 1] * T0
         D = np.mod(Z[:, 0] * T0 - T, T)
-        c, sh, ch = half_period_terms(self.omega, self.b, T)
-        sp, cp = delay_terms(self.omega, T, D)
-        return T0, T, D, c, sh, ch, cp, (sp if sines else None)
+        S, C, W, X = self._scratch(len(T))  # sines, cosines, then c = b²/(2 sin(ωT/2)) in W[0]
+        np.multiply((T / 4)[:, None], self.omega, out=S[0])
+        np.multiply(((D - T / 2) / 2)[:, None], self.omega, out=S[1])
+        np.tan(S, out=S)  # sincos_half, in place: t = tan y, sin 2y = 2t/(1 + t²), cos 2y = (1 - t²)/(1 + t²)
+        np.multiply(S, S, out=C)
+        np.add(C, 1.0, out=W)
+        np.reciprocal(W, out=W)
+        np.subtract(1.0, C, out=C)
+        C *= W
+        S *= W
+        S *= 2.0
+        c = np.multiply(S[0], 2.0, out=W[0])
+        np.divide(self._b2, c, out=c)
+        return T0, T, D, c, S[0], C[0], C[1], S[1], W[1], X
+
+    def _sigma(self, c, ch, cp, w, x) -> np.ndarray:
+        """``g(0) + g(D) = Σ (cos ωT/2 + cos ω(D - T/2)) c/ω`` of :meth:`_pair`'s terms (``Σ`` is singular where
+        it vanishes), with the scratch blocks ``w``, ``x`` ``(B, m)``."""
+        return np.einsum("bm,bm->b", np.add(ch, cp, out=x), np.divide(c, self.omega, out=w))
 
     def _evaluate2(self, Z, idx, jacobian: bool):
         """:meth:`evaluate` for k = 2 in closed form: ``n = Σ⁻¹1 ∝ (1, 1)``, so ``R = ∓s(D) (1, -1)/(√2 S)``."""
-        T0, _, _, c, sh, ch, cp, sp = self._pair(Z, idx)
-        w = c / self.omega
-        sigma = np.einsum("bm,bm->b", ch + cp, w)  # g(0) + g(D): Σ is singular where it vanishes
-        s_d = -np.einsum("bm,bm->b", sp, c)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            f = np.where(sigma == 0, np.nan, -np.sign(sigma)) / (np.sqrt(2) * self.scale)  # u = -sign(σ)(1, 1)/√2
-        R = np.stack([f * s_d, -f * s_d], axis=1)
+        T0, _, _, c, sh, ch, cp, sp, w, X = self._terms(Z, idx)
+        sigma = self._sigma(c, ch, cp, w, X[0])
+        f = np.where(sigma == 0, np.nan, -np.sign(sigma)) / self._sqrt2_scale  # u = -sign(σ)(1, 1)/√2
+        R = np.empty((len(T0), 2))
+        np.multiply(f, np.einsum("bm,bm->b", sp, c), out=R[:, 1])  # -f·s(D), s(D) = -Σ c sin
+        np.negative(R[:, 1], out=R[:, 0])
         if not jacobian:
             return R, None
-        cw = c * self.omega
+        cw = np.multiply(c, self.omega, out=w)
         ds = -np.einsum("bm,bm->b", cp, cw)  # s'(D)
-        b1, b2 = -ds / 2, np.einsum("bm,bm->b", sp, cw * ch / sh) / 2  # ∂s/∂T at D and T - D: b1 ± b2
+        x = np.multiply(cw, ch, out=X[1])
+        np.divide(x, sh, out=x)
+        b1, b2 = -ds / 2, np.einsum("bm,bm->b", sp, x) / 2  # ∂s/∂T at D and T - D: b1 ± b2
         g = f * T0
-        J = np.stack([np.stack([g * ds, g * (b1 + b2)], axis=1), np.stack([-g * ds, g * (ds + b1 - b2)], axis=1)],
-                     axis=1)
+        J = np.empty((len(T0), 2, 2))
+        np.multiply(g, ds, out=J[:, 0, 0])
+        np.multiply(g, b1 + b2, out=J[:, 0, 1])
+        np.negative(J[:, 0, 0], out=J[:, 1, 0])
+        np.multiply(g, ds + b1 - b2, out=J[:, 1, 1])
         return R, J
 
     def evaluate(self, Z, idx, jacobian: bool = False):
@@ -150,11 +191,11 @@ class KippCurves:
             return ok
         t, T = times[rows], T[rows]
         if self.k == 2:  # Σ⁻¹1 = -(1, 1)/(g(0) + g(D))
-            _, _, _, c, _, ch, cp, _ = self._pair(Z[rows], idx[rows], sines=False)
+            _, _, _, c, _, ch, cp, _, w, X = self._terms(Z[rows], idx[rows])
             with np.errstate(divide="ignore"):
-                lam = np.repeat((-self.d / np.einsum("bm,bm->b", ch + cp, c / self.omega))[:, None], 2, axis=1)
+                lam = np.repeat((-self.d / self._sigma(c, ch, cp, w, X[0]))[:, None], 2, axis=1)
         else:
-            lam = self.d * solve_stack(-impact_kernels(self.omega, self.b, t)[0], np.ones(t.shape))
+            lam = self.d * solve_stack(-impact_kernels(self.omega, self.b, t, which="g")[0], np.ones(t.shape))
         with np.errstate(invalid="ignore"):
             fine = np.all(np.isfinite(lam), axis=1) & (np.abs(lam).max(axis=1) <= 1e8 * self.lam0[idx[rows]])
             ok[rows] = fine & (_distance_to_repetition(t, lam, T) > MERGE_RTOL)
@@ -199,8 +240,8 @@ class KippCurve:
 
     def times(self, z) -> tuple[float, np.ndarray]:
         """``(T, impact times)`` at ``z``."""
-        T = z[-1] * self.T0
-        return T, np.append(z[:-1] * self.T0, T)
+        times = np.asarray(z, dtype=float) * self.T0
+        return times[-1], times
 
     def period(self, z) -> float:
         return float(z[-1] * self.T0)
@@ -371,7 +412,10 @@ def complete_families(traced: list[tuple[KippCurve, list]], T_range: tuple[float
     :class:`FollowedFamily` per stretch (the problem and the curve points shared).
     """
     T_lo, T_hi = T_range
-    todo = [(f, z) for f, (problem, zs) in enumerate(traced) for z in zs if T_lo <= problem.period(z) <= T_hi]
+    todo = []  # the points within T_range (their periods as KippCurve.period computes them)
+    for f, (problem, zs) in enumerate(traced):
+        T = np.array(zs, dtype=float)[:, -1] * problem.T0
+        todo.extend((f, zs[i]) for i in np.flatnonzero((T_lo <= T) & (T <= T_hi)).tolist())
     orbits: list[list[PeriodicOrbit]] = [[] for _ in traced]
     for (f, _), orbit in zip(todo, polished_orbits([(traced[f][0], z) for f, z in todo])):
         if orbit is not None:
@@ -416,13 +460,18 @@ def polished_orbits(points: list[tuple[KippCurve, np.ndarray]]) -> list[Periodic
     problem = points[0][0]
     system, d = problem.system, problem.d
     omega, b, _ = system.spectrum.contact_modes
-    times = np.array([problem.times(z)[1] for problem, z in points])
+    times = np.array([z for _, z in points], dtype=float) * np.array([problem.T0 for problem, _ in points])[:, None]
     T = times[:, -1]
-    lam = d * solve_stack(-impact_kernels(omega, b, times)[0], np.ones(times.shape))  # Λ = d Σ⁻¹1: NaN if singular
+    lam = d * solve_stack(-impact_kernels(omega, b, times, which="g")[0], np.ones(times.shape))  # NaN if Σ singular
     rows = np.flatnonzero(np.all(np.isfinite(lam), axis=1))
-    for i, sol in zip(rows, solve_times_stack(system, T[rows], times[rows], d)):
-        if sol is not None and np.abs(sol[0] - times[i]).max() < 1e-6 * T[i]:
-            times[i], lam[i] = sol
+    sols = solve_times_stack(system, T[rows], times[rows], d)
+    solved = np.array([sol is not None for sol in sols], dtype=bool)
+    if solved.any():
+        at = rows[solved]
+        new_times = np.array([sol[0] for sol in sols if sol is not None])
+        new_lam = np.array([sol[1] for sol in sols if sol is not None])
+        near = np.abs(new_times - times[at]).max(axis=1) < 1e-6 * T[at]  # the same orbit: polished
+        times[at[near]], lam[at[near]] = new_times[near], new_lam[near]
     rows = rows[np.all(np.isfinite(times[rows]), axis=1) & np.all(np.isfinite(lam[rows]), axis=1)]
     for i, orbit in zip(rows, make_orbits(system, T[rows], times[rows], lam[rows])):  # certified all together
         out[i] = orbit

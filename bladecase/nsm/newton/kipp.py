@@ -8,6 +8,7 @@ Levenberg–Marquardt from the most promising cells and from repeated lower-orde
 
 from __future__ import annotations
 
+import math
 from itertools import combinations
 from math import comb
 
@@ -176,6 +177,11 @@ def canonical_rotation(times: np.ndarray, impulses: np.ndarray, T: float) -> tup
     ([4.0, 10.0], [1.0, 2.0])
     """
     tol = REPEAT_RTOL * T
+    if times.size == 2 and impulses.size == 2:
+        pair = _canonical_pair(float(times[0]), float(times[1]), tol, T)
+        if pair is not None:
+            order, shifted = pair
+            return np.array(shifted), impulses[list(order)]
     best = None
     for r in range(times.size):
         shifted = np.mod(times - times[r], T)
@@ -190,6 +196,28 @@ def canonical_rotation(times: np.ndarray, impulses: np.ndarray, T: float) -> tup
         if first.size and diff[first[0]] < 0:
             best = cand
     best[0][-1] = T
+    return best
+
+
+def _canonical_pair(t1: float, t2: float, tol: float, T: float) -> tuple[tuple[int, int], list[float]] | None:
+    """:func:`canonical_rotation` of two impacts in scalar arithmetic (the same operations: ``%`` is ``np.mod``):
+    ``(order, shifted times)``, or ``None`` unless the times are finite and ``T > 0`` (the general code decides)."""
+    if not (math.isfinite(t1) and math.isfinite(t2) and math.isfinite(T) and T > 0):
+        return None
+    best = None
+    for r in (t1, t2):
+        shifted = [(t1 - r) % T, (t2 - r) % T]
+        shifted = [T if (x <= tol or x >= T - tol) else x for x in shifted]
+        order = (1, 0) if shifted[1] < shifted[0] else (0, 1)  # np.argsort of two: ties keep their order
+        cand = [shifted[order[0]], shifted[order[1]]]
+        if best is None:
+            best = (order, cand)
+            continue
+        diff = [cand[0] - best[1][0], cand[1] - best[1][1]]
+        first = next((x for x in diff if abs(x) > tol), None)
+        if first is not None and first < 0:
+            best = (order, cand)
+    best[1][-1] = T
     return best
 
 
@@ -284,7 +312,7 @@ def _multistart(md: ModalKernel, k: int, d: float, resolution: int | None) -> li
     # 2e6 kernel terms (k(k-1)/2 delays × modes per cell) to bound the memory
     chunk = max(256, 2_000_000 // max(1, k * (k - 1) // 2 * md.omega.size))
     for part in np.array_split(starts, -(-len(starts) // chunk)):
-        lam0 = lstsq_stack(-impact_kernels(md.omega, md.b, part)[0], np.full(part.shape, d), rcond=1e-12)
+        lam0 = lstsq_stack(-impact_kernels(md.omega, md.b, part, which="g")[0], np.full(part.shape, d), rcond=1e-12)
         rows = np.flatnonzero(np.all(np.isfinite(lam0), axis=1))
         times, lam, ok = _newton_stack(md.omega, md.b, np.full(rows.size, T), part[rows], lam0[rows], d)
         for j in np.flatnonzero(ok):

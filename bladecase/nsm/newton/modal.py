@@ -300,19 +300,22 @@ def solve_pairs(omega: np.ndarray, b: np.ndarray, T: np.ndarray, t1: np.ndarray,
     prev = np.full(u.size, np.inf)
     live = np.ones(u.size, dtype=bool)
     failed = np.zeros(u.size, dtype=bool)
-    for _ in range(maxiter):
-        rows = np.flatnonzero(live)
-        if rows.size == 0:
-            break
-        sn, cs = delay_terms(omega, T[rows], u[rows])
-        with np.errstate(divide="ignore", invalid="ignore"):
-            step = -np.einsum("bm,bm->b", sn, c[rows]) / np.einsum("bm,bm->b", cs, cw[rows])  # -s/s'
-        u[rows] += step
-        size = np.abs(step) / T[rows]
-        bad = ~np.isfinite(step) | (size > 10 * prev[rows])
-        failed[rows[bad]] = True
-        live[rows[bad | (size < 1e-14)]] = False
-        prev[rows] = size
+    rows, Tr, cr, cwr = np.arange(u.size), T, c, cw  # the rows still iterating, and their terms
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for _ in range(maxiter):
+            if rows.size == 0:
+                break
+            sn, cs = delay_terms(omega, Tr, u[rows])
+            step = -np.einsum("bm,bm->b", sn, cr) / np.einsum("bm,bm->b", cs, cwr)  # -s/s'
+            u[rows] += step
+            size = np.abs(step) / Tr
+            bad = ~np.isfinite(step) | (size > 10 * prev[rows])
+            failed[rows[bad]] = True
+            stop = bad | (size < 1e-14)
+            live[rows[stop]] = False
+            prev[rows] = size
+            if stop.any():
+                rows, Tr, cr, cwr = rows[~stop], Tr[~stop], cr[~stop], cwr[~stop]
     failed |= live  # not converged within maxiter
     with np.errstate(invalid="ignore"):
         failed |= ~((u > DISTINCT_RTOL * T) & (T - u > DISTINCT_RTOL * T))
@@ -367,7 +370,7 @@ def _upper_pairs(k: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def impact_kernels(omega: np.ndarray, b: np.ndarray, times: np.ndarray, derivatives: bool = False,
-                   T: np.ndarray | None = None):
+                   T: np.ndarray | None = None, which: str = "all"):
     """The kernel sums at the delays ``D_ij = (t_i - t_j) mod T`` of many impact patterns at once.
 
     ``times`` ``(B, k)``: rows ``0 < t₁ < … < t_k = T`` (periods ``T`` ``(B,)``: default the last column).
@@ -375,7 +378,9 @@ def impact_kernels(omega: np.ndarray, b: np.ndarray, times: np.ndarray, derivati
     also ``(s', ∂g/∂T, ∂s/∂T)`` — each ``(B, k, k)`` (the sums of :meth:`ModalKernel.g_s`, :meth:`ModalKernel.ds`,
     :meth:`ModalKernel.dT`; ``s`` with its diagonal ``s(0)``, not zeroed).  The trigonometric terms are evaluated
     at the ``k(k-1)/2`` delays ``i < j`` only: ``D_ji = T - D_ij`` and ``D_ii = 0`` follow by symmetry about
-    ``T/2`` (``g``, ``s'`` even, ``s`` odd).
+    ``T/2`` (``g``, ``s'`` even, ``s`` odd).  ``which = "g"``: ``(g, None)`` only; ``which = "times"`` (with
+    ``derivatives``): ``(g, s, s')`` only, the derivatives in the impact times (the same values, the rest not
+    computed).
 
     >>> from bladecase.nsm import chain
     >>> s2 = chain(2, k=1.0, m=0.5, gap=1.0)
@@ -393,7 +398,7 @@ def impact_kernels(omega: np.ndarray, b: np.ndarray, times: np.ndarray, derivati
     iu, ju = _upper_pairs(k)
     D = np.mod(times[:, iu] - times[:, ju], T[:, None])  # (B, P): the delays above the diagonal
     ph = (D - (T / 2)[:, None])[:, :, None] * omega
-    cp, sp = np.cos(ph), np.sin(ph)
+    cp = np.cos(ph)
     dg = np.arange(k)
 
     def dot(x, w):
@@ -405,17 +410,24 @@ def impact_kernels(omega: np.ndarray, b: np.ndarray, times: np.ndarray, derivati
         return out
 
     w = c / omega
-    g_p, s_p = dot(cp, w), -dot(sp, c)
-    g, s = full(g_p, g_p, np.einsum("bm,bm->b", ch, w)), full(s_p, -s_p, np.einsum("bm,bm->b", sh, c))
+    g_p = dot(cp, w)
+    g = full(g_p, g_p, np.einsum("bm,bm->b", ch, w))
+    if which == "g":
+        return g, None
+    sp = np.sin(ph)
+    s_p = -dot(sp, c)
+    s = full(s_p, -s_p, np.einsum("bm,bm->b", sh, c))
     if not derivatives:
         return g, s
-    cot = ch / sh
     cw = c * omega
     ds_p = -dot(cp, cw)
+    dsD = full(ds_p, ds_p, -np.einsum("bm,bm->b", ch, cw))
+    if which == "times":
+        return g, s, dsD
+    cot = ch / sh
     a1, a2 = dot(sp, c / 2), dot(cp, c * cot / 2)
     b1, b2 = dot(cp, cw / 2), dot(sp, cw * cot / 2)
-    return (g, s, full(ds_p, ds_p, -np.einsum("bm,bm->b", ch, cw)),
-            full(a1 - a2, -a1 - a2, np.einsum("bm,bm->b", -sh - ch * cot, c / 2)),
+    return (g, s, dsD, full(a1 - a2, -a1 - a2, np.einsum("bm,bm->b", -sh - ch * cot, c / 2)),
             full(b1 + b2, b1 - b2, np.einsum("bm,bm->b", ch - sh * cot, cw / 2)))
 
 
@@ -440,7 +452,7 @@ def _residual_jacobian_stack(omega, b, T, times, lam, d, jacobian=True):
     """:func:`_residual_jacobian` at many periods: residuals ``(B, 2k)`` and Jacobians ``(B, 2k, 2k-1)``."""
     k = times.shape[1]
     off = ~np.eye(k, dtype=bool)
-    sums = impact_kernels(omega, b, times, derivatives=jacobian, T=T)
+    sums = impact_kernels(omega, b, times, derivatives=jacobian, T=T, which="times")
     g, s = sums[0], np.where(off, sums[1], 0.0)
     r = np.concatenate([np.einsum("bij,bj->bi", s, lam), -np.einsum("bij,bj->bi", g, lam) - d], axis=1)
     if not jacobian:
@@ -482,7 +494,7 @@ def solve_times_stack(system: LinearSystem, T: np.ndarray, times0: np.ndarray,
         for i, sol in zip(rest, solve_times_stack(system, T[rest], times0[rest], d, pairs=False) if rest.size else []):
             out[i] = sol
         return out
-    Sigma = -impact_kernels(omega, b, times0, T=T)[0]
+    Sigma = -impact_kernels(omega, b, times0, T=T, which="g")[0]
     lam0 = lstsq_stack(Sigma, np.full((count, k), d), rcond=1e-12)
     start = np.flatnonzero(np.all(np.isfinite(lam0), axis=1))
     times, lam, ok = _newton_stack(omega, b, T[start], times0[start], lam0[start], d)

@@ -16,8 +16,9 @@ from functools import cached_property
 
 import numpy as np
 
-from ..signals import POINTS_PER_PERIOD, TrigSum, certified_max, certified_max_stack, sincos
+from ..signals import POINTS_PER_PERIOD, TrigSum, certified_max, sincos
 from ..system import LinearSystem
+from .certify import certify_flights
 from .modal import RESONANCE_RTOL, ModalKernel, check_period, impact_matrices
 
 __all__ = [
@@ -137,6 +138,17 @@ class PeriodicOrbit:
     def __setstate__(self, state: dict) -> None:
         for f in dataclasses.fields(self):
             object.__setattr__(self, f.name, state.get(f.name, f.default))
+
+    @classmethod
+    def _record(cls, system, T, impact_times, impulses, energy, admissible, max_violation, max_violation_time,
+                repeats) -> PeriodicOrbit:
+        """The record with these fields (``stable``, ``multipliers``: ``None``), as ``PeriodicOrbit(...)`` makes
+        it, without its field-by-field frozen assignments (the searches make tens of thousands)."""
+        self = object.__new__(cls)
+        self.__dict__.update(system=system, T=T, impact_times=impact_times, impulses=impulses, energy=energy,
+                             admissible=admissible, max_violation=max_violation,
+                             max_violation_time=max_violation_time, repeats=repeats, stable=None, multipliers=None)
+        return self
 
     def bind(self, system: LinearSystem) -> PeriodicOrbit:
         """This orbit attached to ``system`` (a copy; the record is unchanged).
@@ -351,7 +363,8 @@ def make_orbits(system: LinearSystem, T, impact_times, impulses, certify: bool =
                 ) -> list[PeriodicOrbit]:
     """:func:`make_orbit` with ``polish=False`` of many orbits with ``k`` impacts at once (periods ``T``
     ``(B,)``, impact times and impulses ``(B, k)``): the energies, the flights' trigonometric sums and their
-    certification (:func:`~bladecase.nsm.signals.certified_max_stack`) computed for all orbits together.
+    certification (:func:`~bladecase.nsm.signals.certified_max_stack`'s proof, as
+    :func:`~bladecase.nsm.newton.certify.certify_flights` runs it) computed for all orbits together.
     ``probe`` ``(B,)``: as in :func:`make_orbit`, a time per orbit where a violation is suspected (NaN: none),
     checked first so that an orbit violated there is rejected without its flights' proofs.
 
@@ -396,16 +409,18 @@ def make_orbits(system: LinearSystem, T, impact_times, impulses, certify: bool =
         if rows.size == 0:
             break
         start = np.zeros(rows.size) if i == 0 else times[rows, i - 1]
-        alpha, beta, tol = _flight_sums(omega, c[rows], d, T[rows], start, times[rows], lam[rows])
-        value, where, _, ok = certified_max_stack(alpha, beta, omega, np.full(rows.size, -d),
-                                                  times[rows, i] - start, tol, ends_at_zero=True)
+        phases = (cos_s[rows], sin_s[rows]) if i == 0 else None  # the first flight's: the energy's
+        alpha, beta, tol = _flight_sums(omega, c[rows], d, T[rows], start, times[rows], lam[rows], phases)
+        value, where, ok = certify_flights(alpha, beta, omega, np.full(rows.size, -d), times[rows, i] - start, tol,
+                                           ends_at_zero=True)
         raise_ = value > worst[rows]
         worst[rows[raise_]], worst_t[rows[raise_]] = value[raise_], (start + where)[raise_]
         certified[rows] = ok
     repeats = _repetitions_stack(times, lam, T)
-    return [PeriodicOrbit(system=system, T=float(T[i]), impact_times=times[i].copy(), impulses=lam[i].copy(),
-                          energy=float(energy[i]), admissible=bool(certified[i]), max_violation=float(worst[i]),
-                          max_violation_time=float(worst_t[i]), repeats=int(repeats[i])) for i in range(T.size)]
+    record = PeriodicOrbit._record
+    return [record(system, Ti, ti.copy(), li.copy(), ei, ai, wi, wti, ri)
+            for Ti, ti, li, ei, ai, wi, wti, ri in zip(T.tolist(), times, lam, energy.tolist(), certified.tolist(),
+                                                       worst.tolist(), worst_t.tolist(), repeats.tolist())]
 
 
 def _refute_at(probe: np.ndarray, omega, c, d: float, T, times, lam, certified, worst, worst_t) -> None:
@@ -431,11 +446,11 @@ def _refute_at(probe: np.ndarray, omega, c, d: float, T, times, lam, certified, 
     certified[rows[bad]] = False
 
 
-def _flight_sums(omega, c, d: float, T, start, times, lam) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _flight_sums(omega, c, d: float, T, start, times, lam, phases=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The flights from ``start`` of many orbits: the contact distance ``-d + Σ α cos(ωτ) + β sin(ωτ)`` at
     ``τ`` after ``start`` as ``(α, β)`` ``(B, m)``, and each flight's admissibility tolerance ``(B,)``
-    (``c = -b²/(2ω sin(ωT/2))`` per orbit)."""
-    cs, sn = _impulse_phases(omega, T, start, times)
+    (``c = -b²/(2ω sin(ωT/2))`` per orbit; ``phases``: :func:`_impulse_phases` there, when known)."""
+    cs, sn = _impulse_phases(omega, T, start, times) if phases is None else phases
     alpha = c * np.einsum("bmk,bk->bm", cs, lam)
     beta = -c * np.einsum("bmk,bk->bm", sn, lam)
     tol = np.maximum(ADMISSIBILITY_RTOL * d, 1e4 * np.finfo(float).eps * np.hypot(alpha, beta).sum(axis=1))
