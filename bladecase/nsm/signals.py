@@ -244,7 +244,6 @@ def certified_max_stack(alpha: np.ndarray, beta: np.ndarray, omega: np.ndarray, 
     q = np.maximum(1, np.ceil(np.sqrt(count)).astype(int))
     p = -(-count // q)
     value, where, upper = np.zeros(S), np.zeros(S), np.full(S, -np.inf)
-    certified = np.zeros(S, dtype=bool)
     opened = []  # the grid intervals left open: (row, lo, hi, f_lo, f_hi, f'_lo, f'_hi)
     shapes = np.stack([p, q], axis=1)
     for pq in np.unique(shapes, axis=0):
@@ -254,17 +253,37 @@ def certified_max_stack(alpha: np.ndarray, beta: np.ndarray, omega: np.ndarray, 
             opened.append(_grid_stack(alpha[part], beta[part], omega, const[part], length[part], count[part],
                                       int(pq[0]), int(pq[1]), B2[part], tol[part], ends_at_zero, part,
                                       (value, where, upper)))
+    certified = bisect_open(opened, alpha, beta, omega, const, tol, B2, count, max_points, (value, where, upper),
+                            np.ones(S, dtype=bool))
+    return value, where, upper, certified
+
+
+def bisect_open(opened: list, alpha, beta, omega, const, tol, B2, count, max_points: int, results: tuple,
+                active: np.ndarray) -> np.ndarray:
+    """The proof's last part for many sums at once: bisect the grid intervals left open until each ``active``
+    row is violated (a sampled value above ``tol``), proved (every interval's bound within ``tol``) or out of
+    points (``count`` + bisections ``> max_points``).
+
+    ``opened``: tuples ``(row, lo, hi, f_lo, f_hi, f'_lo, f'_hi)`` of the open intervals; ``results``:
+    ``(value, where, upper)``, raised in place (``upper`` is the proved bound of the finished rows); inactive rows
+    are left as they are.  Returns ``certified`` ``(S,)``.
+    """
+    value, where, upper = results
+    S = len(alpha)
     row, lo, hi, fl, fr, dl, dr = (np.concatenate(x) for x in zip(*opened))
+    certified = np.zeros(S, dtype=bool)
     used = count.copy()
-    active = np.ones(S, dtype=bool)
+    active = active.copy()
+    neg_wa, wb = -omega * alpha, omega * beta
     while True:
         # rows with a sampled violation, or no open interval left (or out of points), are finished
-        U = interval_bound(fl, fr, dl, dr, hi - lo, B2[row])
+        width, b2, tol_row = hi - lo, B2[row], tol[row]
+        U = interval_bound(fl, fr, dl, dr, width, b2)
         top = np.full(S, -np.inf)
         np.maximum.at(top, row, U)
-        violated = active & (value > tol)
-        open_ = (U > tol[row]) & (B2[row] * (hi - lo) ** 2 / 8 > tol[row] / 2)
+        open_ = (U > tol_row) & (b2 * width**2 / 8 > tol_row / 2)
         any_open = np.bincount(row[open_], minlength=S) > 0
+        violated = active & (value > tol)
         finish = violated | (active & (~any_open | (used > max_points)))
         upper[finish] = np.maximum(upper[finish], top[finish])
         certified[finish] = ~violated[finish] & ~any_open[finish] & (upper[finish] <= tol[finish])
@@ -274,12 +293,12 @@ def certified_max_stack(alpha: np.ndarray, beta: np.ndarray, omega: np.ndarray, 
         np.maximum.at(upper, row[closed], U[closed])
         sel = active[row] & open_
         if not sel.any():
-            return value, where, upper, certified
+            return certified
         row, a, b = row[sel], lo[sel], hi[sel]
         mid = 0.5 * (a + b)
-        s, c = sincos(np.multiply.outer(mid, omega))
+        s, c = sincos_half(np.multiply.outer(0.5 * mid, omega))  # sincos(mid·ω): the half angle, exactly
         fm = np.einsum("nm,nm->n", c, alpha[row]) + np.einsum("nm,nm->n", s, beta[row]) + const[row]
-        dm = np.einsum("nm,nm->n", s, -omega * alpha[row]) + np.einsum("nm,nm->n", c, omega * beta[row])
+        dm = np.einsum("nm,nm->n", s, neg_wa[row]) + np.einsum("nm,nm->n", c, wb[row])
         used += np.bincount(row, minlength=S)
         _raise_best(row, fm, mid, value, where)
         lo, hi = np.concatenate([a, mid]), np.concatenate([mid, b])

@@ -13,6 +13,9 @@ of the intervals left open, the same arithmetic: the same values, bit for bit) f
 * a flight whose grid already shows a violation is finished there: the intervals its grid leaves open are not
   extracted, bounded or bisected (its proof would stop at their first look; only the upper bound
   ``certified_max_stack`` also returns, which nothing here uses, would differ).
+
+The bisection of the intervals left open is :func:`bladecase.nsm.signals.bisect_open`, shared with
+``certified_max_stack``.
 """
 
 from __future__ import annotations
@@ -21,7 +24,7 @@ import threading
 
 import numpy as np
 
-from ..signals import POINTS_PER_PERIOD, _raise_best, interval_bound, sincos_half
+from ..signals import POINTS_PER_PERIOD, bisect_open, interval_bound
 
 __all__ = ["certify_flights"]
 
@@ -90,39 +93,9 @@ def certify_flights(alpha: np.ndarray, beta: np.ndarray, omega: np.ndarray, cons
             F, D, tau = _grid(alpha[rows], beta[rows], omega, const[rows], length[rows], count[rows], h[a:b],
                               U[:pp, a:b], V[a:b, :qq], ends_at_zero)
             opened.append(_intervals(F, D, tau, count[rows], B2[rows], tol[rows], rows, (value, where, upper)))
-    row, lo, hi, fl, fr, dl, dr = (np.concatenate(x) for x in zip(*opened))
-    certified = np.zeros(S, dtype=bool)
-    used = count.copy()
-    active = ~(value > tol)  # the violated flights are finished
-    neg_wa, wb = -omega * alpha, omega * beta
-    while True:  # certified_max_stack's bisection of the open intervals, for the flights still running
-        width, b2, tol_row = hi - lo, B2[row], tol[row]
-        U = interval_bound(fl, fr, dl, dr, width, b2)
-        top = np.full(S, -np.inf)
-        np.maximum.at(top, row, U)
-        open_ = (U > tol_row) & (b2 * width**2 / 8 > tol_row / 2)
-        any_open = np.bincount(row[open_], minlength=S) > 0
-        violated = active & (value > tol)
-        finish = violated | (active & (~any_open | (used > max_points)))
-        upper[finish] = np.maximum(upper[finish], top[finish])
-        certified[finish] = ~violated[finish] & ~any_open[finish] & (upper[finish] <= tol[finish])
-        active &= ~finish
-        closed = active[row] & ~open_
-        np.maximum.at(upper, row[closed], U[closed])
-        sel = active[row] & open_
-        if not sel.any():
-            return value, where, certified
-        row, a, b = row[sel], lo[sel], hi[sel]
-        mid = 0.5 * (a + b)
-        s, c = sincos_half(np.multiply.outer(0.5 * mid, omega))  # sincos(mid·ω): the half angle, exactly
-        fm = np.einsum("nm,nm->n", c, alpha[row]) + np.einsum("nm,nm->n", s, beta[row]) + const[row]
-        dm = np.einsum("nm,nm->n", s, neg_wa[row]) + np.einsum("nm,nm->n", c, wb[row])
-        used += np.bincount(row, minlength=S)
-        _raise_best(row, fm, mid, value, where)
-        lo, hi = np.concatenate([a, mid]), np.concatenate([mid, b])
-        fl, fr = np.concatenate([fl[sel], fm]), np.concatenate([fm, fr[sel]])
-        dl, dr = np.concatenate([dl[sel], dm]), np.concatenate([dm, dr[sel]])
-        row = np.concatenate([row, row])
+    certified = bisect_open(opened, alpha, beta, omega, const, tol, B2, count, max_points, (value, where, upper),
+                            ~(value > tol))  # the flights violated on their grid are finished
+    return value, where, certified
 
 
 def _powers(h, q, omega, P: int, Q: int) -> tuple[np.ndarray, np.ndarray]:
