@@ -15,7 +15,11 @@ Cases:
   compare families and arcs before/after;
 
 What it shows (measured, CPU s on a loaded 2-core machine): ``cb58w`` 52 s for 4 962 families (506 with arcs,
-683 arcs); the full ``cb58`` passes 300 s without finishing and its baseline went past 23 GB. The families do not
+683 arcs); the full ``cb58`` passes 300 s without finishing and its baseline went past 23 GB.  With the faster
+search (idle machine) ``cb58w`` takes 24.7 s, and with cvxopt's block solves the CB model differs by round-off
+(``10⁻¹⁴`` in ``K``): 4 968 families, 643 arcs — the family set of this model is that fragile (with the old
+solves the new search gives the old families and arcs exactly).  The "middle orbits on no family" count is not a
+test here: the old code compared with its own run gives 111 of 683. The families do not
 multiply through modes the contact barely sees (none has ``b_j² < 1e-12 Σb²``, six are below ``1e-6``; deflating
 those changes nothing), but through the boundary modes that it sees strongly, up to ``ω ≈ 6700 ω₁``: 3 500–6 000
 roots of the 2-ipp equations per period, 12 349 resonances in the range cutting the families into pieces (median

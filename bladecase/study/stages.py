@@ -440,12 +440,11 @@ def _check_start_grid(system, k: int, T: float, scan: int, resolution: int | Non
 
 
 #: Seconds per resonance of the contact in the period range × reduced dof of a k-ipp search — for estimates
-#: only.  Each resonance ``T = 2πm/ω_j`` cuts the families into pieces; measured (2-ipp, CPU): the demo's 16
-#: and 32 Lanczos vectors, 190 and 684 resonances, 12.5 and 82 s (4.1e-3, 3.7e-3); a 58-dof Craig–Bampton model
-#: of a 16-node face, modes up to 6 700 ω₁ and 12 349 resonances in [0.9, 0.9999] T₁: 59 s for the 0.2 % of
-#: the range that holds ~250 of them (4.1e-3), the whole range past 300 s and 23 GB; chains are faster
-#: (chain(50): 203, 6.4 s).
-RESONANCE_SECONDS = 4e-3
+#: only.  Each resonance ``T = 2πm/ω_j`` cuts the families into pieces; measured (2-ipp, CPU, idle machine):
+#: the demo's 16 and 32 Lanczos vectors, 190 and 684 resonances, 6.4 and 28.5 s (2.1e-3, 1.3e-3); a 58-dof
+#: Craig–Bampton model of a 16-node face, modes up to 6 700 ω₁ and 12 349 resonances in [0.9, 0.9999] T₁: 24.7 s
+#: for the 0.2 % of the range that holds 246 of them (1.7e-3); chains are faster (chain(50): 203, 4.8 s).
+RESONANCE_SECONDS = 2e-3
 
 #: Estimated seconds of a k-ipp search above which the study warns, and above which it refuses.
 SEARCH_WARN_S, SEARCH_REFUSE_S = 60.0, 1800.0
@@ -487,6 +486,8 @@ def _check_resonances(system, k: int, T_range: tuple[float, float], label: str =
         for _ in range(60):
             mid = 0.5 * (hi + top)
             hi, top = (mid, top) if _search_estimate(system, (T_range[0], mid)) <= SEARCH_REFUSE_S else (hi, mid)
+        unit = 10.0 ** (np.floor(np.log10(hi)) - 5)  # rounded down to the 6 digits the message shows
+        hi = float(np.floor(hi / unit) * unit)
         raise StudyError(f"[search] periods: {what}, with thousands of families to hold in memory; valid: a range "
                          f"estimated within {SEARCH_REFUSE_S / 60:.0f} min (from {T_range[0]:.6g} s: up to "
                          f"{hi:.6g} s), a reduced model without the contact's stiffest modes (a Craig–Bampton model "
