@@ -232,17 +232,10 @@ def certified_max_stack(alpha: np.ndarray, beta: np.ndarray, omega: np.ndarray, 
     >>> bool(ok[0]) == one.certified, float(v[0]) == one.value, bool(ok[1]), bool(v[1] > 0)
     (True, True, False, True)
     """
-    alpha, beta = np.atleast_2d(np.asarray(alpha, dtype=float)), np.atleast_2d(np.asarray(beta, dtype=float))
-    omega = np.asarray(omega, dtype=float)
+    alpha, beta, omega, const, length, tol, B2, count, p, q = grid_plan(alpha, beta, omega, const, length, tol)
     S = len(alpha)
     if S == 0:
         return np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0, dtype=bool)
-    const, length, tol = (np.broadcast_to(np.asarray(x, dtype=float), (S,)) for x in (const, length, tol))
-    B2 = np.hypot(alpha, beta) @ (omega**2)
-    step = 2 * np.pi / (POINTS_PER_PERIOD * float(omega.max())) if omega.size else np.inf
-    count = np.maximum(2, np.ceil(length / step).astype(int) + 1)
-    q = np.maximum(1, np.ceil(np.sqrt(count)).astype(int))
-    p = -(-count // q)
     value, where, upper = np.zeros(S), np.zeros(S), np.full(S, -np.inf)
     opened = []  # the grid intervals left open: (row, lo, hi, f_lo, f_hi, f'_lo, f'_hi)
     shapes = np.stack([p, q], axis=1)
@@ -256,6 +249,20 @@ def certified_max_stack(alpha: np.ndarray, beta: np.ndarray, omega: np.ndarray, 
     certified = bisect_open(opened, alpha, beta, omega, const, tol, B2, count, max_points, (value, where, upper),
                             np.ones(S, dtype=bool))
     return value, where, upper, certified
+
+
+def grid_plan(alpha, beta, omega, const, length, tol) -> tuple:
+    """The inputs of a stacked proof as arrays, and its grid: ``(alpha, beta, omega, const, length, tol, B2,
+    count, p, q)`` — ``B2 >= max|f''|`` per row, ``count`` grid points per row (``POINTS_PER_PERIOD`` per period of
+    the highest frequency, at least 2), laid out as ``p × q`` angle-addition products."""
+    alpha, beta = np.atleast_2d(np.asarray(alpha, dtype=float)), np.atleast_2d(np.asarray(beta, dtype=float))
+    omega = np.asarray(omega, dtype=float)
+    const, length, tol = (np.broadcast_to(np.asarray(x, dtype=float), (len(alpha),)) for x in (const, length, tol))
+    B2 = np.hypot(alpha, beta) @ (omega**2)
+    step = 2 * np.pi / (POINTS_PER_PERIOD * float(omega.max())) if omega.size else np.inf
+    count = np.maximum(2, np.ceil(length / step).astype(int) + 1)
+    q = np.maximum(1, np.ceil(np.sqrt(count)).astype(int))
+    return alpha, beta, omega, const, length, tol, B2, count, -(-count // q), q
 
 
 def bisect_open(opened: list, alpha, beta, omega, const, tol, B2, count, max_points: int, results: tuple,

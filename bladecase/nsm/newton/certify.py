@@ -24,7 +24,7 @@ import threading
 
 import numpy as np
 
-from ..signals import POINTS_PER_PERIOD, bisect_open, interval_bound
+from ..signals import bisect_open, grid_plan, interval_bound
 
 __all__ = ["certify_flights"]
 
@@ -66,17 +66,10 @@ def certify_flights(alpha: np.ndarray, beta: np.ndarray, omega: np.ndarray, cons
     >>> all(np.array_equal(a, b) for a, b in zip(mine, (theirs[0], theirs[1], theirs[3]))), int(mine[2].sum())
     (True, 14)
     """
-    alpha, beta = np.atleast_2d(np.asarray(alpha, dtype=float)), np.atleast_2d(np.asarray(beta, dtype=float))
-    omega = np.asarray(omega, dtype=float)
+    alpha, beta, omega, const, length, tol, B2, count, p, q = grid_plan(alpha, beta, omega, const, length, tol)
     S = len(alpha)
     if S == 0:
         return np.zeros(0), np.zeros(0), np.zeros(0, dtype=bool)
-    const, length, tol = (np.broadcast_to(np.asarray(x, dtype=float), (S,)) for x in (const, length, tol))
-    B2 = np.hypot(alpha, beta) @ (omega**2)
-    step = 2 * np.pi / (POINTS_PER_PERIOD * float(omega.max())) if omega.size else np.inf
-    count = np.maximum(2, np.ceil(length / step).astype(int) + 1)
-    q = np.maximum(1, np.ceil(np.sqrt(count)).astype(int))
-    p = -(-count // q)
     value, where, upper = np.zeros(S), np.zeros(S), np.full(S, -np.inf)
     opened = []  # the grid intervals left open of the flights not violated: (row, lo, hi, f_lo, f_hi, f'_lo, f'_hi)
     key = p * (int(q.max()) + 1) + q  # the grid shapes (p, q), in the order of np.unique(axis=0)
