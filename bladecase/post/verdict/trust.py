@@ -134,13 +134,10 @@ class _Trust(_Base):
                 return
             j, worst = max(pairs, key=lambda p: abs(p[1]["relative_error"]))
             err = abs(worst["relative_error"])
-            if err > FREQUENCY_RTOL:
-                self.code("reduced_model_off_fe")
-                doubts.append(f"reduced mode {j + 1} is {err:.1%} off its FE counterpart (FE mode {worst['fe_mode']})")
-            else:
-                self.code("reduced_model_matches_fe")
-                facts.append(f"the reduced model's linear frequencies match the FE model's to {err:.1e} "
-                             f"({_modes_words([p[0] for p in pairs])}, matched by mode shape)")
+            self._frequencies(err, f"reduced mode {j + 1} is {err:.1%} off its FE counterpart (FE mode "
+                              f"{worst['fe_mode']})", f"the reduced model's linear frequencies match the FE model's "
+                              f"to {err:.1e} ({_modes_words([p[0] for p in pairs])}, matched by mode shape)",
+                              doubts, facts)
             return
         fe = (self.s.get("model") or {}).get("linear_frequencies_hz") or []
         errs = [e for e, f in zip(r.get("relative_error_vs_fe") or [], fe)
@@ -148,13 +145,18 @@ class _Trust(_Base):
         if not errs:
             return
         err = max(errs)
+        self._frequencies(err, f"the reduced model's frequencies are up to {err:.1%} off the FE model's (nearest "
+                          "frequency)", f"the reduced model's linear frequencies match the FE model's to {err:.1e} "
+                          f"(nearest frequency, {len(errs)} modes)", doubts, facts)
+
+    def _frequencies(self, err: float, off: str, match: str, doubts: list, facts: list) -> None:
+        """The reduced model's frequency check: ``off`` a doubt beyond ``FREQUENCY_RTOL``, else ``match`` a fact."""
         if err > FREQUENCY_RTOL:
             self.code("reduced_model_off_fe")
-            doubts.append(f"the reduced model's frequencies are up to {err:.1%} off the FE model's (nearest frequency)")
+            doubts.append(off)
         else:
             self.code("reduced_model_matches_fe")
-            facts.append(f"the reduced model's linear frequencies match the FE model's to {err:.1e} (nearest "
-                         f"frequency, {len(errs)} modes)")
+            facts.append(match)
 
     def comparison_rows(self) -> list[dict]:
         return [r for r in (self.s.get("comparison") or {}).get("rows") or [] if r.get("method") != "fe"]
