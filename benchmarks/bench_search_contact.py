@@ -96,13 +96,15 @@ def case(name: str):
 
 
 def measure_spectrum(system, rng) -> str:
-    """The contact's spectral measure in a line: modes, weak ones, highest ω/ω₁, resonances in ``rng``."""
+    """The contact's spectral measure in a line: modes, weak ones, highest ω/ω₁, the share of ``Σb²`` above
+    ``100 ω₁``, resonances in ``rng``."""
     sp = system.spectrum
     b2 = sp.b**2 / (sp.b**2).sum()
     res = np.floor(sp.omega * rng[1] / (2 * np.pi)) - np.floor(sp.omega * rng[0] / (2 * np.pi))
     return (f"{sp.omega.size} modes, b_j²/Σb² < 1e-12: {(b2 < 1e-12).sum()}, < 1e-6: {(b2 < 1e-6).sum()}, "
-            f"< 1e-3: {(b2 < 1e-3).sum()}; ω_max/ω₁ = {sp.omega[-1] / sp.omega[0]:.0f}; resonances in the range: "
-            f"{int(res.sum())}")
+            f"< 1e-3: {(b2 < 1e-3).sum()}; ω_max/ω₁ = {sp.omega[-1] / sp.omega[0]:.0f}; share of Σb² (the contact's "
+            f"inverse mass) above 100 ω₁: {100 * b2[sp.omega > 100 * sp.omega[0]].sum():.1f} %; resonances in the "
+            f"range: {int(res.sum())}")
 
 
 class _CpuLimit(Exception):

@@ -40,7 +40,8 @@ def test_a_long_search_is_announced_and_a_runaway_one_refused_with_the_range_tha
     assert SEARCH_WARN_S < est < SEARCH_REFUSE_S
     assert re.search(rf"chain 100: 2-ipp search: the contact sees modes up to \d+ × the lowest frequency .* "
                      rf"\d+ resonances T = 2πm/ω_j lie in the period range .* estimated {est / 60:.1f} min on 100 "
-                     r"dofs \(a narrower \[search\] periods shortens it\)", caplog.text)
+                     r"dofs; [\d.]+ % of the contact's inverse mass .* \(a narrower \[search\] periods shortens it\)",
+                     caplog.text)
 
     runaway = bc.chain(300, k=1.0, m=1 / 300, gap=1.0)
     text = demo_text().replace('model = "massless"', 'model = "newton"').replace("casing_stiffness = 1e6 ",
@@ -57,3 +58,21 @@ def test_a_long_search_is_announced_and_a_runaway_one_refused_with_the_range_tha
     beyond = RESONANCE_SECONDS * resonance_count(runaway, (lo, hi * 1.001)) * 300
     assert within <= SEARCH_REFUSE_S < beyond
     assert "massless contact model" in str(err.value)
+
+
+def test_the_warning_says_how_much_of_the_contacts_inverse_mass_the_stiff_modes_carry(caplog):
+    """A model whose contact sees stiff local modes (a Craig–Bampton contact face): the warning gives the share of
+    ``Σ b_j² = wᵀM⁻¹w`` in the modes above STIFF_RATIO × the lowest frequency, computed from the model."""
+    omega = np.array([1.0, 2.0, 5e4, 8e4])
+    b = np.array([1.0, 1.0, 1.0, 2.0])  # above 100 × ω₁: (1 + 4) / (1 + 1 + 1 + 4) = 71.4 %
+    system = bc.LinearSystem(np.eye(4), np.diag(omega**2), b, 1.0)
+    with caplog.at_level("WARNING", logger="bladecase"):
+        _check_resonances(system, 2, _range(system), "face")
+    assert stages.STIFF_RATIO == 100
+    assert ("estimated 1.7 min on 4 dofs; 71.4 % of the contact's inverse mass wᵀM⁻¹w (what an impact excites) lies in "
+            "its 2 modes above 100 × the lowest frequency (a narrower [search] periods shortens it)") in caplog.text
+    caplog.clear()
+    soft = bc.LinearSystem(np.eye(4), np.diag([1.0, 4.0, 2500.0, 9000.0]), b, 1.0)  # none above 100 × ω₁: no share
+    with caplog.at_level("WARNING", logger="bladecase"):
+        _check_resonances(soft, 2, _range(soft, 0.01, 0.9999), "soft")
+    assert "inverse mass" not in caplog.text

@@ -449,6 +449,10 @@ RESONANCE_SECONDS = 2e-3
 #: Estimated seconds of a k-ipp search above which the study warns, and above which it refuses.
 SEARCH_WARN_S, SEARCH_REFUSE_S = 60.0, 1800.0
 
+#: A long search's warning says how much of the contact's inverse mass lies in the modes above this many times
+#: the lowest frequency (on a Craig–Bampton contact face: the face's local modes).
+STIFF_RATIO = 100.0
+
 
 def resonance_count(system, T_range: tuple[float, float]) -> int:
     """Resonances ``T = 2πm/ω_j`` (``m ≥ 1``, ``ω_j`` the modes the contact sees) in ``T_range``.
@@ -468,6 +472,18 @@ def _search_estimate(system, T_range: tuple[float, float]) -> float:
     return RESONANCE_SECONDS * resonance_count(system, T_range) * system.n
 
 
+def _stiff_share(omega: np.ndarray, b: np.ndarray, omega1: float) -> str:
+    """Words for the share of the contact's inverse mass ``Σ b_j² = wᵀM⁻¹w`` (the velocity an impulse gives the
+    contact: what an impact excites) in the modes above :data:`STIFF_RATIO` × the lowest frequency; empty when
+    there are none."""
+    high = omega > STIFF_RATIO * omega1
+    if not high.any():
+        return ""
+    share = float(b[high] @ b[high] / (b @ b))
+    return (f"; {100 * share:.3g} % of the contact's inverse mass wᵀM⁻¹w (what an impact excites) lies in its "
+            f"{int(high.sum())} modes above {STIFF_RATIO:g} × the lowest frequency")
+
+
 def _check_resonances(system, k: int, T_range: tuple[float, float], label: str = "") -> None:
     """Announce (or refuse) a k-ipp search whose period range holds a great many resonances of the contact."""
     if not hasattr(system, "spectrum"):
@@ -475,12 +491,13 @@ def _check_resonances(system, k: int, T_range: tuple[float, float], label: str =
     est = _search_estimate(system, T_range)
     if est <= SEARCH_WARN_S:
         return
-    omega = system.spectrum.contact_modes[0]
+    omega, b, _ = system.spectrum.contact_modes
     ratio = float(omega.max() / system.spectrum.omega[0])
     what = (f"{label + ': ' if label else ''}{k}-ipp search: the contact sees modes up to {ratio:.0f} × the lowest "
             f"frequency ({omega.max() / (2 * np.pi):.4g} Hz) and {resonance_count(system, T_range)} resonances "
             f"T = 2πm/ω_j lie in the period range [{T_range[0]:.6g}, {T_range[1]:.6g}] s, each cutting the families "
             f"into pieces: estimated {est / 60:.{1 if est < 600 else 0}f} min on {system.n} dofs")
+    share = _stiff_share(omega, b, system.spectrum.omega[0])
     if est > SEARCH_REFUSE_S:
         hi, top = T_range[0], T_range[1]  # the longest range from T_lo estimated within SEARCH_REFUSE_S
         for _ in range(60):
@@ -488,12 +505,12 @@ def _check_resonances(system, k: int, T_range: tuple[float, float], label: str =
             hi, top = (mid, top) if _search_estimate(system, (T_range[0], mid)) <= SEARCH_REFUSE_S else (hi, mid)
         unit = 10.0 ** (np.floor(np.log10(hi)) - 5)  # rounded down to the 6 digits the message shows
         hi = float(np.floor(hi / unit) * unit)
-        raise StudyError(f"[search] periods: {what}, with thousands of families to hold in memory; valid: a range "
-                         f"estimated within {SEARCH_REFUSE_S / 60:.0f} min (from {T_range[0]:.6g} s: up to "
+        raise StudyError(f"[search] periods: {what}, with thousands of families to hold in memory{share}; valid: a "
+                         f"range estimated within {SEARCH_REFUSE_S / 60:.0f} min (from {T_range[0]:.6g} s: up to "
                          f"{hi:.6g} s), a reduced model without the contact's stiffest modes (a Craig–Bampton model "
                          "of a contact face keeps the face's local modes), or the massless contact model ([contact] "
                          "model = \"massless\")")
-    log.warning("%s (a narrower [search] periods shortens it)", what)
+    log.warning("%s%s (a narrower [search] periods shortens it)", what, share)
 
 
 def _lowest_omega(system) -> float:
