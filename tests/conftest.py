@@ -7,6 +7,7 @@ Reference systems
 * ``chain10``   — the paper's Sec. 2 chain with n = 10 (``k = 1``, ``m = 1/n``, ``d = 1``).
 * ``random_sys`` — a dense, non-diagonal SPD ``M`` and ``K`` (n = 6, seeded) with a generic,
   non-unit constraint vector ``w`` (exercises the Moreau impact law beyond the paper).
+* ``five_dof``  — ``chain(5, k=1, m=0.2, gap=1)``.
 
 Engines
 -------
@@ -31,6 +32,7 @@ import functools
 import gc
 import importlib.util
 import os
+import threading
 from pathlib import Path
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # before numpy's first import (see "BLAS threads" above)
@@ -61,6 +63,27 @@ def chain10() -> bc.LinearSystem:
 @pytest.fixture(scope="session")
 def random_sys() -> bc.LinearSystem:
     return random_spd_system()
+
+
+@pytest.fixture(scope="session")
+def five_dof() -> bc.LinearSystem:
+    return bc.chain(5, k=1.0, m=0.2, gap=1.0)
+
+
+@pytest.fixture(scope="session")
+def chain_families(two_dof, five_dof):
+    """``chain_families(name, k, T_range, scan)``: ``nonsmooth_mode(system, k, T_range, scan=scan)`` of ``two_dof``
+    or ``five_dof`` (by name), computed once per argument for the session.  tests/test_kipp.py checks these families'
+    orbits and arcs, tests/test_search_speed.py compares two of them with its one-by-one search: the search is pure
+    (a system and a range in, new families out), the tests only read them, so the first call serves both files
+    (:data:`SEARCH_FILES`, one work unit)."""
+    systems = {"two_dof": two_dof, "five_dof": five_dof}
+
+    @functools.cache
+    def families(name: str, k: int, T_range: tuple[float, float], scan: int) -> list:
+        return bc.nonsmooth_mode(systems[name], k, T_range, scan=scan)
+
+    return families
 
 
 @pytest.fixture(scope="session")
@@ -96,6 +119,23 @@ def dask_executor():
             _DASK.remove(ex)
 
 
+@pytest.fixture(scope="session")
+def bar10_massless_mode() -> bc.Branch:
+    """``massless_mode(bar(10, 0.5, contact="massless"), (3.2, 4.1))`` (about half a second): the 10-element bar's
+    first massless mode, one contact phase from grazing, then two (a fold in T).  Pure (a system and a range in, a
+    new branch out) and only read by the files of :data:`MASSLESS_MODE_FILES` (one work unit), so computed once;
+    ``bar10_massless_mode.system`` is its bar."""
+    return bc.massless_mode(bc.bar(10, 0.5, contact="massless"), (3.2, 4.1))
+
+
+@pytest.fixture(scope="session")
+def twisted_blade_p2() -> bc.FEModel:
+    """``meshes/twisted_blade.msh`` assembled at order 2 (tetra10; about a second): the P2 model on which
+    tests/test_viz.py draws and tests/test_export.py writes synthetic fields, which its material does not enter
+    (both files: one work unit, :data:`SAME_WORKER`)."""
+    return bc.assemble(bc.load_mesh(EXAMPLES.parent / "meshes" / "twisted_blade.msh"), "Ti-6Al-4V", order=2)
+
+
 def load_example(name: str):
     """``examples/<name>.py`` as a fresh module (the scripts put ``examples/`` on ``sys.path`` themselves)."""
     spec = importlib.util.spec_from_file_location(f"bladecase_example_{name}", EXAMPLES / f"{name}.py")
@@ -104,36 +144,73 @@ def load_example(name: str):
     return mod
 
 
-def fork_script(script: str | Path, *args, log: Path, cwd: Path | None = None):
+def _native_threads() -> int | None:
+    """Threads of this process that Python did not start (None where ``/proc`` cannot tell)."""
+    try:
+        return len(os.listdir("/proc/self/task")) - threading.active_count()
+    except OSError:
+        return None
+
+
+#: :func:`_native_threads` once collection has imported the test modules (pytest-xdist's own I/O thread).
+_NATIVE_AT_START: list[int | None] = []
+
+
+def fork_is_safe() -> bool:
+    """No thread that Python did not start has appeared in this process since collection.  A forked child has only
+    the forking thread: once this process has meshed, gmsh's thread pool exists here and not in the child, and gmsh
+    meshing in the child waits for it for ever.  Where this is False, run a script that may mesh in a fresh
+    interpreter instead of :func:`fork_script`."""
+    now = _native_threads()
+    return now is not None and bool(_NATIVE_AT_START) and now <= _NATIVE_AT_START[0]
+
+
+def fork_script(script: str | Path, *args, log: Path, cwd: Path | None = None, env: dict | None = None,
+                errlog: Path | None = None):
     """``script`` (Python source, or a script file) run as ``__main__`` with the arguments ``args`` in a forked
     child of this process, where bladecase is already imported: no interpreter starts (about a second of CPU each).
-    For what a script does, not for what importing does (that needs a fresh interpreter).  SIGINT and SIGTERM are
-    handled as in a fresh interpreter, stdout and stderr go to the file ``log``, the working directory is ``cwd``
-    if given.  Returns the started child (``join``, ``is_alive``, ``exitcode``: ``-signum`` when a signal killed
-    it, 1 after an uncaught exception)."""
+    For what a script does, not for what importing does (that needs a fresh interpreter); a script that meshes only
+    while :func:`fork_is_safe`.  SIGINT and SIGTERM are handled as in a fresh interpreter, stdout and stderr go to
+    the file ``log`` (stderr to ``errlog`` if given), the working directory is ``cwd`` and ``env`` is added to
+    ``os.environ`` if given.  Returns the started child (``join``, ``is_alive``, ``exitcode``: ``-signum`` when a
+    signal killed it, 1 after an uncaught exception)."""
     import multiprocessing
 
-    child = multiprocessing.get_context("fork").Process(target=_script_in_child, args=(script, args, log, cwd))
+    child = multiprocessing.get_context("fork").Process(target=_script_in_child,
+                                                        args=(script, args, log, cwd, env, errlog))
     child.start()
     return child
 
 
-def run_forked(script: str | Path, *args, cwd: Path | None = None, timeout: float = 120) -> tuple[int, str]:
+def run_forked(script: str | Path, *args, cwd: Path | None = None, timeout: float = 120,
+               env: dict | None = None) -> tuple[int, str]:
     """:func:`fork_script` to its end: the exit code and the output (stdout and stderr)."""
+    code, output, _ = _run_forked(script, args, cwd, timeout, env, split=False)
+    return code, output
+
+
+def run_forked_split(script: str | Path, *args, cwd: Path | None = None, timeout: float = 120,
+                     env: dict | None = None) -> tuple[int, str, str]:
+    """:func:`fork_script` to its end: the exit code, stdout and stderr (as ``subprocess.run`` gives them)."""
+    return _run_forked(script, args, cwd, timeout, env, split=True)
+
+
+def _run_forked(script, args, cwd, timeout, env, split: bool) -> tuple[int, str, str]:
     import tempfile
 
     with tempfile.TemporaryDirectory() as tmp:
-        log = Path(tmp) / "output.txt"
-        child = fork_script(script, *args, log=log, cwd=cwd)
+        log, errlog = Path(tmp) / "output.txt", (Path(tmp) / "stderr.txt" if split else None)
+        child = fork_script(script, *args, log=log, cwd=cwd, env=env, errlog=errlog)
         child.join(timeout)
         if child.is_alive():
             child.kill()
             child.join()
             raise TimeoutError(f"the forked script did not finish within {timeout} s")
-        return child.exitcode, log.read_text()
+        return child.exitcode, log.read_text(), (errlog.read_text() if split else "")
 
 
-def _script_in_child(script: str | Path, args: tuple, log: Path, cwd: Path | None) -> None:
+def _script_in_child(script: str | Path, args: tuple, log: Path, cwd: Path | None, env: dict | None = None,
+                     errlog: Path | None = None) -> None:
     import runpy
     import signal
     import sys
@@ -142,7 +219,11 @@ def _script_in_child(script: str | Path, args: tuple, log: Path, cwd: Path | Non
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     if cwd is not None:
         os.chdir(cwd)
+    if env:
+        os.environ.update(env)
     sys.stdout = sys.stderr = open(log, "w", buffering=1)  # the child's streams until it exits
+    if errlog is not None:
+        sys.stderr = open(errlog, "w", buffering=1)
     if isinstance(script, Path):
         sys.argv = [str(script), *map(str, args)]
         runpy.run_path(str(script), run_name="__main__")
@@ -173,31 +254,28 @@ def fig8_example():
 #: number of tests per file, which left a few slow files of 1–5 tests for the end.)  An out-of-date list only
 #: costs balance, never a test.
 HEAVIEST_FIRST = [
-    "tests/test_docs_run.py",  # the README's commands in order (its critical path) beside the docs' Python
+    "tests/test_docs_run.py",  # the README's commands in order (its critical path) beside the docs' Python; with
+    # test_readme.py (SAME_WORKER)
     "tests/test_executor.py",  # with test_comparison_study.py (SAME_WORKER)
+    "tests/test_search_speed.py",  # with test_kipp.py (SAME_WORKER)
+    "tests/test_engineering_outputs.py",  # with the other MASSLESS_MODE_FILES (SAME_WORKER)
     "tests/test_examples.py",  # with test_fig8.py (SAME_WORKER)
     "tests/test_pipeline.py",
-    "tests/test_search_speed.py",
     "tests/test_rub_study.py",
-    "tests/test_kipp.py",
-    "tests/test_inputs_api.py",  # mostly waiting (time-outs of unreachable schedulers), little CPU
+    "tests/test_scan.py",  # with test_orbits.py and test_simulate.py (SAME_WORKER)
     "tests/test_nodal_modes.py",
     "tests/test_fem.py",
-    "tests/test_engineering_outputs.py",
-    "tests/test_forcing_stage.py",
+    "tests/test_viz.py",  # with test_export.py (SAME_WORKER)
     "tests/test_compare_decides.py",
-    "tests/test_readme.py",
-    "tests/test_casing_sweep.py",
-    "tests/test_nodal_study.py",
     "tests/test_nodes.py",
+    "tests/test_forcing_stage.py",
+    "tests/test_nodal_study.py",
     "tests/test_forced_massless.py",
     "tests/test_calculix.py",
+    "tests/test_casing_sweep.py",
     "tests/test_isoparametric.py",
     "tests/test_hex_blade.py",
     "tests/test_tip_excursion.py",
-    "tests/test_scan.py",
-    "tests/test_orbits.py",
-    "tests/test_viz.py",
     "tests/test_massless.py",
     "tests/test_rotation_study.py",
     "tests/test_rotation.py",
@@ -210,12 +288,37 @@ DASK_FILES = ("tests/test_executor.py", "tests/test_comparison_study.py")
 _DASK: list = []
 
 
+#: The files that use the session's backbones of ``chain10`` and ``random_sys`` (about 0.9 s of CPU for both).
+BACKBONE_FILES = ("tests/test_scan.py", "tests/test_orbits.py", "tests/test_simulate.py")
+
+
+#: The files that read ``chain_families``.
+SEARCH_FILES = ("tests/test_search_speed.py", "tests/test_kipp.py")
+
+
+#: The files that read ``bar10_massless_mode``.
+MASSLESS_MODE_FILES = ("tests/test_engineering_outputs.py", "tests/test_inputs_api.py", "tests/test_massless_phases.py",
+                       "tests/test_review_fixes.py", "tests/test_verify_phased.py")
+
+
+#: Files that fork scripts which mesh (:func:`fork_is_safe`), one work unit: the docs' run first (it meshes only in
+#: its children), so that the README's Python still finds this process as collection left it.
+PROCESS_CLEAN = ("tests/test_docs_run.py", "tests/test_readme.py")
+
+
 #: Files that share session fixtures, each group one work unit (run one after the other on one worker, so the
 #: fixture is computed once): the Dask cluster (``dask_executor``: each start spawns and imports two Dask workers,
-#: seconds of CPU) and the Fig. 8 example's computations (``fig8_example``).
+#: seconds of CPU), the Fig. 8 example's computations (``fig8_example``), the backbones (:data:`BACKBONE_FILES`), the
+#: P2 blade (``twisted_blade_p2``), the bar's massless mode (:data:`MASSLESS_MODE_FILES`) and the chains' nonsmooth
+#: modes (:data:`SEARCH_FILES`); and the files that fork scripts which mesh (:data:`PROCESS_CLEAN`).
 SAME_WORKER = [
     DASK_FILES,
     ("tests/test_examples.py", "tests/test_fig8.py"),
+    PROCESS_CLEAN,
+    BACKBONE_FILES,
+    ("tests/test_viz.py", "tests/test_export.py"),
+    MASSLESS_MODE_FILES,
+    SEARCH_FILES,
 ]
 
 
@@ -225,6 +328,7 @@ def pytest_collection_finish(session):
     create (measured over the suite: about 3 s of full collections per worker, half that with the freeze)."""
     gc.collect()
     gc.freeze()
+    _NATIVE_AT_START.append(_native_threads())
 
 
 def pytest_runtest_teardown(item, nextitem):

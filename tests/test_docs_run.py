@@ -4,9 +4,14 @@ What is run, and the rule for what is not
 -----------------------------------------
 
 * **Python** — every fenced ```python block of a docs/*.md page, the blocks of a page concatenated in order and
-  run as one script in a fresh interpreter (a fresh namespace per page), in a temporary working directory that
-  holds a link ``meshes`` to the repository's reference meshes (pages name ``meshes/plate.inp`` as a user in the
-  repository's root would).  README.md's Python blocks are run by tests/test_readme.py and not again here.
+  run as one script (a fresh namespace per page, as ``__main__``) in a forked child of this process, where bladecase
+  is already imported (no interpreter start; what importing does is tested by the commands below, through the
+  installed executable) — or in a fresh interpreter: for a page that starts processes (:data:`STARTS_PROCESSES`:
+  spawned workers import the page's script as ``__main__``, so its ``if __name__ == "__main__"`` guard matters),
+  and for every page once this process has meshed (conftest's ``fork_is_safe()``);
+  in a temporary working directory that holds a link ``meshes`` to the repository's reference meshes (pages name
+  ``meshes/plate.inp`` as a user in the repository's root would).  README.md's Python blocks are run by
+  tests/test_readme.py and not again here.
 * **Commands** — in fenced ```sh, ```bash and ```console blocks, every line that starts with ``bladecase `` (in
   console blocks: ``$ bladecase ``; a line ending in ``\\`` continues on the next; ``;`` separates commands):
 
@@ -43,11 +48,13 @@ import shlex
 import shutil
 import subprocess
 import sys
+import time
 import tomllib
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
+from conftest import fork_is_safe, fork_script
 
 ROOT = Path(__file__).resolve().parents[1]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
@@ -72,6 +79,10 @@ HYGIENE = [
     ("a file outside the repository", r"/work/|\.\./shared/|\bscratch/", True, ()),
     ("lab-notebook prose", r"\b(?:this|last|previous|next|second|third) (?:session|stop)\b", True, ()),
 ]
+
+#: Python that starts processes (a Dask local cluster, a process pool): the page runs in a fresh interpreter.
+STARTS_PROCESSES = re.compile(r"\b(?:DaskExecutor|ProcessExecutor|LocalCluster|make_executor|multiprocessing)\b|"
+                              r"__main__")
 
 FENCE = re.compile(r"^```([^\n`]*)\n(.*?)^```", re.S | re.M)
 SHELLS = {"sh", "bash", "shell", "console"}
@@ -171,6 +182,29 @@ def _run_python(page: str, source: str, tmp: Path) -> str | None:
     return None
 
 
+class _ForkedPage:
+    """A page's Python running in a forked child (conftest's :func:`fork_script`), started now: ``result()`` is
+    its failure in words, or None, like the futures of the fresh interpreters (``TIMEOUT`` from its start)."""
+
+    def __init__(self, page: str, source: str, tmp: Path):
+        self.page, self.log, self.deadline = page, tmp / "output.txt", time.monotonic() + TIMEOUT
+        self.child = fork_script(source, log=self.log, cwd=tmp, env=_env())
+
+    def result(self) -> str | None:
+        self.child.join(max(0.0, self.deadline - time.monotonic()))
+        if self.child.is_alive():
+            self.stop()
+            return f"{self.page}: its Python blocks took more than {TIMEOUT} s"
+        if self.child.exitcode != 0:
+            return f"{self.page}: its Python blocks fail (exit {self.child.exitcode}):\n{self.log.read_text()[-3000:]}"
+        return None
+
+    def stop(self) -> None:
+        if self.child.is_alive():
+            self.child.kill()
+        self.child.join()
+
+
 def _run_commands(page: str, cmds: list[str], tmp: Path) -> str | None:
     """Run ``cmds`` in order in ``tmp`` through the installed executable; the first failure in words, or None."""
     if shutil.which("bladecase", path=_env()["PATH"]) is None:
@@ -196,25 +230,39 @@ def _command_pages() -> list[str]:
 
 @pytest.fixture(scope="module")
 def page_runs(tmp_path_factory):
-    """Every page's Python and commands, started together on two threads (each job its own process and folder):
-    ``{("python" | "commands", page): future of the failure in words or None}``.
+    """Every page's Python and commands, started together (forked children, and two threads for the fresh
+    processes; each job its own process and folder): ``{("python" | "commands", page): future of the failure in
+    words or None}``.
 
-    The command sequences go first: the README's is the longest job (its commands one after the other), and the
-    Python pages run on the other thread meanwhile, so the file takes about as long as that one sequence."""
+    The pages forked (not :data:`STARTS_PROCESSES`, and only while conftest's ``fork_is_safe()``: a page may mesh)
+    start first, from this thread before any other runs (a fork copies only the forking thread).  Then the command
+    sequences: the README's is the longest job (its commands one after the other), and the Python pages in fresh
+    interpreters run on the other thread meanwhile, so the file takes about as long as that one sequence."""
     by_page: dict[str, list[str]] = {}
     for page, cmd, runnable in documented_commands():
         if runnable:
             by_page.setdefault(page, []).append(cmd)
-    pool = ThreadPoolExecutor(max_workers=2)
     jobs = {}
+    fresh = []
+    forkable = fork_is_safe()
+    for page in _python_pages():
+        source = python_source(ROOT / page)
+        tmp = _workdir(tmp_path_factory.mktemp("python"))
+        if STARTS_PROCESSES.search(source) or not forkable:
+            fresh.append((page, source, tmp))
+        else:
+            jobs[("python", page)] = _ForkedPage(page, source, tmp)
+    pool = ThreadPoolExecutor(max_workers=2)
     for page, cmds in sorted(by_page.items(), key=lambda item: -len(item[1])):
         tmp = _workdir(tmp_path_factory.mktemp("commands"))
         jobs[("commands", page)] = pool.submit(_run_commands, page, cmds, tmp)
-    for page in _python_pages():
-        tmp = _workdir(tmp_path_factory.mktemp("python"))
-        jobs[("python", page)] = pool.submit(_run_python, page, python_source(ROOT / page), tmp)
+    for page, source, tmp in fresh:
+        jobs[("python", page)] = pool.submit(_run_python, page, source, tmp)
     yield jobs
     pool.shutdown(wait=True)
+    for job in jobs.values():
+        if isinstance(job, _ForkedPage):
+            job.stop()
 
 
 @pytest.mark.parametrize("page", _python_pages())

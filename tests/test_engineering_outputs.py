@@ -113,13 +113,13 @@ def test_newton_modes_file_stability_and_resonant_periods(tmp_path):
     assert [o.stable if o is not None else None for o in back.orbits] == [False, True, True, None]
 
 
-def test_large_systems_sample_the_stability_and_say_so(monkeypatch):
+def test_large_systems_sample_the_stability_and_say_so(monkeypatch, bar10_massless_mode):
     """Above STABILITY_DOFS dofs the multipliers are computed for STABILITY_SAMPLES orbits per arc (ends included);
     every other admissible orbit says why it has no verdict."""
     from bladecase.study import documents
 
-    system = bc.bar(10, 0.5, contact="massless")
-    branch = bc.massless_mode(system, (3.2, 4.1))
+    branch = bar10_massless_mode  # conftest's: massless_mode(bar(10, 0.5, contact="massless"), (3.2, 4.1))
+    system = branch.system
     arc = max(branch.arcs, key=lambda a: a.stop - a.start)
     assert arc.stop - arc.start >= 4
     monkeypatch.setattr(documents, "STABILITY_DOFS", 0)

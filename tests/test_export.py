@@ -325,7 +325,7 @@ def test_manifold_rejects_other_suffix(tmp_path):
 def p2_model(request) -> bc.FEModel:
     if request.param == "plate":
         return bc.assemble(bc.load_mesh(MESHES / "plate.vtu"), "steel", order=2, thickness=0.002)
-    return bc.assemble(request.getfixturevalue("blade"), "Ti-6Al-4V", order=2)
+    return request.getfixturevalue("twisted_blade_p2")  # conftest's: shared with tests/test_viz.py
 
 
 def test_p2_series_has_all_nodes_and_quadratic_cells(p2_model, tmp_path):

@@ -252,10 +252,18 @@ def test_reduced_file_with_wrong_field_types(tmp_path, strip_files, key, value, 
 
 # ----------------------------------------------------------------------------- modes files
 
-def _modes_file(tmp_path, system, edit) -> Path:
+@pytest.fixture(scope="module")
+def strip_modes(strip_files) -> str:
+    """The strip's modes file (a 1-ipp backbone with admissible arcs) as JSON text, computed once for the module."""
+    system = strip_files["system"]
     branch = bc.backbone(system, np.linspace(0.5, 0.9999, 40) * system.spectrum.periods[0])
     assert branch.arcs, "the fixture needs admissible arcs"
-    doc = families_document([branch], system)
+    return json.dumps(families_document([branch], system))
+
+
+def _modes_file(tmp_path, text: str, edit) -> Path:
+    """The modes file ``text``, edited by ``edit`` (each test its own copy)."""
+    doc = json.loads(text)
     edit(doc)
     path = tmp_path / "modes.json"
     path.write_text(json.dumps(doc))
@@ -279,8 +287,8 @@ def _mark_inadmissible(doc):
     (lambda d: d.update(system_dofs=7), "computed on a system of 7 dofs, this one has 4"),
     (lambda d: d.pop("families"), "is not a bladecase modes file"),
 ])
-def test_animate_with_a_broken_modes_file(tmp_path, plate_toml, strip_files, capsys, edit, words):
-    modes = _modes_file(tmp_path, strip_files["system"], edit)
+def test_animate_with_a_broken_modes_file(tmp_path, plate_toml, strip_files, strip_modes, capsys, edit, words):
+    modes = _modes_file(tmp_path, strip_modes, edit)
     code, err = _run(["animate", plate_toml, "--reduced", strip_files["reduced"], "--modes", modes,
                       "--out", tmp_path / "anim", "--quiet", "--no-progress"], capsys)
     line = _one_error_line(err)

@@ -12,8 +12,6 @@ from __future__ import annotations
 import dataclasses
 import os
 import re
-import subprocess
-import sys
 import textwrap
 import time
 from pathlib import Path
@@ -22,6 +20,7 @@ import meshio
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from conftest import run_forked_split
 
 import bladecase as bc
 from bladecase.fe import Mesh, assemble, load_mesh, natural_frequencies
@@ -140,7 +139,8 @@ def test_unmerged_mesh_with_coincident_nodes():
 
 
 def test_pipes_and_devices_are_refused_before_opening(tmp_path):
-    """Run in a child process with a timeout: before the fix these hung (a FIFO) or read forever (/dev/zero)."""
+    """Run in a child process with a timeout: before the fix these hung (a FIFO) or read forever (/dev/zero).  A
+    forked child (conftest's ``run_forked_split``: no interpreter start; the script reads no mesh with gmsh)."""
     fifo = tmp_path / "pipe.vtu"
     os.mkfifo(fifo)
     zero = tmp_path / "zero.vtu"
@@ -158,9 +158,9 @@ def test_pipes_and_devices_are_refused_before_opening(tmp_path):
         except ValueError as e:
             print(e)
     """)
-    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120, cwd=REPO)
-    lines = out.stdout.splitlines()
-    assert out.returncode == 0, out.stderr
+    code, stdout, stderr = run_forked_split(script, cwd=REPO, timeout=120)
+    lines = stdout.splitlines()
+    assert code == 0, stderr
     assert lines[0] == f"mesh file {str(fifo)!r} is not a regular file (a pipe, device or socket): give a file on disk"
     assert lines[1] == f"mesh file {str(zero)!r} is not a regular file (a pipe, device or socket): give a file on disk"
     assert lines[2] == "mesh file '/dev/zero' is not a regular file (a pipe, device or socket): give a file on disk"

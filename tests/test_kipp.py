@@ -143,11 +143,6 @@ T2_2DOF = 2 * np.pi / np.sqrt(3 + np.sqrt(5))  # 2π/ω₂ of the 2-dof example 
 
 
 @pytest.fixture(scope="module")
-def five_dof():
-    return bc.chain(5, k=1.0, m=0.2, gap=1.0)
-
-
-@pytest.fixture(scope="module")
 def kipp_at(two_dof):
     """``orbits_kipp(two_dof, T, k)``, solved once per ``(T, k)`` for the module: several tests check different
     properties of the same solutions (the multistart for k >= 3 is the slow part of this file)."""
@@ -162,25 +157,29 @@ def kipp_at(two_dof):
     return get
 
 
+# ``nonsmooth_mode(system, k, T_range, scan=scan)``, through conftest's ``chain_families`` (computed once for the
+# session: tests/test_search_speed.py searches two of them too)
+
+
 @pytest.fixture(scope="module")
-def fam2(two_dof):
+def fam2(chain_families):
     """The paper's Fig. 2 families (k = 2)."""
-    return bc.nonsmooth_mode(two_dof, 2, (3.0, 14.5), scan=24)
+    return chain_families("two_dof", 2, (3.0, 14.5), 24)
 
 
 @pytest.fixture(scope="module")
-def fam3(two_dof):
-    return bc.nonsmooth_mode(two_dof, 3, (5.0, 9.0), scan=8)
+def fam3(chain_families):
+    return chain_families("two_dof", 3, (5.0, 9.0), 8)
 
 
 @pytest.fixture(scope="module")
-def fam2_5(five_dof):
-    return bc.nonsmooth_mode(five_dof, 2, (6.0, 9.0), scan=8)
+def fam2_5(chain_families):
+    return chain_families("five_dof", 2, (6.0, 9.0), 8)
 
 
 @pytest.fixture(scope="module")
-def fam3_5(five_dof):
-    return bc.nonsmooth_mode(five_dof, 3, (6.9, 7.45), scan=4)
+def fam3_5(chain_families):
+    return chain_families("five_dof", 3, (6.9, 7.45), 4)
 
 
 @pytest.fixture(scope="module")

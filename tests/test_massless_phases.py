@@ -6,21 +6,20 @@ import pickle
 import numpy as np
 import pytest
 
-from bladecase.nsm import Branch, bar
-from bladecase.nsm.massless.branches import massless_mode
+from bladecase.nsm import Branch
 from bladecase.nsm.massless.model import simulate_massless
 from bladecase.nsm.massless.orbits import closing_residual
 from bladecase.nsm.massless.phases import PhasedOrbit, solve_half, split_at
 
 
 @pytest.fixture(scope="module")
-def bar10():
-    return bar(10, 0.5, contact="massless")
+def bar10(mode10):
+    return mode10.system  # bar(10, 0.5, contact="massless")
 
 
 @pytest.fixture(scope="module")
-def mode10(bar10):
-    return massless_mode(bar10, (3.2, 4.1))
+def mode10(bar10_massless_mode):
+    return bar10_massless_mode  # conftest's: massless_mode(bar(10, 0.5, contact="massless"), (3.2, 4.1))
 
 
 def test_one_phase_pattern_is_the_symmetric_orbit_residual(bar10):

@@ -369,10 +369,14 @@ _RACER = textwrap.dedent("""
         staging = pub.staging_dir(out)
     except pub.OutputInUse as exc:
         print("refused", exc)
+        (out.parent / "refused").touch()
         sys.exit(3)
     for name in ("modes.json", "report.md", "summary.json"):
         (staging / name).write_text(tag)
-    time.sleep(1.5)
+    # the folder is held until the other run was refused (60 s at most: a run let in as well fails the test)
+    deadline = time.monotonic() + 60
+    while not (out.parent / "refused").exists() and time.monotonic() < deadline:
+        time.sleep(0.01)
     pub.publish(staging, out, pub.RUN_RESULTS, whole=True)
     print("published")
 """)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import bladecase as bc
-from bladecase.nsm import Branch, backbone, bar, chain, massless_mode
+from bladecase.nsm import Branch, backbone, chain
 from bladecase.nsm.massless.model import simulate_massless
 from bladecase.nsm.massless.phases import PhasedOrbit
 
@@ -17,10 +17,11 @@ from bladecase.nsm.massless.phases import PhasedOrbit
 
 
 @pytest.fixture(scope="module")
-def phased():
+def phased(bar10_massless_mode):
     """The 10-element bar's first massless mode over (3.2, 4.1): one contact phase from grazing, two after the
-    pattern changes near T = 3.2695, then a fold in T (measured: 17 one-phase points, then 97 two-phase ones)."""
-    return massless_mode(bar(10, 0.5, contact="massless"), (3.2, 4.1))
+    pattern changes near T = 3.2695, then a fold in T (measured: 17 one-phase points, then 97 two-phase ones);
+    conftest's ``massless_mode(bar(10, 0.5, contact="massless"), (3.2, 4.1))``."""
+    return bar10_massless_mode
 
 
 def _returns(orbit) -> float:

@@ -37,16 +37,7 @@ from bladecase.nsm.newton.modal import (
 from bladecase.nsm.newton.orbits import REPEAT_RTOL, make_orbit, make_orbits
 from bladecase.nsm.signals import TrigSum, certified_max, certified_max_stack, sincos
 
-
-@pytest.fixture(scope="module")
-def two_dof():
-    return bc.chain(2, k=1.0, m=0.5, gap=1.0)
-
-
-@pytest.fixture(scope="module")
-def five_dof():
-    return bc.chain(5, k=1.0, m=0.2, gap=1.0)
-
+# two_dof, five_dof: conftest's (chain(2, k=1, m=0.5, gap=1) and chain(5, k=1, m=0.2, gap=1))
 
 # ---------------------------------------------------------------------------------------------------------
 # 1. Vectorised pieces against their scalar counterparts
@@ -395,9 +386,9 @@ def _reference_search(system, k, T_range, scan):
 
 @pytest.mark.parametrize("sysname,k,T_range,scan", [("two_dof", 2, (3.0, 14.5), 24), ("five_dof", 2, (6.0, 9.0), 8),
                                                     ("two_dof", 3, (5.0, 9.0), 4)])
-def test_search_finds_what_the_one_by_one_search_finds(request, sysname, k, T_range, scan):
+def test_search_finds_what_the_one_by_one_search_finds(request, chain_families, sysname, k, T_range, scan):
     system = request.getfixturevalue(sysname)
-    fast = bc.nonsmooth_mode(system, k, T_range, scan=scan)
+    fast = chain_families(sysname, k, T_range, scan)  # bc.nonsmooth_mode(system, k, T_range, scan=scan), once
     ref = _reference_search(system, k, T_range, scan)
     assert len(fast) == len(ref)
     for f, (orbits, arcs) in zip(fast, ref):
@@ -469,8 +460,8 @@ def test_no_family_lies_on_another(chain10_runs):
                 assert not modes.on_curve(g.orbits, f.orbits).all(), (i, j)
 
 
-def test_distinct_runs_leaves_out_a_retraced_stretch(two_dof):
-    fam = max(bc.nonsmooth_mode(two_dof, 2, (3.0, 14.5), scan=24), key=lambda f: len(f.orbits))
+def test_distinct_runs_leaves_out_a_retraced_stretch(chain_families):
+    fam = max(chain_families("two_dof", 2, (3.0, 14.5), 24), key=lambda f: len(f.orbits))  # nonsmooth_mode(...)
     n = len(fam.orbits)
     assert modes.distinct_runs(fam.orbits) == [list(range(n))]  # a plain family: one run, all of it
     back = fam.orbits + fam.orbits[n - 2: n // 2: -1]  # then back along itself: the way back is left out

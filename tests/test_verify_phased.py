@@ -5,13 +5,14 @@ from __future__ import annotations
 
 import pytest
 
-from bladecase.nsm import bar, massless_mode, verify
+from bladecase.nsm import verify
 
 
 @pytest.fixture(scope="module")
-def mode():
-    """The 10-element bar's first massless mode over (3.2, 4.1): one contact phase, then two (a fold in T)."""
-    return massless_mode(bar(10, 0.5, contact="massless"), (3.2, 4.1))
+def mode(bar10_massless_mode):
+    """The 10-element bar's first massless mode over (3.2, 4.1): one contact phase, then two (a fold in T);
+    conftest's ``massless_mode(bar(10, 0.5, contact="massless"), (3.2, 4.1))``."""
+    return bar10_massless_mode
 
 
 def test_verify_accepts_the_orbits_of_one_and_of_two_contact_phases(mode):

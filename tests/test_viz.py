@@ -232,11 +232,14 @@ def test_no_offscreen_rendering_is_a_clear_error(plate, tmp_path, monkeypatch):
 
 @pytest.fixture(scope="module", params=["plate", "blade"])
 def p2_grid(request):
-    """``(model, fe_grid(model))`` of a P2 model: all FE nodes, quadratic cells."""
+    """``(model, fe_grid(model))`` of a P2 model: all FE nodes, quadratic cells (the blade: conftest's, shared with
+    tests/test_export.py; the fields drawn are synthetic, the material does not enter)."""
     from bladecase.post.grid import fe_grid
 
-    mesh = request.getfixturevalue(request.param)
-    model = bc.assemble(mesh, "steel", order=2, **({"thickness": 0.002} if mesh.dim == 2 else {}))
+    if request.param == "blade":
+        model = request.getfixturevalue("twisted_blade_p2")
+    else:
+        model = bc.assemble(request.getfixturevalue(request.param), "steel", order=2, thickness=0.002)
     return model, fe_grid(model)
 
 
