@@ -6,7 +6,8 @@ import argparse
 import logging
 import os
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 
 from .cli_input import _floats, _ipp, _periods, _positive_int
@@ -257,13 +258,37 @@ def _study(path: Path, model: bool = True):
     return load_study(path, model=model)
 
 
+@contextmanager
+def _folder_as_found(folder: Path) -> Iterator[None]:
+    """A command that fails leaves no output folder it created: the folders made for it (left empty by the failed
+    run, whose staging is gone) are removed again; an existing folder is left to the run's own all-or-nothing
+    publication."""
+    missing = []
+    p = Path(folder).absolute()
+    while not os.path.lexists(p) and p != p.parent:
+        missing.append(p)
+        p = p.parent
+    ok = False
+    try:
+        yield
+        ok = True
+    finally:
+        if not ok:
+            for made in missing:  # deepest first
+                try:
+                    made.rmdir()  # only an empty folder
+                except OSError:
+                    break
+
+
 def _cmd_run(args) -> int:
     from .io import check_output_dir
 
     progress = _setup(args)
     study = _study(args.study)
-    check_output_dir(study.output_dir(args.out))
-    result = _run_study(study, args, progress)
+    with _folder_as_found(study.output_dir(args.out)):
+        check_output_dir(study.output_dir(args.out))
+        result = _run_study(study, args, progress)
     print(result.directory / "report.md")
     return 0
 
@@ -277,14 +302,16 @@ def _cmd_demo(args) -> int:
         return 0
     progress = _setup(args)
     study = demo_study()
-    check_output_dir(study.output_dir(args.out))
-    result = _run_study(study, args, progress)
+    with _folder_as_found(study.output_dir(args.out)):
+        check_output_dir(study.output_dir(args.out))
+        result = _run_study(study, args, progress)
     print(result.directory / "report.md")
     return 0
 
 
 def _cmd_mesh(args) -> int:
     from .fe import save_mesh
+    from .io import written_together
     from .study.stages import build_mesh
 
     _setup(args)
@@ -292,11 +319,12 @@ def _cmd_mesh(args) -> int:
     study = _study(args.study)
     _not_onto_inputs({"-o": args.output}, {"STUDY": args.study,
                                            "[mesh] path": None if study.parametric else study.mesh_path()})
-    if study.parametric and args.output.suffix == ".msh":
-        mesh = build_mesh(study, path=args.output)
-    else:
-        mesh = build_mesh(study)
-        save_mesh(mesh, args.output)
+    with written_together(args.output) as (out,):  # the mesh's groups are checked before it appears
+        if study.parametric and args.output.suffix == ".msh":
+            mesh = build_mesh(study, path=out)
+        else:
+            mesh = build_mesh(study)
+            save_mesh(mesh, out)
     groups = ", ".join(f"{k} ({len(v)})" for k, v in sorted(mesh.groups.items()))
     print(f"{args.output}: {len(mesh.points)} nodes, {len(mesh.cells[mesh.body_type])} {mesh.body_type}; "
           f"groups {groups}")
@@ -305,7 +333,8 @@ def _cmd_mesh(args) -> int:
 
 def _cmd_assemble(args) -> int:
     from .fe import load_mesh, natural_frequencies, save_model
-    from .study.stages import build_mesh, build_model
+    from .io import write_text, written_together
+    from .study.stages import build_mesh, build_model, check_plausibility
 
     _setup(args)
     _check_outputs(args.output, args.calculix)
@@ -333,13 +362,17 @@ def _cmd_assemble(args) -> int:
         spin = {} if not speed else {"speed": speed, "axis": rotation_axis(study, model)}
         deck = calculix_deck(model, count, unit=args.calculix_unit, **spin)
     f = natural_frequencies(model, count)
-    save_model(model, args.output)
+    check_plausibility(study, model, float(f[0]))  # the unit slips a run warns of (a modulus in MPa…)
+    at_speed = _frequencies_at_speed(study, model, count)
+    with written_together(args.output, args.calculix) as (out, deck_out):  # both files or neither
+        save_model(model, out)
+        if deck is not None:
+            write_text(deck_out, deck)
     print(f"{args.output}: {model}")
     print("linear frequencies (Hz): " + ", ".join(f"{x:.3f}" for x in f))
+    if at_speed is not None:
+        print(at_speed)
     if deck is not None:
-        from .io import write_text
-
-        write_text(args.calculix, deck)
         print(f"{args.calculix}: CalculiX deck ({args.calculix_unit}; run: ccx {args.calculix.with_suffix('').name}"
               + (f"; spinning at {speed:.6g} rad/s: compare with the Campbell diagram, not with the frequencies "
                  "at rest above" if speed else "")
@@ -348,9 +381,34 @@ def _cmd_assemble(args) -> int:
     return 0
 
 
+def _frequencies_at_speed(study, model, count: int) -> str | None:
+    """With ``[rotation]``: the printed line of the model's frequencies at the operating speed (``K(Ω)``: stress
+    stiffening, spin softening), and the note that the model file holds the structure at rest."""
+    from .study.rotation import operating_speed, rotation_axis
+
+    speed = operating_speed(study)
+    if speed is None:
+        return None
+    import math
+
+    from .fe import natural_frequencies
+    from .fe.rotation import spin
+    from .study import StudyError
+
+    try:
+        state = spin(model, speed, rotation_axis(study, model), static=study["rotation"].get("static", "auto"))
+    except ValueError as exc:
+        raise StudyError(f"[rotation] speed: {exc}") from None
+    f = natural_frequencies(state.model, count, factor=state.factor)
+    return (f"at the operating speed {speed:.6g} rad/s ({speed * 30 / math.pi:.6g} rpm, [rotation]): linear "
+            "frequencies (Hz): " + ", ".join(f"{x:.3f}" for x in f) + " — the model file holds the structure at rest; "
+            "'bladecase reduce' spins it to this speed")
+
+
 def _cmd_reduce(args) -> int:
     from .fe import load_model
     from .reduction import save_reduced
+    from .study.rotation import operating_point
     from .study.stages import build_contact, build_reduced
 
     _setup(args)
@@ -359,16 +417,19 @@ def _cmd_reduce(args) -> int:
     study = _study(args.study)
     model = load_model(args.model)
     contact = build_contact(study, model)
-    reduced = build_reduced(study, model, contact, args.method, args.size)
+    model, contact, factor, rotation = operating_point(study, model, contact)  # [rotation]: K(Ω), running clearance
+    reduced = build_reduced(study, model, contact, args.method, args.size, factor=factor)
     save_reduced(reduced, args.output)
     sp = reduced.system.spectrum
-    print(f"{args.output}: {reduced}; contact node {model.mesh.node_id(contact.node)}")
+    print(f"{args.output}: {reduced}; contact node {model.mesh.node_id(contact.node)}"
+          + ("" if rotation is None else f"; at {rotation['speed_rad_s']:.6g} rad/s ([rotation]), running clearance "
+             f"{rotation['clearance_running_m'] * 1e3:.4g} mm"))
     print("reduced frequencies (Hz): " + ", ".join(f"{x:.3f}" for x in sp.frequencies[sp.active][:12]))
     return 0
 
 
 def _cmd_modes(args) -> int:
-    from .io import write_json
+    from .io import save_figure, write_json, written_together
     from .study.documents import families_document
     from .study.stages import search
 
@@ -385,13 +446,16 @@ def _cmd_modes(args) -> int:
         args.chain, args.gap = None, None
         system = _load_system(args)
     families = search(study, system, progress=progress)
-    write_json(args.output, families_document(families, system))
+    document = families_document(families, system)
+    figure = _plot(families) if args.plot else None  # before anything is written: nothing to plot is an error
+    with written_together(args.output, args.plot) as (out, plot):
+        write_json(out, document)
+        if figure is not None:
+            save_figure(figure, plot, dpi=150)
     for i, fam in enumerate(families):
         if fam.arcs:
             print(f"family {i}: " + fam.table())
     print(f"{args.output}: {len(families)} families, {sum(len(f.arcs) for f in families)} admissible arcs")
-    if args.plot:
-        _save_plot(families, args.plot)
     return 0
 
 
@@ -405,20 +469,24 @@ def _cmd_animate(args) -> int:
     progress = _setup(args)
     study = _study(args.study)
     check_inputs(study.output_dir(args.out), [args.study, args.reduced, args.modes], ("animations", "vtk"))
-    check_output_dir(study.output_dir(args.out))
-    reduced = load_reduced(args.reduced)
-    families = load_families(args.modes, reduced.system, reduced=args.reduced)
-    written = animate_families(study, reduced, families, out=args.out, progress=progress)
+    with _folder_as_found(study.output_dir(args.out)):
+        reduced = load_reduced(args.reduced)
+        families = load_families(args.modes, reduced.system, reduced=args.reduced)
+        check_output_dir(study.output_dir(args.out))
+        written = animate_families(study, reduced, families, out=args.out, progress=progress)
+        if not written:  # nothing was published: the folder is as it was
+            raise _NothingToAnimate()
     for entry in written:
         print(", ".join(str(entry[k]) for k in ("gif", "mp4", "pvd", "manifold") if k in entry))
-    if not written:
-        print("no admissible orbit to animate", file=sys.stderr)
-        return 1
     return 0
 
 
+class _NothingToAnimate(Exception):
+    """``bladecase animate`` found no orbit to animate (exit 1; the output folder untouched)."""
+
+
 def _cmd_backbone(args) -> int:
-    from .io import write_json, write_text
+    from .io import save_figure, write_json, write_text, written_together
     from .nsm import backbone
 
     _check_outputs(args.table, args.json, args.plot)
@@ -450,28 +518,28 @@ def _cmd_backbone(args) -> int:
             "T_range": [float(P[0]), float(P[-1])],
             "families": [f.to_dict() for f in curves],
         }
+    figure = _plot(curves) if args.plot else None  # before anything is written: nothing to plot is an error
+    with written_together(args.table, args.json, args.plot) as (table_out, json_out, plot_out):
+        if args.table:
+            write_text(table_out, table + "\n")
+        if args.json:
+            write_json(json_out, data)
+        if figure is not None:
+            save_figure(figure, plot_out, dpi=150)
     print(summary if args.quiet else table)
-    if args.table:
-        write_text(args.table, table + "\n")
-    if args.json:
-        write_json(args.json, data)
-    if args.plot:
-        _save_plot(curves, args.plot)
     for label, path in (("table", args.table), ("json", args.json), ("plot", args.plot)):
         if path:
             print(f"wrote {label}: {path}", file=sys.stderr)
     return 0
 
 
-def _save_plot(curves, path: Path) -> None:
-    """The frequency–energy plot of backbones/families, written atomically."""
-    from .io import save_figure
+def _plot(curves):
+    """The frequency–energy plot (a Figure) of backbones/families; ``ValueError`` when there is none."""
     from .post.plots import frequency_energy
 
     if not curves:
-        raise ValueError("nothing to plot: no family found")
-    fig = frequency_energy(curves)
-    save_figure(fig, path, dpi=150)
+        raise ValueError("nothing to plot: no family found (--plot needs one; leave it out, or widen the periods)")
+    return frequency_energy(curves)
 
 
 class _Terminated(KeyboardInterrupt):
@@ -511,6 +579,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except ValueError as exc:  # includes StudyError: the message names the key
         print(f"{where}: error: {_one_line(exc)}", file=sys.stderr)
         return 2
+    except _NothingToAnimate:
+        print(f"{where}: no admissible orbit to animate: nothing written, the output folder is as it was",
+              file=sys.stderr)
+        return 1
     except BrokenPipeError:  # output piped into e.g. `head`
         sys.stdout = open(os.devnull, "w")
         return 0

@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 
 __all__ = ["WriteError", "atomic_path", "check_output_dir", "check_output_file", "npz_array", "npz_scalar", "os_reason",
-           "read_npz", "replace_dir", "save_figure", "strict_json", "write_json", "write_text"]
+           "read_npz", "replace_dir", "save_figure", "strict_json", "write_json", "write_text", "written_together"]
 
 
 class WriteError(OSError, ValueError):
@@ -238,6 +238,81 @@ def replace_dir(new: str | os.PathLike, target: str | os.PathLike) -> None:
         shutil.rmtree(aside, ignore_errors=True)
         raise
     shutil.rmtree(aside, ignore_errors=True)
+
+
+@contextmanager
+def written_together(*paths: str | os.PathLike | None) -> Iterator[list[Path | None]]:
+    """Temporary paths beside each of ``paths`` (``None`` stays ``None``), renamed onto them together when the
+    block ends without error: a command's result files appear all or none. On an error in the block every
+    temporary file is removed and the targets are as they were; if one rename fails, the targets already
+    replaced are put back.
+
+    >>> import tempfile
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> write_text(folder / "a.txt", "old")
+    >>> try:
+    ...     with written_together(folder / "a.txt", folder / "b.txt") as (a, b):
+    ...         write_text(a, "new")
+    ...         raise ValueError("the second result cannot be made")
+    ... except ValueError:
+    ...     pass
+    >>> (folder / "a.txt").read_text(), sorted(p.name for p in folder.iterdir())
+    ('old', ['a.txt'])
+    >>> shutil.rmtree(folder)
+    """
+    targets = [None if p is None else check_output_file(p) for p in paths]
+    temps: list[Path | None] = []
+    try:
+        for target in targets:
+            if target is None:
+                temps.append(None)
+                continue
+            target.parent.mkdir(parents=True, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=target.suffix, dir=target.parent)
+            os.close(fd)
+            temps.append(Path(tmp))
+        yield temps
+        _rename_all([(t, p) for t, p in zip(temps, targets) if t is not None])
+    except OSError as exc:
+        if isinstance(exc, WriteError):
+            raise
+        raise WriteError(f"cannot write {str(exc.filename or targets[0])!r}: {os_reason(exc)}") from None
+    finally:
+        for tmp in temps:
+            if tmp is not None:
+                tmp.unlink(missing_ok=True)
+
+
+def _rename_all(pairs: list[tuple[Path, Path]]) -> None:
+    """``os.replace`` each ``(tmp, target)``; the previous targets are kept as hard links until every rename
+    succeeded, and put back if one fails."""
+    umask = os.umask(0)
+    os.umask(umask)
+    backups: list[tuple[Path | None, Path]] = []
+    try:
+        for tmp, target in pairs:
+            os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; results are ordinary files
+            backup = None
+            if os.path.lexists(target):
+                backup = target.parent / f".{target.stem}.old-{os.getpid()}-{len(backups)}{target.suffix}"
+                backup.unlink(missing_ok=True)
+                try:
+                    os.link(target, backup, follow_symlinks=False)
+                except OSError:  # a file system without hard links
+                    shutil.copy2(target, backup, follow_symlinks=False)
+            backups.append((backup, target))
+            os.replace(tmp, target)
+    except BaseException:
+        for backup, target in backups:
+            if backup is not None:
+                os.replace(backup, target)
+            else:
+                target.unlink(missing_ok=True)
+        raise
+    finally:
+        for backup, _ in backups:
+            if backup is not None:
+                backup.unlink(missing_ok=True)
 
 
 # ----------------------------------------------------------------------------- stage files (.npz)

@@ -4,7 +4,7 @@ admissible arcs; frames with one frame on each impact instant."""
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -15,14 +15,54 @@ from .schema import Study, StudyError
 
 @dataclass(frozen=True)
 class Choice:
-    """An orbit chosen for animation: family index and the orbit."""
+    """An orbit chosen for animation: family index and the orbit; ``digits`` of the period in its file stem
+    (more than 7 only where two chosen orbits would otherwise share one, see :func:`distinct_stems`) and a
+    ``suffix`` for orbits whose periods agree to every digit."""
 
     family: int
     orbit: PeriodicOrbit
+    digits: int = 7
+    suffix: str = ""
 
     @property
     def stem(self) -> str:
-        return f"mode{self.family:02d}_{self.orbit.k}ipp_T{self.orbit.T:.6e}".replace("+", "").replace(".", "p")
+        """The file stem of the orbit's animations and VTK files, e.g. ``mode00_1ipp_T1p396486e-03``."""
+        return _stem(self.family, self.orbit.k, self.orbit.T, self.digits) + self.suffix
+
+
+def _stem(family: int, k: int, T: float, digits: int) -> str:
+    return f"mode{family:02d}_{k}ipp_T{T:.{digits - 1}e}".replace("+", "").replace(".", "p")
+
+
+def _distinct(chosen: list[Choice], members: list[int], digits: int) -> int:
+    return len({_stem(chosen[i].family, chosen[i].orbit.k, chosen[i].orbit.T, digits) for i in members})
+
+
+def distinct_stems(chosen: list[Choice]) -> list[Choice]:
+    """``chosen`` with one file stem per orbit: where stems collide at 7 digits of the period, those orbits'
+    periods are written with as many digits as tell them apart (up to 17); orbits whose periods agree to every
+    digit (the same orbit asked for twice, or two families through one orbit) are numbered ``_2``, ``_3`` …
+
+    >>> import bladecase as bc
+    >>> o = bc.orbit_1ipp(bc.chain(2, k=1.0, m=1.0, gap=1.0), 5.0)
+    >>> near = bc.orbit_1ipp(o.system, 5.0000001)
+    >>> [c.stem for c in distinct_stems([Choice(0, o), Choice(0, near), Choice(0, o)])]
+    ['mode00_1ipp_T5p0000000e00', 'mode00_1ipp_T5p0000001e00', 'mode00_1ipp_T5p0000000e00_2']
+    """
+    out = list(chosen)
+    groups: dict[str, list[int]] = {}
+    for i, c in enumerate(out):
+        groups.setdefault(c.stem, []).append(i)
+    for members in groups.values():
+        if len(members) < 2:
+            continue
+        digits = next(d for d in range(7, 18) if _distinct(out, members, d) == _distinct(out, members, 17))
+        seen: dict[str, int] = {}
+        for i in members:
+            c = replace(out[i], digits=digits)
+            n = seen[c.stem] = seen.get(c.stem, 0) + 1
+            out[i] = c if n == 1 else replace(c, suffix=f"_{n}")
+    return out
 
 
 def _admissible_at(fam: Branch, T: float) -> PeriodicOrbit | None:
@@ -65,7 +105,7 @@ def choose_orbits(study: Study, families: list[Branch], unit: float,
                 log.info("no admissible %d-ipp orbit at T = %.6g s; animating the nearest one, T = %.6g s",
                          req["ipp"], T, best[2].T)
             chosen.append(Choice(best[1], best[2]))
-        return chosen
+        return distinct_stems(chosen)
     arcs = sorted((((a.T_hi - a.T_lo) / a.T_hi, i, n) for i, fam in enumerate(families)
                    for n, a in enumerate(fam.arcs)), reverse=True)
     # Widest arcs first, one per family; then further arcs of the same families if fewer families than asked.
@@ -85,7 +125,7 @@ def choose_orbits(study: Study, families: list[Branch], unit: float,
         if accept is not None and not accept(orbit):
             continue
         chosen.append(Choice(i, orbit))
-    return chosen
+    return distinct_stems(chosen)
 
 
 def frame_times(orbit: PeriodicOrbit, frames: int) -> tuple[np.ndarray, np.ndarray]:

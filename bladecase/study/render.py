@@ -229,18 +229,21 @@ def animate_families(study: Study, reduced: ReducedModel, families: list[Branch]
     """The render stage alone (``bladecase animate``): animations and VTK files of the chosen orbits.
 
     Returns one entry per animated orbit (period, energy, verification, file
-    names relative to the output directory); files are published together.
+    names relative to the output directory); files are published together. With no orbit to animate nothing
+    is published: the folder's previous ``animations/`` and ``vtk/`` stay as they were.
     """
     out = output_folder(study, out)
     staging = staging_dir(out, ("animations", "vtk"))
+    entries: list[dict] = []
     try:
         o = study["output"]
         reference = (reference_model(reduced.model, reduced.contact, reduced, basis=study_basis(study))
                      if o["reference"] else None)
         entries = render_all(study, reduced, families, staging, progress, reference)
-        publish(staging, out, ("animations", "vtk"))
-    except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
-        release(out)
-        raise
+        if entries:
+            publish(staging, out, ("animations", "vtk"))
+    finally:
+        if not entries or os.path.lexists(staging):  # failed, or nothing to publish
+            shutil.rmtree(staging, ignore_errors=True)
+            release(out)
     return entries

@@ -112,6 +112,10 @@ def _log_clamp(spec, mesh: Mesh, model: FEModel, chosen: np.ndarray) -> None:
                     mesh.node_id(loose[0]))
 
 
+#: A modulus (Pa) below which no blade is made (polymers start near 1e9; a metal's modulus typed in MPa is ~1e5).
+SOFTEST_BLADE_E = 1e7
+
+
 def check_plausibility(study: Study, model: FEModel, f1_hz: float | None = None) -> str | None:
     """Warn (log) when ``model`` is not a blade: its total mass (and, given, its first frequency ``f1_hz``) far
     outside :data:`~bladecase.fe.mesh_checks.BLADE_MASS_KG` (:data:`~bladecase.fe.mesh_checks.BLADE_F1_HZ`), naming
@@ -125,6 +129,10 @@ def check_plausibility(study: Study, model: FEModel, f1_hz: float | None = None)
         thick = thin_plate(model.thickness, float(np.ptp(model.mesh.points[:, :2], axis=0).max()))
         if thick:
             log.warning("%s", thick)
+    E = model.material.E
+    if f1_hz is None and sentence is None and E < SOFTEST_BLADE_E:  # whatever the frequencies: no blade is rubber
+        log.warning("[material] E = %g Pa is a rubber's stiffness (a blade's metal or composite: 1e10 to 5e11 Pa): "
+                    "a modulus in MPa? Give it in Pa (E = %.4g) with rho in kg/m³", E, E * 1e6)
     if sentence and (f1_hz is None or not BLADE_F1_HZ[0] <= f1_hz <= BLADE_F1_HZ[1]):
         log.warning("FE model of %s: %s", model.mesh.source or "the mesh", sentence)
     return sentence
