@@ -217,3 +217,27 @@ def test_reduce_spins_the_model_to_the_operating_speed(plate, tmp_path, capsys):
     spun = load_reduced(tmp_path / "r.npz").system.spectrum.frequencies[0]
     rest = load_reduced(plate / "red.npz").system.spectrum.frequencies[0]
     assert spun > rest * (1 + 1e-4)
+
+
+# ----------------------------------------------------------------------------- [output] orbits never silent
+
+def test_requested_orbits_substituted_or_merged_are_said(plate, tmp_path, caplog):
+    """Ten periods asked for between the plate's narrow arcs: the nearest admissible orbits stand in for them,
+    each substitution is a warning and a field of its entry, and requests that end on one orbit give it once."""
+    from bladecase.study import load_study
+    from bladecase.study.documents import load_families
+    from bladecase.study.render import animate_families
+
+    asked = [round(0.70 + 0.01 * i, 2) for i in range(10)]
+    study = plate / "asked.toml"
+    study.write_text(PLATE.replace('reference = false', 'reference = false\norbits = [' + ", ".join(
+        f"{{ipp = 1, T = {t}}}" for t in asked) + "]\nformats = []").replace('formats = ["gif", "vtu"]\n', ""))
+    reduced = load_reduced(plate / "red.npz")
+    families = load_families(plate / "modes.json", reduced.system, reduced=plate / "red.npz")
+    with caplog.at_level(logging.WARNING, logger="bladecase"):
+        entries = animate_families(load_study(study), reduced, families, out=tmp_path / "out")
+    subs = [t for e in entries for t in e.get("substitutes_for_T", [])]
+    assert len(entries) < len(asked) and len({e["T"] for e in entries}) == len(entries)
+    assert len(subs) == len(asked)  # none of the ten is on an arc here: every one is said
+    assert caplog.text.count("animating the nearest admissible one") == len(entries)
+    assert "requests (T = " in caplog.text and "give one orbit" in caplog.text

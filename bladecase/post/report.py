@@ -160,6 +160,10 @@ def report(summary: dict) -> str:
                      f"Hz, E = {a['energy_j']:.3e} J, "
                      f"{phases}, displacements × {a['scale']:.4g}; event-driven simulation returns to it to "
                      f"{check['return_error']:.1e}{'' if check['ok'] else ' — CHECK FAILED'}): {what}")
+        if a.get("substitutes_for_T"):
+            asked = ", ".join(f"{t:.8g}" for t in a["substitutes_for_T"])
+            lines.append(f"  - **Not the orbit asked for:** `[output] orbits` asked for T = {asked} s, where no "
+                         "admissible orbit of this ipp was found; this is the nearest admissible one.")
         if "reference_check" in a:
             lines.append(f"  - {_reference_words(a['reference_check'], a['ipp'])}")
         if "energy_words" in a:

@@ -23,6 +23,10 @@ class Choice:
     orbit: PeriodicOrbit
     digits: int = 7
     suffix: str = ""
+    #: The periods (s) asked for in ``[output] orbits`` that this orbit stands for, when it is not at them: no
+    #: admissible orbit was there and this, the nearest, was animated instead (empty: chosen as asked or
+    #: automatically).
+    substitutes: tuple[float, ...] = ()
 
     @property
     def stem(self) -> str:
@@ -82,30 +86,9 @@ def choose_orbits(study: Study, families: list[Branch], unit: float,
     animated whatever it says (the caller flags them).
     """
     o = study["output"]
-    chosen: list[Choice] = []
     if o["orbits"]:
-        for req in o["orbits"]:
-            T = req["T"] * unit
-            best = None
-            for i, fam in enumerate(families):
-                if fam.k != req["ipp"]:
-                    continue
-                if any(a.T_lo <= T <= a.T_hi for a in fam.arcs):
-                    orbit = _admissible_at(fam, T)
-                    if orbit is not None:
-                        best = (0.0, i, orbit)
-                        break
-                for orbit in fam.orbits:
-                    if orbit.admissible and (best is None or abs(orbit.T - T) < best[0]):
-                        best = (abs(orbit.T - T), i, orbit)
-            if best is None:
-                raise StudyError(f"[output] orbits: no admissible {req['ipp']}-ipp orbit was found in the search "
-                                 f"range (asked T = {req['T']} {study['search']['period_unit']})")
-            if best[0] > 0:
-                log.info("no admissible %d-ipp orbit at T = %.6g s; animating the nearest one, T = %.6g s",
-                         req["ipp"], T, best[2].T)
-            chosen.append(Choice(best[1], best[2]))
-        return distinct_stems(chosen)
+        return _requested(study, families, unit)
+    chosen: list[Choice] = []
     arcs = sorted((((a.T_hi - a.T_lo) / a.T_hi, i, n) for i, fam in enumerate(families)
                    for n, a in enumerate(fam.arcs)), reverse=True)
     # Widest arcs first, one per family; then further arcs of the same families if fewer families than asked.
@@ -125,6 +108,54 @@ def choose_orbits(study: Study, families: list[Branch], unit: float,
         if accept is not None and not accept(orbit):
             continue
         chosen.append(Choice(i, orbit))
+    return distinct_stems(chosen)
+
+
+def _requested(study: Study, families: list[Branch], unit: float) -> list[Choice]:
+    """The orbits of ``[output] orbits``: the admissible orbit at each period asked for, else the nearest admissible
+    one of its ipp — a substitution said by a warning and kept on the choice (the report says it too); requests
+    that end on one orbit give it once, with a warning that names them."""
+    o = study["output"]
+    picks: list[tuple[int, PeriodicOrbit, float, float]] = []  # family, orbit, period asked (s), distance (s)
+    for req in o["orbits"]:
+        T = req["T"] * unit
+        best = None
+        for i, fam in enumerate(families):
+            if fam.k != req["ipp"]:
+                continue
+            if any(a.T_lo <= T <= a.T_hi for a in fam.arcs):
+                orbit = _admissible_at(fam, T)
+                if orbit is not None:
+                    best = (0.0, i, orbit)
+                    break
+            for orbit in fam.orbits:
+                if orbit.admissible and (best is None or abs(orbit.T - T) < best[0]):
+                    best = (abs(orbit.T - T), i, orbit)
+        if best is None:
+            raise StudyError(f"[output] orbits: no admissible {req['ipp']}-ipp orbit was found in the search "
+                             f"range (asked T = {req['T']} {study['search']['period_unit']})")
+        picks.append((best[1], best[2], T, best[0]))
+    chosen: list[Choice] = []
+    where: dict[tuple[int, float], int] = {}  # (family, period of the orbit) → its place in chosen
+    asked: dict[int, list[float]] = {}
+    for family, orbit, T, distance in picks:
+        key = (family, float(orbit.T))
+        if key not in where:
+            where[key] = len(chosen)
+            chosen.append(Choice(family, orbit))
+        n = where[key]
+        asked.setdefault(n, []).append(T)
+        if distance > 0:
+            chosen[n] = replace(chosen[n], substitutes=(*chosen[n].substitutes, T))
+    for n, periods in asked.items():
+        c = chosen[n]
+        if c.substitutes:
+            log.warning("[output] orbits: no admissible %d-ipp orbit at T = %s s; animating the nearest admissible "
+                        "one, T = %.8g s, instead", c.orbit.k, ", ".join(f"{t:.8g}" for t in c.substitutes),
+                        c.orbit.T)
+        if len(periods) > 1:
+            log.warning("[output] orbits: %d requests (T = %s s) give one orbit, T = %.8g s: animated once",
+                        len(periods), ", ".join(f"{t:.8g}" for t in periods), c.orbit.T)
     return distinct_stems(chosen)
 
 

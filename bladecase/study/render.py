@@ -74,6 +74,8 @@ def render(study: Study, reduced: ReducedModel, families: list[Branch], choice: 
         check = {("contact_phases" if k == "impacts" else k): v for k, v in check.items()}
     entry = {"family": choice.family, "ipp": orbit.k, "T": orbit.T, "frequency_hz": 1 / orbit.T,
              "energy_j": orbit.energy}
+    if choice.substitutes:  # [output] orbits asked for periods where no admissible orbit is: the nearest instead
+        entry["substitutes_for_T"] = list(choice.substitutes)
     if massless:  # contact phases of finite duration, and the momentum the casing gives in each (∫λ dt)
         entry.update(contact_time=orbit.contact_time, contact_intervals=[list(c) for c in orbit.contact_intervals],
                      contact_momentum_ns=orbit.impulses.tolist())
