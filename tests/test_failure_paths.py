@@ -241,3 +241,11 @@ def test_requested_orbits_substituted_or_merged_are_said(plate, tmp_path, caplog
     assert len(subs) == len(asked)  # none of the ten is on an arc here: every one is said
     assert caplog.text.count("animating the nearest admissible one") == len(entries)
     assert "requests (T = " in caplog.text and "give one orbit" in caplog.text
+
+
+def test_run_that_fails_into_a_new_folder_leaves_no_folder(plate, tmp_path, capsys):
+    study = plate / "noclamp.toml"
+    study.write_text(PLATE.replace("thickness = 0.002\n", 'thickness = 0.002\nclamp = "nosuch"\n'))
+    code = _run("run", study, "--out", tmp_path / "new" / "out")
+    assert code == 2 and "no group 'nosuch'" in capsys.readouterr().err
+    assert not (tmp_path / "new").exists()
