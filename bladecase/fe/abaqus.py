@@ -11,12 +11,30 @@ only the last ``*NODE`` block and reads no ``*BOUNDARY``; :func:`read_abaqus` re
   (same variants); other elements (shells, beams, springs, masses, axisymmetric ``CAX``) are left out with a log
   line counting them;
 * ``*NSET`` / ``*ELSET`` (``GENERATE``, nested set names, case-insensitive as in Abaqus) as named node groups
-  (``point_sets``; an element set becomes the nodes of its elements);
+  (``point_sets``; an element set becomes the nodes of its elements; ``*NSET, NSET=…, ELSET`` the nodes of the
+  elements it lists);
 * ``*BOUNDARY`` (node numbers or node sets, a dof range or ``ENCASTRE``, ``PINNED``, ``XSYMM``, …) as the groups
   ``boundary`` (every node with a fixed dof), ``boundary_fixed`` (the nodes whose three translations are all
   fixed, by one line or several) and ``boundary_<first>_<last>`` per dof range as written (``boundary_1_3``;
   ``ENCASTRE`` is ``boundary_1_6``, ``PINNED`` ``boundary_1_3``, ``XSYMM`` ``boundary_xsymm``); a prescribed
   non-zero displacement is not a fixed dof.
+
+A set or a ``*BOUNDARY`` line must name nodes and elements the deck defines, or the study would run on a group
+that silently lost members:
+
+* a listed node or element number the deck does not define is an error (CalculiX warns about a node number above
+  its largest one and leaves it out: a misspelt number would quietly shrink a clamp);
+* a ``GENERATE`` range ``first, last, step`` is an error when it reaches below the deck's smallest number or
+  beyond its largest one, or holds none of its numbers (CalculiX stops when ``first`` is beyond its largest number,
+  and warns and cuts ``last`` down to it: here both are errors);
+* inside the deck's numbering, the numbers of a range that a gappy numbering leaves out are skipped without a
+  word, as CalculiX does (it keeps the range as written and says nothing of the numbers no node has): ``1, 99``
+  over nodes 1, 3, …, 99 names those 50 nodes.
+
+Each error names the file, the line, the set, the number or range and the deck's numbering ("the file has 412
+nodes, numbered 1 to 412"). Ranges are checked by binary search before anything is expanded, so ``1, 1000000000``
+costs no memory. Sets are checked once the whole deck is read (a set may name nodes defined further down), and a
+``*BOUNDARY`` line naming a node set takes the whole set.
 
 Coordinates are taken as they are (the length unit is the study's ``[mesh] unit``). Errors name the file, the line
 and what was expected. :func:`looks_like_abaqus` tells an Abaqus-syntax file from its content (a CalculiX ``.msh``).
@@ -192,6 +210,29 @@ def _ints(place, text: str, what: str) -> list[int]:
         raise AbaqusError(f"{_where(place)}: expected {what} (integers separated by commas), got {text!r}") from None
 
 
+class _Members:
+    """What one set names, line by line: listed numbers (each with its line) and ``GENERATE`` ranges, of nodes or
+    of elements (in a node set, an element stands for its nodes); checked and expanded by :class:`_Numbers` once
+    the whole deck is read."""
+
+    def __init__(self):
+        self.listed: dict[str, tuple[list[int], list]] = {"node": ([], []), "element": ([], [])}
+        self.ranges: list[tuple[tuple[str, int], str, int, int, int]] = []  # (line, kind, first, last, step)
+
+    def add(self, kind: str, numbers, where) -> None:
+        """The numbers of ``kind`` (node or element) one line lists."""
+        listed, places = self.listed[kind]
+        listed += numbers
+        places += [where] * len(numbers)
+
+    def extend(self, other: _Members) -> None:
+        """Everything ``other`` names (a set named inside another)."""
+        for kind, (listed, places) in other.listed.items():
+            self.listed[kind][0].extend(listed)
+            self.listed[kind][1].extend(places)
+        self.ranges += other.ranges
+
+
 class _Deck:
     """What a deck defines, as it is read."""
 
@@ -203,11 +244,10 @@ class _Deck:
         self.elements: dict[str, list[tuple[int, list[int]]]] = {}
         self.element_nodes: dict[int, list[int]] = {}  # element number -> node numbers (every element read)
         self.left_out: dict[str, int] = {}
-        self.nsets: dict[str, tuple[str, set[int]]] = {}  # upper-case name -> (name as written, node numbers)
-        self.elsets: dict[str, tuple[str, set[int]]] = {}
-        self.fixed: dict[str, set[int]] = {}  # boundary group -> node numbers
-        self.translations: dict[int, set[int]] = {}  # node number -> its fixed translations (1, 2, 3)
-        self.boundary: list[tuple[tuple[str, int], str]] = []
+        self.nsets: dict[str, tuple[str, _Members]] = {}  # upper-case name -> (name as written, members)
+        self.elsets: dict[str, tuple[str, _Members]] = {}
+        self.bcs: list[tuple[tuple[str, int], int | str, tuple[int, ...], str]] = []  # line, node/set, dofs, group
+        self.files: set[str] = set()  # the files read (the deck and its includes)
         self.materials: list[str] = []
 
     # -------------------------------------------------------------- keywords
@@ -224,7 +264,7 @@ class _Deck:
             self.node_place.append(where)
             members.append(number)
         if params.get("NSET"):
-            self._add(self.nsets, params["NSET"], members)
+            self._add(self.nsets, params["NSET"], "node", members, place)
 
     def element(self, place, params, data) -> None:
         name = (params.get("TYPE") or "").upper()
@@ -237,7 +277,7 @@ class _Deck:
             for numbers in records:
                 self.element_nodes[numbers[0]] = numbers[1:]
             if params.get("ELSET"):
-                self._add(self.elsets, params["ELSET"], [r[0] for r in records])
+                self._add(self.elsets, params["ELSET"], "element", [r[0] for r in records], place)
             return
         kind, width = known[0], known[1] + 1
         values = [v for where, text in data for v in _ints(where, text, f"{name} element records")]
@@ -251,33 +291,36 @@ class _Deck:
             block.append((row[0], row[1:]))
             self.element_nodes[row[0]] = row[1:]
         if params.get("ELSET"):
-            self._add(self.elsets, params["ELSET"], rows[:, 0].tolist())
+            self._add(self.elsets, params["ELSET"], "element", rows[:, 0].tolist(), place)
 
     def sets(self, place, params, data, which: str) -> None:
         table = self.nsets if which == "NSET" else self.elsets
         name = params.get(which)
         if not name:
             raise AbaqusError(f"{_where(place)}: *{which} needs {which}=<name>")
-        members: list[int] = []
-        of_elements = which == "NSET" and "ELSET" in params  # *NSET, NSET=A, ELSET: the nodes of these elements
+        members = _Members()
+        # *NSET, NSET=A, ELSET: the nodes of the elements listed
+        kind = "element" if which == "ELSET" or "ELSET" in params else "node"
+        named = self.elsets if kind == "element" else self.nsets
         for where, text in data:
-            fields = [f.strip() for f in text.split(",") if f.strip()]
             if "GENERATE" in params:
                 v = _ints(where, text, "'first, last, step' of a GENERATE set")
                 if len(v) not in (2, 3) or (len(v) == 3 and v[2] <= 0) or v[1] < v[0]:
                     raise AbaqusError(f"{_where(where)}: a GENERATE line is 'first, last[, step]' with first <= "
                                       f"last and step > 0, got {text!r}")
-                span = range(v[0], v[1] + 1, v[2] if len(v) == 3 else 1)
-                members += [n for e in span for n in self.element_nodes.get(e, [])] if of_elements else span
+                members.ranges.append((where, kind, v[0], v[1], v[2] if len(v) == 3 else 1))
                 continue
+            fields = [f.strip() for f in text.split(",") if f.strip()]
+            members.add(kind, [int(f) for f in fields if re.fullmatch(r"[+-]?\d+", f)], where)
+            itself = table.get(name.upper(), (None, None))[1]
             for f in fields:
-                number = re.fullmatch(r"[+-]?\d+", f) is not None
-                if of_elements:
-                    elements = [int(f)] if number else self._lookup(self.elsets, f, where, "ELSET")[1]
-                    members += [n for e in elements for n in self.element_nodes.get(e, [])]
-                else:
-                    members += [int(f)] if number else self._lookup(table, f, where, which)[1]
-        self._add(table, name, members)
+                if re.fullmatch(r"[+-]?\d+", f) is None:  # a set named in it
+                    other = self._lookup(named, f, where, "ELSET" if kind == "element" else which)[1]
+                    if other is not itself:
+                        members.extend(other)
+        written, have = table.get(name.upper(), (name, _Members()))
+        have.extend(members)
+        table[name.upper()] = (written, have)
 
     def bc(self, place, params, data) -> None:
         if (params.get("TYPE") or "DISPLACEMENT").upper() != "DISPLACEMENT":
@@ -305,13 +348,11 @@ class _Deck:
                              "group 'boundary'", _where(where), text, value)
                     continue
                 dofs, group = tuple(range(a, b + 1)), f"boundary_{a}_{b}"
-            self.boundary.append((where, target))
-            nodes = [int(target)] if re.fullmatch(r"[+-]?\d+", target) else \
-                self._lookup(self.nsets, target, where, "NSET")[1]
-            for key in ("boundary", group):
-                self.fixed.setdefault(key, set()).update(nodes)
-            for n in nodes:
-                self.translations.setdefault(n, set()).update(d for d in dofs if d <= 3)
+            if re.fullmatch(r"[+-]?\d+", target):
+                self.bcs.append((where, int(target), dofs, group))
+            else:
+                self._lookup(self.nsets, target, where, "NSET")  # defined before this line
+                self.bcs.append((where, target.upper(), dofs, group))
 
     # -------------------------------------------------------------- helpers
     @staticmethod
@@ -326,9 +367,10 @@ class _Deck:
         return out + ([current] if current else [])
 
     @staticmethod
-    def _add(table, name: str, members) -> None:
-        written, have = table.get(name.upper(), (name, set()))
-        table[name.upper()] = (written, have | set(members))
+    def _add(table, name: str, kind: str, numbers, where) -> None:
+        written, have = table.get(name.upper(), (name, _Members()))
+        have.add(kind, numbers, where)
+        table[name.upper()] = (written, have)
 
     @staticmethod
     def _lookup(table, name: str, where, which: str):
@@ -346,6 +388,7 @@ def read_abaqus(path: str | os.PathLike):
     source = os.fspath(path)
     deck = _Deck(source)
     for place, keyword, params, data in _blocks(source):
+        deck.files.add(place[0])
         if keyword == "NODE":
             deck.node(place, params, data)
         elif keyword == "ELEMENT":
@@ -370,7 +413,7 @@ def read_abaqus(path: str | os.PathLike):
                           "(*PART, *INSTANCE) is not read; export the assembly as one flat input file")
 
     def index(numbers, what: str, where) -> np.ndarray:
-        numbers = np.asarray(list(numbers), dtype=np.int64)
+        numbers = np.asarray(numbers, dtype=np.int64)
         k = np.minimum(np.searchsorted(ranked, numbers), ranked.size - 1)
         found = ranked[k] == numbers
         if not found.all():
@@ -393,19 +436,21 @@ def read_abaqus(path: str | os.PathLike):
         found = ", ".join(f"{n} × {t}" for t, n in deck.left_out.items()) or "none"
         raise AbaqusError(f"Abaqus file {source!r} has no solid or plane element bladecase reads (found: {found}; "
                           "read: C3D4, C3D6, C3D8, C3D10, C3D15, C3D20 and variants, CPS/CPE 3, 4, 6, 8)")
+    numbers = _Numbers(ranked, deck.element_nodes, source, deck.files | {p[0] for p in deck.node_place})
+    # element sets first: a number is named under the set whose line lists it
+    elset_nodes = {key: numbers.nodes(m, f"*ELSET {w!r}") for key, (w, m) in deck.elsets.items()}
+    nset_nodes = {key: numbers.nodes(m, f"*NSET {w!r}") for key, (w, m) in deck.nsets.items()}
     point_sets: dict[str, np.ndarray] = {}
-    for written, members in deck.nsets.values():
-        point_sets[written] = index(sorted(members), f"*NSET {written!r}", source)
-    for written, members in deck.elsets.values():
-        nodes = {n for e in members for n in deck.element_nodes.get(e, [])}
+    for key, (written, _) in deck.nsets.items():
+        point_sets[written] = index(nset_nodes[key], f"*NSET {written!r}", source)
+    for key, (written, _) in deck.elsets.items():
         extra = point_sets.get(written, np.zeros(0, dtype=np.int64))
-        point_sets[written] = np.union1d(extra, index(sorted(nodes), f"*ELSET {written!r}", source))
-    for group, members in deck.fixed.items():
-        point_sets[group] = np.sort(index(sorted(members), "*BOUNDARY", source))
-    full = {n for n, dofs in deck.translations.items() if dofs >= {1, 2, 3}}
-    if deck.fixed:
-        point_sets["boundary_fixed"] = np.sort(index(sorted(full), "*BOUNDARY", source))
-        _log_boundary(source, deck, full)
+        point_sets[written] = np.union1d(extra, index(elset_nodes[key], f"*ELSET {written!r}", source))
+    if deck.bcs:
+        fixed, full = _boundary_groups(deck.bcs, numbers, nset_nodes, lambda n: index(n, "*BOUNDARY", source))
+        point_sets.update(fixed)
+        point_sets["boundary_fixed"] = full
+        _log_boundary(source, fixed, full, ids)
     if deck.materials:
         log.info("Abaqus file %s: material(s) %s of the deck not used (the study's [material] is, in SI units)",
                  source, ", ".join(deck.materials))
@@ -413,15 +458,99 @@ def read_abaqus(path: str | os.PathLike):
                        point_data={NODE_ID_KEY: ids})
 
 
-def _log_boundary(source: str, deck: _Deck, full: set[int]) -> None:
-    groups = ", ".join(f"{g} ({len(m)})" for g, m in sorted(deck.fixed.items()) if g != "boundary")
+class _Numbers:
+    """The deck's node and element numbers, against which what a set or a ``*BOUNDARY`` line names is checked
+    (module docstring): binary searches, so a range is checked before it is expanded, and expanded only to the
+    numbers the deck has."""
+
+    def __init__(self, nodes: np.ndarray, element_nodes: dict[int, list[int]], source: str, files: set[str]):
+        elements = np.array(sorted(element_nodes), dtype=np.int64)
+        self.have = {"node": nodes, "element": elements}
+        sizes = np.fromiter((len(element_nodes[e]) for e in elements.tolist()), dtype=np.int64, count=elements.size)
+        self.start = np.concatenate([[0], np.cumsum(sizes)])  # element k's nodes: flat[start[k]:start[k + 1]]
+        self.flat = np.fromiter((n for e in elements.tolist() for n in element_nodes[e]), dtype=np.int64,
+                                count=int(self.start[-1]))
+        self.deck = "the file" if files <= {os.path.abspath(source)} else "the deck"
+        self.source = source
+
+    def numbering(self, kind: str) -> str:
+        """E.g. "the file has 412 nodes, numbered 1 to 412"."""
+        have = self.have[kind]
+        whole = self.deck if self.deck == "the file" else f"the deck ({self.source!r} and the files it includes)"
+        if not have.size:
+            return f"{whole} has no {kind}"
+        return f"{whole} has {have.size} {kind}{'s' if have.size > 1 else ''}, numbered {have[0]} to {have[-1]}"
+
+    def nodes(self, members: _Members, owner: str) -> np.ndarray:
+        """The node numbers (sorted, unique) a set names; ``owner`` (e.g. ``*NSET 'ROOT'``) for the messages."""
+        nodes = [self.listed(*members.listed["node"], "node", owner)]
+        elements = [self.listed(*members.listed["element"], "element", owner)]
+        for where, kind, first, last, step in members.ranges:
+            (nodes if kind == "node" else elements).append(self._range(where, kind, first, last, step, owner))
+        nodes.append(self._nodes_of(np.concatenate(elements)))
+        return np.unique(np.concatenate(nodes))
+
+    def listed(self, numbers, places, kind: str, owner: str) -> np.ndarray:
+        """``numbers`` (the line of each in ``places``), when the deck has every one of them."""
+        numbers, have = np.asarray(numbers, dtype=np.int64), self.have[kind]
+        k = np.minimum(np.searchsorted(have, numbers), max(have.size - 1, 0))
+        missing = np.flatnonzero(have[k] != numbers) if have.size else np.arange(numbers.size)
+        if missing.size:
+            i = missing[0]
+            more = f"; {missing.size - 1} more numbers it names are missing too" if missing.size > 1 else ""
+            raise AbaqusError(f"{_where(places[i])}: {owner} names {kind} {numbers[i]}, which {self.deck} does not "
+                              f"have ({self.numbering(kind)}){more}")
+        return numbers
+
+    def _range(self, where, kind: str, first: int, last: int, step: int, owner: str) -> np.ndarray:
+        """The numbers the deck has among ``first, first + step, …, last`` (its gaps skipped)."""
+        have = self.have[kind]
+        beyond = not have.size or first < have[0] or last > have[-1]
+        chosen = have[np.searchsorted(have, first):np.searchsorted(have, last, "right")]
+        chosen = chosen[(chosen - first) % step == 0]
+        if beyond or not chosen.size:
+            how = f"beyond {self.deck}'s {kind}s" if beyond else f"none of which {self.deck} has"
+            raise AbaqusError(f"{_where(where)}: {owner} names {kind}s {first}..{last}"
+                              f"{f' step {step}' if step != 1 else ''}, {how} ({self.numbering(kind)})")
+        return chosen
+
+    def _nodes_of(self, elements: np.ndarray) -> np.ndarray:
+        """The node numbers of ``elements`` (numbers the deck has), with repeats."""
+        k = np.searchsorted(self.have["element"], elements)
+        first, sizes = self.start[k], self.start[k + 1] - self.start[k]
+        offsets = np.repeat(first - (np.cumsum(sizes) - sizes), sizes)
+        return self.flat[offsets + np.arange(int(sizes.sum()))]
+
+
+def _boundary_groups(bcs, numbers: _Numbers, nset_nodes: dict[str, np.ndarray], index):
+    """The ``*BOUNDARY`` groups (node positions, see the module docstring) and the positions of the nodes whose
+    three translations are fixed; ``index`` maps node numbers to positions."""
+    singles = [bc for bc in bcs if isinstance(bc[1], int)]  # one node a line (as cgx writes them): checked at once
+    single_pos = index(numbers.listed([bc[1] for bc in singles], [bc[0] for bc in singles], "node", "*BOUNDARY"))
+    groups: dict[str, list[np.ndarray]] = {"boundary": [single_pos]}
+    bits = np.array([sum(1 << (d - 1) for d in set(bc[2]) if d <= 3) for bc in singles], dtype=np.uint8)
+    held = np.zeros(len(numbers.have["node"]), dtype=np.uint8)  # bit d - 1: translation d fixed
+    np.bitwise_or.at(held, single_pos, bits)
+    labels = np.array([bc[3] for bc in singles], dtype=object)
+    for group in dict.fromkeys(labels.tolist()):
+        groups.setdefault(group, []).append(single_pos[labels == group])
+    for _, target, dofs, group in (bc for bc in bcs if isinstance(bc[1], str)):
+        pos = index(nset_nodes[target])
+        groups["boundary"].append(pos)
+        groups.setdefault(group, []).append(pos)
+        held[pos] |= sum(1 << (d - 1) for d in set(dofs) if d <= 3)
+    return {g: np.unique(np.concatenate(p)) for g, p in groups.items()}, np.flatnonzero(held == 7)
+
+
+def _log_boundary(source: str, fixed: dict[str, np.ndarray], full: np.ndarray, ids: np.ndarray) -> None:
+    groups = ", ".join(f"{g} ({len(m)})" for g, m in sorted(fixed.items()) if g != "boundary")
     log.info("Abaqus file %s: *BOUNDARY fixes %d nodes: group boundary; all three translations fixed: "
-             "boundary_fixed (%d); per dof range: %s", source, len(deck.fixed["boundary"]), len(full), groups)
-    partial = sorted(deck.fixed["boundary"] - full)
-    if partial:
+             "boundary_fixed (%d); per dof range: %s", source, len(fixed["boundary"]), len(full), groups)
+    partial = np.setdiff1d(fixed["boundary"], full)
+    if partial.size:
         log.info("Abaqus file %s: %d of the *BOUNDARY nodes have only some translations fixed (symmetry or "
                  "sliding conditions; first: node %d): a clamp fixes all three — clamp = \"boundary_fixed\" takes "
-                 "only the nodes fixed in x, y and z", source, len(partial), partial[0])
+                 "only the nodes fixed in x, y and z", source, partial.size, int(ids[partial].min()))
 
 
 #: meshio body type → the Abaqus element :func:`abaqus_text` writes (one that :func:`read_abaqus` reads back).

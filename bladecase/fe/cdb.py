@@ -13,6 +13,13 @@ meshio 5.3 reads no ``.cdb``; :func:`read_cdb` reads the blocks a mesh needs and
 * ``CMBLOCK``: node components (``NODE``) as they are and element components (``ELEM``) as the nodes of their
   elements, both as named node groups (``point_sets``); a negative entry closes a range (``1, -10`` is 1…10).
 
+A component must name numbers the file has: a single number the NBLOCK (or the EBLOCK, for an element component)
+does not define, a range reaching below the file's smallest number or beyond its largest (``1, -1000000000`` over 412
+nodes), or a range that holds none of its numbers is an error naming the file, the line, the component, the number
+or range and the file's numbering ("the file has 412 nodes, numbered 1 to 412"). Ranges are checked by binary search
+before anything is expanded. Inside the file's numbering, the numbers of a range that a gappy numbering leaves out
+are skipped: the range stands for the nodes (or elements) the file has between its ends.
+
 Element types: 3-D solids — 8-node bricks ``SOLID185``, ``SOLID45``, ``SOLID70``, ``SOLID164`` and their degenerate
 forms (``K = L``, ``O = P``: a wedge; ``K = L``, ``M = N = O = P``: a tetrahedron); 20-node bricks ``SOLID186``,
 ``SOLID95``, ``SOLID90`` (degenerate: 15-node wedge, 10-node tetrahedron); tetrahedra ``SOLID187``, ``SOLID92``,
@@ -115,7 +122,7 @@ def read_cdb(path: str | os.PathLike):
     ids = np.zeros(0, dtype=np.int64)
     xyz = np.zeros((0, 3))
     elements: list[tuple[int, int, list[int], int]] = []  # (type number, element number, nodes, line)
-    components: dict[str, tuple[str, list[tuple[int, int]], int]] = {}  # name -> (kind, ranges, line)
+    components: dict[str, tuple[str, list[tuple[int, int, int]]]] = {}  # name -> (kind, [(first, last, line)])
     i = 0
     while i < len(lines):
         head = lines[i].split("!")[0].strip()
@@ -134,8 +141,8 @@ def read_cdb(path: str | os.PathLike):
             elements += block
             continue
         elif word == "CMBLOCK":
-            name, kind, ranges, start, i = _cmblock(lines, i, source)
-            components[name] = (kind, ranges, start)
+            name, kind, ranges, i = _cmblock(lines, i, source)
+            components[name] = (kind, ranges)
             continue
         i += 1
     if ids.size == 0:
@@ -148,11 +155,14 @@ def read_cdb(path: str | os.PathLike):
                        f"{', '.join(map(element_name, sorted(SOLIDS)))})")
     numbers = np.array(sorted(by_number), dtype=np.int64)
     point_sets = {}
-    for name, (kind, ranges, _) in components.items():
+    for name, (kind, ranges) in components.items():
+        have = index.sorted if kind == "NODE" else numbers
+        _check_component(name, "node" if kind == "NODE" else "element", ranges, have, source)
         if kind == "NODE":
-            nodes = [index.position[a:b] for a, b in (index.span(lo, hi) for lo, hi in ranges)]
+            nodes = [index.position[a:b] for a, b in (index.span(lo, hi) for lo, hi, _ in ranges)]
         else:
-            chosen = [numbers[np.searchsorted(numbers, lo):np.searchsorted(numbers, hi, "right")] for lo, hi in ranges]
+            chosen = [numbers[np.searchsorted(numbers, lo):np.searchsorted(numbers, hi, "right")]
+                      for lo, hi, _ in ranges]
             nodes = [np.asarray(by_number[int(e)], dtype=np.int64) for part in chosen for e in part]
         point_sets[name] = np.unique(np.concatenate(nodes)) if nodes else np.zeros(0, dtype=np.int64)
     return meshio.Mesh(xyz, [(t, np.asarray(c, dtype=np.int64)) for t, c in cells.items()], point_sets=point_sets,
@@ -347,8 +357,9 @@ def _eblock(lines: list[str], i: int, source: str) -> tuple[list, int]:
     raise CdbError(f"ANSYS archive {source!r}: the EBLOCK of line {i + 1} has no end (-1): the file is truncated")
 
 
-def _cmblock(lines: list[str], i: int, source: str) -> tuple[str, str, list[tuple[int, int]], int, int]:
-    """``(name, kind, ranges, line, next line)``: the component's members as inclusive number ranges."""
+def _cmblock(lines: list[str], i: int, source: str) -> tuple[str, str, list[tuple[int, int, int]], int]:
+    """``(name, kind, ranges, next line)``: the component's members as inclusive number ranges ``(first, last,
+    line)`` (a single number is the range ``n..n``; ``line`` 0-based)."""
     parts = [p.strip() for p in lines[i].split("!")[0].split(",")]
     if len(parts) < 4 or parts[2].upper() not in ("NODE", "ELEM"):
         raise CdbError(f"ANSYS archive {source!r}, line {i + 1}: expected CMBLOCK,name,NODE|ELEM,count, got "
@@ -367,7 +378,7 @@ def _cmblock(lines: list[str], i: int, source: str) -> tuple[str, str, list[tupl
         raise CdbError(f"ANSYS archive {source!r}: component {name!r} (line {i + 1}) lists {len(values)} of its "
                        f"{count} entries before the end of the file: the file is truncated")
     what = "node" if kind == "NODE" else "element"
-    ranges: list[tuple[int, int]] = []
+    ranges: list[tuple[int, int, int]] = []
     for v, line in values[:count]:
         if v < 0:
             if not ranges or ranges[-1][0] != ranges[-1][1]:
@@ -379,14 +390,42 @@ def _cmblock(lines: list[str], i: int, source: str) -> tuple[str, str, list[tupl
             if hi < lo:
                 raise CdbError(f"ANSYS archive {source!r}, line {line + 1}: component {name!r}: the range {lo}..{hi} "
                                "runs backwards")
-            ranges[-1] = (lo, hi)
+            ranges[-1] = (lo, hi, ranges[-1][2])
         elif v > 0:
             v = _number(v, source, line, f"component {name!r}: {what} number")
-            ranges.append((v, v))
+            ranges.append((v, v, line))
         else:
             raise CdbError(f"ANSYS archive {source!r}, line {line + 1}: component {name!r}: entry 0 is not a "
                            f"{what} number (1..{MAX_NUMBER}, or a negative number closing a range)")
-    return name, kind, ranges, i, j
+    return name, kind, ranges, j
+
+
+def _numbering(have: np.ndarray, what: str) -> str:
+    """How the file numbers its nodes or elements (``have``: their numbers, sorted), e.g. "the file has 412 nodes,
+    numbered 1 to 412"."""
+    plural = what if have.size == 1 else f"{what}s"
+    return f"the file has {have.size} {plural}, numbered {have[0]} to {have[-1]}"
+
+
+def _check_component(name: str, what: str, ranges: list[tuple[int, int, int]], have: np.ndarray, source: str) -> None:
+    """A :class:`CdbError` when component ``name`` names a ``what`` (node or element) the file does not have: a
+    single number not in ``have`` (the file's numbers, sorted), a range reaching beyond them or holding none of
+    them (see the module docstring). Binary searches over ``have``: no range is expanded."""
+    if not ranges:
+        return
+    lo, hi, line = (np.asarray(column, dtype=np.int64) for column in zip(*ranges))
+    inside = np.searchsorted(have, hi, "right") - np.searchsorted(have, lo)  # numbers of the file in each range
+    single = lo == hi
+    bad = (inside == 0) | (~single & ((lo < have[0]) | (hi > have[-1])))
+    if not bad.any():
+        return
+    k = int(np.flatnonzero(bad)[0])
+    where = f"ANSYS archive {source!r}, line {line[k] + 1}: component {name!r} names"
+    more = f"; {int(bad.sum()) - 1} more of its entries name numbers the file does not have" if bad.sum() > 1 else ""
+    if single[k]:
+        raise CdbError(f"{where} {what} {lo[k]}, which the file does not have ({_numbering(have, what)}){more}")
+    how = "none of which the file has" if have[0] <= lo[k] and hi[k] <= have[-1] else f"beyond the file's {what}s"
+    raise CdbError(f"{where} {what}s {lo[k]}..{hi[k]}, {how} ({_numbering(have, what)}){more}")
 
 
 def _cells(elements, types: dict[int, int], index: _NodeIndex, source: str):
