@@ -151,3 +151,17 @@ def test_cli_mesh_of_an_archive_naming_missing_nodes_exits_2_and_writes_nothing(
     lines = [line for line in err.splitlines() if line.strip()]
     assert len(lines) == 1 and "'ROOT'" in lines[0] and "1..1000000000" in lines[0] and NUMBERING in lines[0], err
     assert not out.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["bad.cdb", "study.toml"]
+
+
+def test_bdf_element_naming_a_missing_grid_is_named(tmp_path):
+    """meshio's bare ``KeyError: 99`` becomes the GRID the element names and the deck lacks."""
+    deck = tmp_path / "bad.bdf"
+    deck.write_text("BEGIN BULK\n"
+                    "GRID           1              0.      0.      0.\n"
+                    "GRID           2              1.      0.      0.\n"
+                    "GRID           3              0.      1.      0.\n"
+                    "GRID           4              0.      0.      1.\n"
+                    "CTETRA         1       1       1       2       3      99\n"
+                    "ENDDATA\n")
+    with pytest.raises(ValueError, match="an element names GRID 99, which the deck does not define"):
+        load_mesh(deck)

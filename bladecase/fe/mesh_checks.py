@@ -377,5 +377,17 @@ def _read_quietly(meshio, path, file_format):
             raise type(exc)(str(exc)) from None  # names the file, the line and the field already
 
         text = ("" if isinstance(exc, SystemExit) else str(exc) if isinstance(exc, CdbError)  # names file and line
+                else _nastran_reason(exc) if _is_nastran(path, file_format) and isinstance(exc, KeyError)
                 else f"{type(exc).__name__}: {exc}".rstrip(": "))
         return None, " ".join(filter(None, [text, said])) or type(exc).__name__
+
+
+def _is_nastran(path, file_format) -> bool:
+    return file_format == "nastran" or (file_format is None and str(path).lower().endswith((".bdf", ".fem", ".nas")))
+
+
+def _nastran_reason(exc: KeyError) -> str:
+    """meshio's ``KeyError`` of a Nastran deck: an element names a GRID the deck does not define."""
+    grid = exc.args[0] if exc.args else "?"
+    return (f"an element names GRID {grid}, which the deck does not define (every node of an element needs its GRID "
+            "card; an INCLUDE with the GRIDs is not read)")
