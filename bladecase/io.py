@@ -332,6 +332,9 @@ def read_npz(path: str | os.PathLike, what: str = "stage file", names: str = "")
         ...
     ValueError: cannot read matrices file '.../bad.npz': not a valid .npz file (truncated, corrupted or ...)
     >>> folder.cleanup()
+
+    A member whose header claims more data than the member holds is a damaged file (checked before anything is
+    allocated: a header may claim terabytes), named with the member and the claimed shape.
     """
     source = str(path)
     try:
@@ -343,8 +346,17 @@ def read_npz(path: str | os.PathLike, what: str = "stage file", names: str = "")
         if head == b"\x93NUMPY":  # np.load would return the array itself, not an archive
             raise ValueError(f"cannot read {what} {source!r}: it is a single .npy array, not an .npz archive of "
                              "named arrays" + (f" {names} (write one with numpy.savez)" if names else ""))
+        headers = _check_npz_members(path, what, source)
+        arrays = {}
         with np.load(path, allow_pickle=False) as data:
-            return {key: data[key] for key in data.files}
+            for key in data.files:
+                try:
+                    arrays[key] = data[key]
+                except MemoryError:
+                    shape, dtype, size = headers.get(f"{key}.npy", ("?", "?", "?"))
+                    raise ValueError(f"cannot read {what} {source!r}: its array {key!r} of shape {shape} ({dtype}, "
+                                     f"{size} bytes) does not fit in memory") from None
+        return arrays
     except FileNotFoundError:
         raise ValueError(f"cannot read {what} {source!r}: no such file") from None
     except IsADirectoryError:
@@ -360,6 +372,46 @@ def read_npz(path: str | os.PathLike, what: str = "stage file", names: str = "")
         reason = ("it holds pickled Python objects, which are never loaded (write plain arrays with numpy.savez)"
                   if "pickle" in str(exc) else f"not a valid .npz file ({exc})")
         raise ValueError(f"cannot read {what} {source!r}: {reason}") from None
+
+
+def _check_npz_members(path, what: str, source: str) -> dict[str, tuple]:
+    """``ValueError`` naming the file, the member and its shape when an ``.npy`` member's header claims more bytes
+    (shape × item size) than the member holds: a truncated or damaged file, which ``np.load`` would first try to
+    allocate (a header claiming a 10⁶ × 10⁶ array asks for 8 TB).  Only the headers are read.  Returns each
+    ``.npy`` member's ``(shape, dtype, bytes)``."""
+    from numpy.lib import format as npy
+
+    headers = {}
+    with zipfile.ZipFile(path) as archive:
+        for info in archive.infolist():
+            try:
+                opened = archive.open(info)
+            except (NotImplementedError, RuntimeError) as exc:  # an unknown compression, an encrypted member
+                raise ValueError(f"cannot read {what} {source!r}: its member {info.filename!r} cannot be read "
+                                 f"({exc}); write the file with numpy.savez or numpy.savez_compressed") from None
+            with opened as member:
+                try:
+                    version = npy.read_magic(member)
+                except ValueError:  # not an .npy member: np.load says what it is
+                    continue
+                if version not in ((1, 0), (2, 0), (3, 0)):
+                    continue  # np.load names the unknown version
+                try:
+                    # a version 3.0 header is 2.0's in UTF-8: read as latin-1 its shape and item size are the same
+                    read = npy.read_array_header_1_0 if version == (1, 0) else npy.read_array_header_2_0
+                    shape, _, dtype = read(member)
+                except ValueError:  # an unreadable header: np.load names the fault
+                    continue
+                if dtype.hasobject:
+                    continue  # pickled objects: refused by np.load (allow_pickle=False)
+                claimed = math.prod(shape) * dtype.itemsize
+                held = info.file_size - member.tell()
+            if claimed > held:
+                raise ValueError(f"cannot read {what} {source!r}: damaged or truncated: its member {info.filename!r} "
+                                 f"has a header for an array of shape {shape} ({dtype}): the header claims {claimed} "
+                                 f"bytes, the member holds {max(held, 0)} (write the file again)")
+            headers[info.filename] = (shape, dtype, claimed)
+    return headers
 
 
 def _field(data, key: str, source: str) -> np.ndarray:

@@ -192,11 +192,13 @@ def test_study_with_a_byte_order_mark_is_read(tmp_path):
 
 def test_huge_study_file_is_refused_unread(tmp_path):
     f = tmp_path / "huge.toml"
-    f.write_text(absolute(PLATE) + ("# " + "x" * 98 + "\n") * 20_000)  # 2 MB of comments
-    with pytest.raises(StudyError, match=r"huge.toml'?: 2\d{6} bytes, more than a study's 1000000"):
+    with open(f, "wb") as fh:  # a sparse 70 MB file: refused from its size, never read
+        fh.truncate(70_000_000)
+    with pytest.raises(StudyError, match=r"huge.toml'?: 70000000 bytes, more than a study file's 64000000"):
         load_study(f)
-    with pytest.raises(StudyError, match=r"more than a study's 1000000"):
-        loads(f.read_text())
+    # comments do not count; content beyond a study's size does
+    with pytest.raises(StudyError, match=r"more than a study's 1000000 characters besides comments"):
+        loads(absolute(PLATE) + "x = 1\n" * 200_000)
 
 
 def test_cli_fifo_study_exit_2(tmp_path, capsys):
@@ -451,7 +453,8 @@ COUNT_KEYS = [(section, key) for section, keys in SCHEMA.items() for key, spec i
 @pytest.mark.parametrize("section, key", COUNT_KEYS, ids=[f"{s}.{k}" for s, k in COUNT_KEYS])
 def test_every_integer_key_refuses_huge_and_negative_values(section, key):
     raw = _raw(BLADE if section == "geometry" else PLATE)
-    for value in (10**30, -1):
+    capped = (section, key) in (("output", "animate"), ("forcing", "animate"))  # a huge count means "all"
+    for value in ((-1,) if capped else (10**30, -1)):
         with pytest.raises(StudyError) as info:
             validate(_edit(raw, section, key, value))
         assert str(info.value).startswith(f"[{section}] {key}: "), str(info.value)
@@ -505,8 +508,6 @@ def test_every_geometry_field_refuses_wrong_types(kind, name, value):
     ("reduction", "compare", [{"method": ["modal"], "size": 4}], "[reduction] compare: item 0: method must be one of"),
     ("reduction", "methods", [["modal"]], "[reduction] methods: must be a list of method names"),
     ("output", "formats", [["gif"]], "[output] formats: must be a list of format names"),
-    ("output", "animate", 10**30, "[output] animate: must be an integer with 0 <= value <= 1000"),
-    ("forcing", "animate", 10**12, "[forcing] animate: must be an integer with 0 <= value <= 1000"),
     ("output", "scale", 1e300, "[output] scale: must be 'auto' or a number in [1e-12, 1e+15], got 1e+300"),
     ("output", "scale", -1.0, "[output] scale: must be 'auto' or a number in"),
     ("output", "fps", 1e-300, "[output] fps: must be at least 0.01 frames per second, got 1e-300"),

@@ -3,7 +3,7 @@
 :func:`select_nodes` takes a group name or one geometric rule:
 
 * ``{"plane": [x0, y0, z0, nx, ny, nz], "tol": t}``: the nodes within ``t`` of the plane through
-  ``(x0, y0, z0)`` with normal ``n`` (any length but zero);
+  ``(x0, y0, z0)`` with normal ``n`` (any finite length but zero: ``[0, 0, 1e308]`` is ``+z``);
 * ``{"box": [[xmin, ymin, zmin], [xmax, ymax, zmax]], "tol": t}``: the nodes inside the box (bounds
   included, widened by ``t``);
 * ``{"sphere": [x, y, z, r], "tol": t}``: the nodes within ``r + t`` of the centre;
@@ -15,6 +15,8 @@ In 2-D, points may leave out ``z`` and a plane may be ``[x0, y0, nx, ny]``.
 
 ``tol`` defaults to :data:`TOL_FRACTION` of the shortest edge of the body cells (a node one element away is
 never caught).  Everything is vectorised over the nodes.  Messages name nodes by their number in the file.
+Values whose distances to the nodes overflow double precision are refused as too large (any magnitude up to
+:data:`MAX_MAGNITUDE` is safe).
 
 :func:`held_nodes` counts every node a clamp holds (midside nodes included).
 """
@@ -31,6 +33,10 @@ TOL_FRACTION = 1e-3
 
 #: The rules of a selection, and the number of values each takes.
 RULES = {"plane": 6, "box": 6, "sphere": 4, "nearest": 3}
+
+#: Coordinates and radii up to this magnitude never overflow a distance (its square included) to a mesh node;
+#: larger ones are refused only where a distance does overflow (a box of ±1e308 still selects every node).
+MAX_MAGNITUDE = 1e150
 
 
 def select_nodes(mesh: Mesh, spec: str | dict, what: str = "selection", allow_all: bool = True) -> np.ndarray:
@@ -51,9 +57,9 @@ def select_nodes(mesh: Mesh, spec: str | dict, what: str = "selection", allow_al
     ------
     ValueError
         An unknown group or rule, a value that is not the right count of finite numbers, a zero normal, a
-        negative radius or tolerance, an empty selection (with the mesh's bounding box and the distance of
-        the nearest node), a node number that is not in the mesh, a selection of every node when ``allow_all`` is
-        false.
+        negative radius or tolerance, values so large that the nodes' distances to them overflow, an empty
+        selection (with the mesh's bounding box and the distance of the nearest node), a node number that is not
+        in the mesh, a selection of every node when ``allow_all`` is false (with what to make smaller).
 
     Examples
     --------
@@ -113,25 +119,30 @@ def select_nodes(mesh: Mesh, spec: str | dict, what: str = "selection", allow_al
     points = np.asarray(mesh.points, dtype=float)
     if rule == "nearest":
         corners = _corner_nodes(mesh)
-        dist = np.linalg.norm(points[corners] - values, axis=1)
+        with np.errstate(over="ignore", invalid="ignore"):
+            dist = np.linalg.norm(points[corners] - values, axis=1)
+        _check_finite(mesh, spec, rule, dist, what)
         return corners[[int(np.argmin(dist))]]
     tol = _tolerance(mesh, spec, what)
-    if rule == "plane":
-        normal = values[3:]
-        size = float(np.linalg.norm(normal))
-        if size == 0.0 or not np.isfinite(size):
-            raise ValueError(f"{what} {spec!r}: the plane's normal (the last 3 values) must not be zero")
-        dist = np.abs((points - values[:3]) @ (normal / size))
-    elif rule == "box":
-        low, high = values[:3], values[3:]
-        if np.any(low > high):
-            raise ValueError(f"{what} {spec!r}: box corners must be [[xmin, ymin, zmin], [xmax, ymax, zmax]] "
-                             f"with min <= max")
-        dist = np.linalg.norm(np.maximum(np.maximum(low - points, points - high), 0.0), axis=1)
-    else:  # sphere
-        if values[3] < 0:
-            raise ValueError(f"{what} {spec!r}: the sphere's radius must be >= 0, got {values[3]:g}")
-        dist = np.maximum(np.linalg.norm(points - values[:3], axis=1) - values[3], 0.0)
+    with np.errstate(over="ignore", invalid="ignore"):  # an overflow is refused just below, naming the values
+        if rule == "plane":
+            normal = values[3:]
+            top = float(np.abs(normal).max())  # scaled first: a normal of 1e308 (or 1e-200) is a direction too
+            if top == 0.0:
+                raise ValueError(f"{what} {spec!r}: the plane's normal (the last 3 values) must not be zero")
+            normal = normal / top
+            dist = np.abs((points - values[:3]) @ (normal / np.linalg.norm(normal)))
+        elif rule == "box":
+            low, high = values[:3], values[3:]
+            if np.any(low > high):
+                raise ValueError(f"{what} {spec!r}: box corners must be [[xmin, ymin, zmin], [xmax, ymax, zmax]] "
+                                 f"with min <= max")
+            dist = np.linalg.norm(np.maximum(np.maximum(low - points, points - high), 0.0), axis=1)
+        else:  # sphere
+            if values[3] < 0:
+                raise ValueError(f"{what} {spec!r}: the sphere's radius must be >= 0, got {values[3]:g}")
+            dist = np.maximum(np.linalg.norm(points - values[:3], axis=1) - values[3], 0.0)
+    _check_finite(mesh, spec, rule, dist, what)
     nodes = np.flatnonzero(dist <= tol)
     if nodes.size == 0:
         k = int(np.argmin(dist))
@@ -140,6 +151,18 @@ def select_nodes(mesh: Mesh, spec: str | dict, what: str = "selection", allow_al
                          f"bounding box is {_fmt(box)}, the nearest node ({mesh.node_id(k)} at {_fmt(points[k])}) is "
                          f"{dist[k]:.3g} away")
     return _checked_all(mesh, nodes, spec, what, allow_all)
+
+
+def _check_finite(mesh: Mesh, spec: dict, rule: str, dist: np.ndarray, what: str) -> None:
+    """``ValueError`` when a distance of the nodes to the selection's values overflowed (``inf``): the selection
+    (and its message's "nearest node … away") would be meaningless."""
+    if np.all(np.isfinite(dist)):
+        return
+    points = np.asarray(mesh.points, dtype=float)
+    box = np.array([points.min(axis=0), points.max(axis=0)])
+    raise ValueError(f"{what} {describe(spec)}: too large: the distances from the mesh's nodes to this {rule} overflow "
+                     f"double precision; valid: finite numbers whose distances to the mesh stay finite (any magnitude "
+                     f"up to {MAX_MAGNITUDE:g} does; the mesh's bounding box is {_fmt(box)})")
 
 
 def _rule(spec: dict, what: str) -> str:
@@ -205,8 +228,34 @@ def _checked_all(mesh: Mesh, nodes: np.ndarray, spec, what: str, allow_all: bool
         body = np.unique(np.asarray(mesh.cells[mesh.body_type]))
         if np.isin(body, nodes).all():
             raise ValueError(f"{what} {describe(spec)} selects every node of the body of mesh {mesh.source or ''} "
-                             f"({body.size} nodes): it must leave nodes free (e.g. select the root face only)")
+                             f"({body.size} nodes): the clamp holds every node, nothing is left free; "
+                             f"{_smaller(mesh, spec, body)}")
     return nodes
+
+
+def _smaller(mesh: Mesh, spec, body: np.ndarray) -> str:
+    """What to change in a selection of every node of the body ``body`` (for :func:`_checked_all`'s message)."""
+    points = np.asarray(mesh.points, dtype=float)[body]
+    if points.shape[1] == 2:
+        points = np.c_[points, np.zeros(len(points))]
+    box = _fmt([points.min(axis=0), points.max(axis=0)])
+    if isinstance(spec, str):
+        return f"use a group of the root face only, not one of the whole body (the body spans {box})"
+    if not isinstance(spec, dict) or "nodes" in spec:
+        return "list the root face's nodes only, not every node of the body"
+    if "sphere" in spec:
+        centre = np.asarray(spec["sphere"], dtype=float)[:-1]
+        centre = np.r_[centre, np.zeros(3 - centre.size)]
+        far = float(np.linalg.norm(points - centre, axis=1).max())
+        shown = float(f"{far:.3g}")
+        if shown >= far > 0:  # printed rounded down: a radius below the printed bound leaves a node free
+            shown -= 10.0 ** (np.floor(np.log10(shown)) - 2)
+        return (f"use a smaller radius: r + tol must stay below {shown:.3g}, the distance from the centre to the "
+                f"farthest node (e.g. a small sphere around the root face)")
+    if "box" in spec:
+        return f"use a smaller box: the body spans {box} (e.g. a thin box around the root face)"
+    return (f"use a plane through the root face only, across the body (the body spans {box}; a plane that holds a "
+            f"flat mesh, or a tol as large as the body, takes every node)")
 
 
 def _fmt(a) -> str:

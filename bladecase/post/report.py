@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .casing import casing_report
+from .convergence_report import convergence_report
 from .nodal_report import nodal_report
 from .rotation_report import rotation_report
 from .rub_report import rub_report
@@ -92,6 +93,7 @@ def report(summary: dict) -> str:
             lines.append(f"| {j + 1} | {f:.3f} | {b2:.3e} | nearest {ref:.3f} Hz | {abs(f - ref) / ref:.2e} |")
             continue
         lines.append(f"| {j + 1} | {f:.3f} | {b2:.3e} | {_counterpart(matches[j])} |")
+    lines += convergence_report(summary.get("convergence"))
     if summary.get("comparison"):
         lines += comparison_report(summary["comparison"])
     lines += nodal_report(summary.get("nodal_modes"))

@@ -10,7 +10,14 @@ import math
 from ..fe import Material, PlateGeometry
 from ..fe.geometry import estimate_cells
 from .keys import StudyError, one_line
-from .sections import casing_checks, execution_checks, forcing_checks, rotation_checks, rub_checks
+from .sections import (
+    casing_checks,
+    convergence_checks,
+    execution_checks,
+    forcing_checks,
+    rotation_checks,
+    rub_checks,
+)
 from .values import LIMITS
 
 __all__ = ["MASSLESS_METHODS", "cross_checks"]
@@ -87,6 +94,7 @@ def cross_checks(c: dict, model: bool = True) -> None:
     rotation_checks(c)
     casing_checks(c, model)
     rub_checks(c)
+    convergence_checks(c)
     o, s = c["output"], c["search"]
     for i, item in enumerate(o["orbits"]):
         if item["ipp"] not in s["ipp"]:

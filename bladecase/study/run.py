@@ -152,7 +152,7 @@ def run(study: Study | str | os.PathLike, out: str | os.PathLike | None = None, 
     stages = _Stages(progress, total=6 + (study["forcing"]["amplitude"] is not None)
                      + bool(study.config.get("rotation") and study["rotation"]["speeds"])
                      + bool((study.config.get("rub") or {}).get("speeds")) + bool(casing_sweep_values(study))
-                     + (study["contact"].get("points") == "nodes"))
+                     + (study["contact"].get("points") == "nodes") + bool(study["convergence"]["meshes"]))
     x = study["execution"]
     own = None if executor is not None else make_executor(x["executor"], x["workers"], x["scheduler"])
     try:
@@ -301,6 +301,11 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
             rub = rub_stage(study, rest_model, cold_contact, families=families, executor=executor, progress=progress,
                             folder=staging, figures="png" in o["formats"], title=study.name)
             files["rub"] = rub.pop("files")
+    convergence = None
+    if study["convergence"]["meshes"]:
+        with stage("convergence"):
+            convergence = _convergence(study, model, reduced, families, float(f_fe[0]), files["animations"],
+                                       executor, progress)
     files["log"] = "run.log"
     from .. import __version__
 
@@ -322,9 +327,30 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         "casing_sweep": sweep,
         "nodal_modes": nodal,
         "comparison": None if comparison is None else summary_section(comparison),
+        "convergence": convergence,
         "files": files,
     }
     return summary, families, {m.name: m for m in models}
+
+
+def _convergence(study: Study, model, reduced, families, f1: float, animations: list, executor, progress: bool
+                 ) -> dict:
+    """The mesh-convergence stage: the orbit's figures read at ``[convergence] ratio``, else at the first animated
+    orbit's ``T/T₁``, else at the middle of the widest admissible arc (:mod:`~bladecase.study.convergence`)."""
+    from .convergence import convergence_stage, mesh_figures
+
+    T1 = 2 * np.pi / float(reduced.system.spectrum.contact_modes[0][0])
+    ratio, ipp = study["convergence"]["ratio"], study["search"]["ipp"][0]
+    if animations:
+        ipp = animations[0]["ipp"]
+        ratio = animations[0]["T"] / T1 if ratio is None else ratio
+    elif ratio is None:
+        arcs = [(f.k, a) for f in families for a in f.arcs]
+        if arcs:
+            ipp, a = max(arcs, key=lambda x: (x[1].T_hi - x[1].T_lo) / x[1].T_hi)
+            ratio = 0.5 * (a.T_lo + a.T_hi) / T1
+    main = mesh_figures(model, reduced, families, f1, ratio, ipp)
+    return convergence_stage(study, main, ratio, ipp, executor, progress)
 
 
 def _casing_sweep(study: Study, model, contact, factor, unit: float, staging: Path, figures: bool,

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from .. import log
 from ..fe import BladeGeometry, PlateGeometry
 from ..fe.mesh_checks import LENGTH_UNITS
 from ..post.outputs import FORMATS as OUTPUT_FORMATS
@@ -33,6 +34,7 @@ from .demo import NEWTON_DEMO, demo_study, demo_text  # noqa: F401 (re-exported:
 from .keys import _BOOL, _INT, _LIST, _NUM, _STR, REQUIRED, Key, StudyError, one_line  # noqa: F401
 from .sections import (
     CASING_KEYS,
+    CONVERGENCE_KEYS,
     EXECUTION_KEYS,
     FORCING_KEYS,
     LIMIT_KEYS,
@@ -45,6 +47,7 @@ from .values import (  # noqa: F401  (RANGES, LIMITS: part of the schema's docum
     RANGES,
     _clamp_spec,
     _compare_periods,
+    _count_capped,
     _density,
     _direction,
     _file,
@@ -226,7 +229,8 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "directory": Key(_STR, None, "Output directory, relative to the current directory; default "
                          "'results/<name>'; the command line's --out overrides it.", _folder),
         "animate": Key(_INT, 2, "How many orbits to animate when 'orbits' is empty: the middles of the "
-                       "widest admissible arcs, one per family.", _int_between(0, LIMITS["animate"])),
+                       f"widest admissible arcs, one per family; above {LIMITS['animate']}: every admissible arc's "
+                       f"middle, at most {LIMITS['animate']} (logged).", _count_capped(LIMITS["animate"])),
         "orbits": Key(_LIST, [], "Orbits to animate: [{ipp = 1, T = 0.95}, …], T in search.period_unit "
                       "(the nearest admissible orbit of a family of that ipp).", _orbit_list),
         "reference": Key(_BOOL, True, "Check each chosen orbit in a reference model (4 times the reduced model's "
@@ -256,6 +260,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
     "rotation": ROTATION_KEYS,
     "casing": CASING_KEYS,
     "rub": RUB_KEYS,
+    "convergence": CONVERGENCE_KEYS,
     "execution": EXECUTION_KEYS,
     "limits": LIMIT_KEYS,
 }
@@ -345,6 +350,21 @@ def _type_name(types: tuple) -> str:
     return " or ".join(names[t] for t in types)
 
 
+def _integer_hint(value) -> str:
+    """What to write instead of the float ``value`` where an integer is expected (TOML reads ``1e9`` and ``2.0`` as
+    floats), for the message: ``" (TOML reads … as a float: write 1000000000)"``, or ``""``."""
+    if not (isinstance(value, float) and math.isfinite(value) and value.is_integer()):
+        return ""
+    write = f": write {int(value)}" if abs(value) < 2**63 else ""
+    return f" (TOML reads a number with an exponent or a decimal point as a float{write})"
+
+
+def _shown_number(value) -> str:
+    """A float for a message: ``1e+09`` rather than ``1000000000.0``, ``2.0`` as it is."""
+    text = f"{value:g}" if isinstance(value, float) else ""
+    return text if "e" in text else show(value)
+
+
 def _quoted(value) -> str:
     """``repr(value)``, cut for a message (a huge list or string is not copied into it)."""
     text = show(value)
@@ -356,7 +376,9 @@ def _check_value(section: str, key: str, spec: Key, value) -> Any:
     where = f"[{section}] {key}"
     ok = any(isinstance(value, t) and not (t in (int, float) and isinstance(value, bool)) for t in spec.types)
     if not ok:
-        raise StudyError(f"{where}: expected {_type_name(spec.types)}, got {show(value)}")
+        hint = _integer_hint(value) if spec.types == _INT else ""
+        raise StudyError(f"{where}: expected {_type_name(spec.types)}, got "
+                         f"{_shown_number(value) if hint else show(value)}{hint}")
     if isinstance(value, float) and not math.isfinite(value):
         raise StudyError(f"{where}: must be finite, got {value!r}")
     if spec.check is not None:
@@ -389,7 +411,8 @@ def _check_field(kind: str, cls, key: str, value) -> None:
     want = _field_kind(cls, key)
     number = isinstance(value, (int, float)) and not isinstance(value, bool)
     if want == "integer" and not (number and isinstance(value, int)):
-        raise StudyError(f"{where}: expected an integer, got {show(value)}")
+        hint = _integer_hint(value)
+        raise StudyError(f"{where}: expected an integer, got {_shown_number(value) if hint else show(value)}{hint}")
     if want == "number" and not number:
         raise StudyError(f"{where}: expected a number, got {show(value)}")
     if want == "string" and not isinstance(value, str):
@@ -490,9 +513,23 @@ def validate(raw: dict, source: str = "<string>", base: str | os.PathLike | None
                 out[key] = list(spec.default) if isinstance(spec.default, list) else spec.default
         if section == "reduction":
             _grid_main_model(out, given)
+        if section in ("output", "forcing"):
+            _cap_animate(out, section)
         config[section] = out
     cross_checks(config, model=model)
     return Study(config=config, source=source, base=Path(base) if base is not None else Path.cwd())
+
+
+def _cap_animate(o: dict, section: str = "output") -> None:
+    """``[output] animate`` (``[forcing] animate``) above :data:`LIMITS` ``["animate"]`` means every orbit (steady
+    state) the study can animate: capped there, and logged."""
+    cap = LIMITS["animate"]
+    if o.get("animate") is not None and o["animate"] > cap:
+        what = ("the middle orbit of every admissible arc" if section == "output"
+                else "every periodic steady state with impacts")
+        log.info("[%s] animate = %d: more than any study can animate; %s is animated (at most %d)", section,
+                 o["animate"], what, cap)
+        o["animate"] = cap
 
 
 def _grid_main_model(r: dict, given: dict) -> None:
@@ -514,8 +551,32 @@ def _grid_main_model(r: dict, given: dict) -> None:
         r["size"] = max(r["sizes"])
 
 
-#: Largest study file read (bytes): a study is a few kilobytes; a bigger file is not a study (a mesh, a log).
+#: Largest study content (characters besides comment lines and blank lines): a study is a few kilobytes; more is
+#: not a study (a mesh, a log).
 MAX_STUDY_BYTES = 1_000_000
+
+#: Largest study file read (bytes): its comments do not count against :data:`MAX_STUDY_BYTES`, so a commented
+#: study may be far bigger; a file above this is refused before it is read.
+MAX_STUDY_FILE_BYTES = 64_000_000
+
+#: A line that is neither a comment nor blank (the lines that count against :data:`MAX_STUDY_BYTES`).
+_CONTENT_LINE = re.compile(r"^[ \t\r]*[^#\s][^\n]*\n?", re.M)
+
+
+def content_size(text: str, stop: int | None = None) -> int:
+    """The characters of the study ``text`` outside its comment lines and blank lines (a comment after a value
+    counts: only whole lines are left out); the count stops once it exceeds ``stop`` (a file of content is not
+    scanned to its end to be refused).
+
+    >>> content_size("# a study\\n[study]\\n\\n  # its name\\nname = 'x'  # here\\n")
+    27
+    """
+    size = 0
+    for line in _CONTENT_LINE.finditer(text):
+        size += line.end() - line.start()
+        if stop is not None and size > stop:
+            break
+    return size
 
 
 def loads(text: str, source: str = "<string>", base: str | os.PathLike | None = None, model: bool = True) -> Study:
@@ -528,8 +589,11 @@ def loads(text: str, source: str = "<string>", base: str | os.PathLike | None = 
     """
     if not isinstance(text, str):
         raise StudyError(f"{source}: a study is TOML text, got {type(text).__name__}")
-    if len(text) > MAX_STUDY_BYTES:
-        raise StudyError(f"{source}: {len(text)} characters, more than a study's {MAX_STUDY_BYTES} (is it a study "
+    if len(text) > MAX_STUDY_FILE_BYTES:
+        raise StudyError(f"{source}: {len(text)} characters, more than a study file's {MAX_STUDY_FILE_BYTES} (is it a "
+                         "study file?)")
+    if len(text) > MAX_STUDY_BYTES and content_size(text, stop=MAX_STUDY_BYTES) > MAX_STUDY_BYTES:
+        raise StudyError(f"{source}: more than a study's {MAX_STUDY_BYTES} characters besides comments (is it a study "
                          "file?)")
     try:
         raw = tomllib.loads(text)
@@ -587,8 +651,9 @@ def load_study(path: str | os.PathLike, model: bool = True) -> Study:
 
 
 def _read_study_bytes(path: Path) -> bytes:
-    """The bytes of a regular file of at most :data:`MAX_STUDY_BYTES`; a pipe, a device or a folder is refused
-    before it is read (reading a FIFO would wait for a writer forever)."""
+    """The bytes of a regular file of at most :data:`MAX_STUDY_FILE_BYTES`; a pipe, a device or a folder is refused
+    before it is read (reading a FIFO would wait for a writer forever).  Its content besides comments is checked
+    by :func:`loads`."""
     where = f"cannot read study file {str(path)!r}"
     try:
         info = path.stat()
@@ -599,9 +664,9 @@ def _read_study_bytes(path: Path) -> bytes:
                 else "a device" if stat.S_ISCHR(info.st_mode) or stat.S_ISBLK(info.st_mode)
                 else "a socket" if stat.S_ISSOCK(info.st_mode) else "a special file")
         raise StudyError(f"{where}: it is {kind}, not a regular file")
-    if info.st_size > MAX_STUDY_BYTES:
-        raise StudyError(f"{where}: {info.st_size} bytes, more than a study's {MAX_STUDY_BYTES} (is it a study "
-                         "file?)")
+    if info.st_size > MAX_STUDY_FILE_BYTES:
+        raise StudyError(f"{where}: {info.st_size} bytes, more than a study file's {MAX_STUDY_FILE_BYTES} (is it a "
+                         "study file?)")
     try:  # O_NONBLOCK: should the path have become a FIFO since the stat, opening it does not wait
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
     except OSError as exc:
@@ -609,7 +674,7 @@ def _read_study_bytes(path: Path) -> bytes:
     with os.fdopen(fd, "rb") as f:
         if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
             raise StudyError(f"{where}: not a regular file")
-        data = f.read(MAX_STUDY_BYTES + 1)
-    if len(data) > MAX_STUDY_BYTES:
-        raise StudyError(f"{where}: more than a study's {MAX_STUDY_BYTES} bytes (is it a study file?)")
+        data = f.read(MAX_STUDY_FILE_BYTES + 1)
+    if len(data) > MAX_STUDY_FILE_BYTES:
+        raise StudyError(f"{where}: more than a study file's {MAX_STUDY_FILE_BYTES} bytes (is it a study file?)")
     return data

@@ -18,6 +18,7 @@ from .keys import _BOOL, _INT, _LIST, _NUM, _STR, Key, StudyError
 from .values import (
     LIMITS,
     _amplitude,
+    _count_capped,
     _direction,
     _int_at_least,
     _int_between,
@@ -61,8 +62,9 @@ FORCING_KEYS: dict[str, Key] = {
     "restitution": Key(_NUM, 1.0, "Newton's coefficient of restitution e in (0, 1] (1: as the nonsmooth modes).",
                        lambda v: None if 0 < v <= 1 else "must be in (0, 1]"),
     "max_p": Key(_INT, 4, "Longest steady-state period looked for, in forcing periods.", _int_between(1, 16)),
-    "animate": Key(_INT, 1, "Periodic steady states with impacts to animate (the highest-energy ones).",
-                   _int_between(0, LIMITS["animate"])),
+    "animate": Key(_INT, 1, "Periodic steady states with impacts to animate (the highest-energy ones); above "
+                   f"{LIMITS['animate']}: all of them, at most {LIMITS['animate']} (logged).",
+                   _count_capped(LIMITS["animate"])),
 }
 
 
@@ -382,3 +384,45 @@ def rub_checks(c: dict) -> None:
         raise StudyError(f"[rub] window: at most revolutions / 2 = {r['revolutions'] // 2} (the window before it "
                          f"tells whether the response settled), got {r['window']}")
     r["speed_unit"] = {"hz": "Hz"}.get(r["speed_unit"].lower(), r["speed_unit"])
+
+
+#: ``[convergence]``: key → :class:`~bladecase.study.keys.Key` (the mesh error of the headline figures; runs when
+#: ``meshes`` is given).
+MAX_MESHES = 6
+
+
+def _meshes(v) -> str | None:
+    if not v:
+        return None
+    if not all(isinstance(x, (int, float)) and not isinstance(x, bool) and np.isfinite(x) for x in v):
+        return "must be a list of numbers (element-size factors), e.g. [1, 0.7, 0.5]"
+    if not all(0.1 <= x <= 1 for x in v):
+        return (f"factors must be in [0.1, 1] (1: the study's own mesh; 0.5: elements half as large), got "
+                f"{[x for x in v if not 0.1 <= x <= 1]}")
+    factors = {float(x) for x in v}
+    if 1.0 not in factors:
+        return f"must include 1 (the study's own mesh, whose figures the report gives), got {v}"
+    if not 3 <= len(factors) <= MAX_MESHES:
+        return (f"needs 3 to {MAX_MESHES} different factors (three meshes give an observed order and a Richardson "
+                f"estimate), got {len(factors)}: {v}")
+    return None
+
+
+CONVERGENCE_KEYS: dict[str, Key] = {
+    "meshes": Key(_LIST, [], "Element-size factors of the meshes the study is run on, 1 (the study's own) included, "
+                  "e.g. [1, 0.7, 0.5]: each headline figure is given with its observed order and the Richardson "
+                  "estimate of its mesh error ([geometry] studies).", _meshes),
+    "ratio": Key(_NUM, None, "T/T1 at which the orbit's figures (energy, tip amplitude, contact force) are compared "
+                 "across the meshes (each mesh's own T1). Not set: the animated orbit's, else the middle of the "
+                 "widest admissible arc.", lambda v: None if 0 < v < 100 else "must be in (0, 100) (× T1)"),
+}
+
+
+def convergence_checks(c: dict) -> None:
+    """``[convergence] meshes`` (when given): a parametric ``[geometry]``, whose element sizes are scaled."""
+    v = c.get("convergence")
+    if not v or not v["meshes"]:
+        return
+    if "geometry" not in c:
+        raise StudyError("[convergence] meshes: the meshes are made from [geometry] (its element sizes × each factor); "
+                         "with a [mesh] file, run the study on your own refined meshes and compare their summaries")

@@ -137,6 +137,13 @@ def _amplitude(v) -> str | None:
             "and the response overflows)")
 
 
+def _count_capped(cap: int):
+    """A count ``>= 0`` of which any value above ``cap`` means "as many as there are" (capped to ``cap`` by
+    :func:`bladecase.study.schema.validate`, and logged)."""
+    return lambda v: None if v >= 0 else (f"must be an integer >= 0 (0: none; a count above {cap} animates at most "
+                                          f"{cap})")
+
+
 def _int_between(lo: int, hi: int, why: str = ""):
     return lambda v: None if lo <= v <= hi else f"must be an integer with {lo} <= value <= {hi}{why}"
 
@@ -331,10 +338,15 @@ def _clamp_spec(v) -> str | None:
     numbers = value if rule != "box" else (
         [x for corner in value for x in corner] if isinstance(value, list) and len(value) == 2
         and all(isinstance(c, list) and len(c) in (2, 3) for c in value) else None)
-    if not isinstance(numbers, list) or not all(_finite_num(x) and abs(x) <= top for x in numbers):
+    # a plane's normal (its second half) is a direction: any finite length but zero (select_nodes scales it)
+    bounded = numbers[:len(numbers) // 2] if rule == "plane" and isinstance(numbers, list) and len(numbers) in (4, 6) \
+        else numbers
+    if not isinstance(numbers, list) or not all(_finite_num(x) for x in numbers) or \
+            not all(abs(x) <= top for x in bounded):
         shape = {"plane": "[x0, y0, z0, nx, ny, nz] (or [x0, y0, nx, ny] in 2-D)",
                  "box": "[[xmin, ymin, zmin], [xmax, ymax, zmax]] (or 2-D corners)", "sphere": "[x, y, z, r]"}[rule]
-        return f"{rule} must be {shape}, finite numbers of magnitude at most {top:g}"
+        return f"{rule} must be {shape}, finite numbers of magnitude at most {top:g}" + (
+            " (the normal: any finite length but zero)" if rule == "plane" else "")
     if "tol" in v and not (_finite_num(v["tol"]) and 0 <= v["tol"] <= RANGES["tol"][1]):
         return f"tol must be a number in [0, {RANGES['tol'][1]:g}] (m)"
     return None

@@ -56,14 +56,23 @@ def check_period(system: LinearSystem, T: float) -> float:
         raise ValueError(f"period T must be finite and > 0, got {T!r}")
     sp = system.spectrum
     omega = sp.omega[sp.active]
-    r = omega * T / (2 * np.pi)
+    with np.errstate(over="ignore"):
+        r = omega * T / (2 * np.pi)
+    if r.size and r.max() >= 0.5 / RESONANCE_RTOL:  # every T is then within the tolerance of a resonance
+        j = int(np.flatnonzero(sp.active)[int(np.argmax(r))])
+        raise ValueError(
+            f"period T = {T:.6g} is too long: it spans {r.max():.6g} periods of mode {j + 1} (linear period "
+            f"{2 * np.pi / sp.omega[j]:.6g}); beyond {0.5 / RESONANCE_RTOL:.6g} periods every T is within the "
+            f"resonance tolerance {RESONANCE_RTOL:g} of a resonance: valid periods are below "
+            f"{0.5 / RESONANCE_RTOL * 2 * np.pi / sp.omega[j]:.6g}"
+        )
     m = np.rint(r)
     bad = np.flatnonzero((m >= 1) & (np.abs(r - m) <= RESONANCE_RTOL * r))
     if bad.size:
         j = int(np.flatnonzero(sp.active)[bad[0]])
         mm = int(m[bad[0]])
         raise ValueError(
-            f"period T = {T!r} is resonant: ω_{j + 1} T = 2π·{mm} (mode {j + 1}, ω = {sp.omega[j]:.10g}, "
+            f"period T = {T:.10g} is resonant: ω_{j + 1} T = 2π·{mm} (mode {j + 1}, ω = {sp.omega[j]:.10g}, "
             f"linear period {2 * np.pi / sp.omega[j]:.10g}); nonsmooth orbits need ω_j T ∉ 2πℤ "
             f"(relative tolerance {RESONANCE_RTOL:g})"
         )

@@ -11,6 +11,7 @@ bound to its system; it pickles without the system (:meth:`PeriodicOrbit.bind` r
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass, field
 from functools import cached_property
 
@@ -22,8 +23,8 @@ from .certify import certify_flights
 from .modal import RESONANCE_RTOL, ModalKernel, check_period, impact_matrices
 
 __all__ = [
-    "ADMISSIBILITY_RTOL", "REPEAT_RTOL", "RESONANCE_RTOL", "PeriodicOrbit", "check_newton_system", "check_period",
-    "impact_matrices", "make_orbit", "make_orbits", "orbit_1ipp", "repetitions",
+    "ADMISSIBILITY_RTOL", "MAX_MODE_PERIODS", "REPEAT_RTOL", "RESONANCE_RTOL", "PeriodicOrbit", "check_long_period",
+    "check_newton_system", "check_period", "impact_matrices", "make_orbit", "make_orbits", "orbit_1ipp", "repetitions",
 ]
 
 
@@ -57,6 +58,67 @@ ADMISSIBILITY_RTOL = 1e-9
 #: Relative tolerance (of ``T`` for times, of ``max|Λ|`` for impulses) of the
 #: repeated-orbit test.
 REPEAT_RTOL = 1e-7
+
+#: Most periods of a contact mode a period ``T`` may span: beyond, ``ω_j T`` lies within the resonance
+#: tolerance of a multiple of 2π whatever ``T`` (``|r - round(r)| <= 1/2 <= RESONANCE_RTOL · r`` for
+#: ``r = ω_j T / 2π``): every such period is resonant to :func:`check_period`, and the phases ``ω_j t`` of the
+#: impulse response are round-off.  Messages say :func:`check_long_period`'s bound on ``T``.
+MAX_MODE_PERIODS = 0.5 / RESONANCE_RTOL
+
+
+def check_long_period(system: LinearSystem, T, what: str) -> None:
+    """``ValueError`` when the period ``T`` spans :data:`MAX_MODE_PERIODS` or more periods of a mode that sees the
+    contact (the fastest is named): too long for its phases, with the valid range of ``T``.  Anything else (not a
+    number, not finite or not > 0, resonant) is left to :func:`check_period` and the callers' own checks.
+
+    >>> from bladecase.nsm import chain
+    >>> check_long_period(chain(2, k=1.0, m=0.5, gap=1.0), 1e300, "orbit_1ipp")  # doctest: +NORMALIZE_WHITESPACE
+    Traceback (most recent call last):
+        ...
+    ValueError: orbit_1ipp: period T = 1e+300 is too long: it spans 3.64186e+299 periods of mode 2 (ω = 2.28825,
+    linear period 2.74585), the fastest that sees the contact; beyond 5e+11 periods every T is within the resonance
+    tolerance 1e-12 of a resonance and ω_j T keeps no phase; valid: 0 < T < 1.37292e+12, away from resonances
+    """
+    try:
+        T = float(T)
+    except (TypeError, ValueError):
+        return
+    sp = system.spectrum
+    active = np.flatnonzero(sp.active)
+    if not (np.isfinite(T) and T > 0) or active.size == 0:
+        return
+    omega = sp.omega[active]
+    j = int(np.argmax(omega))
+    with np.errstate(over="ignore"):
+        periods = float(omega[j] * T / (2 * np.pi))
+    if periods >= MAX_MODE_PERIODS:
+        linear = 2 * np.pi / omega[j]
+        raise ValueError(f"{what}: period T = {_g(T)} is too long: it spans {periods:.6g} periods of mode "
+                         f"{active[j] + 1} (ω = {omega[j]:.6g}, linear period {linear:.6g}), the fastest that sees the "
+                         f"contact; beyond {MAX_MODE_PERIODS:.6g} periods every T is within the resonance tolerance "
+                         f"{RESONANCE_RTOL:g} of a resonance and ω_j T keeps no phase; valid: 0 < T < "
+                         f"{_g_below(MAX_MODE_PERIODS * linear)}, away from resonances")
+
+
+def _g(x) -> str:
+    """A number for a message: as written when that is short (``6.0``, ``0.95``, ``1e+300``), else ``%.6g``."""
+    text = repr(float(x))
+    return text if len(text) <= 8 else f"{float(x):.6g}"
+
+
+def _g_below(x: float) -> str:
+    """``x > 0`` to 6 significant digits, rounded down (a bound a reader may take as it is printed)."""
+    shown = float(f"{x:.6g}")
+    if shown > x:  # rounded up: one unit of the 6th digit less
+        shown -= 10.0 ** (math.floor(math.log10(shown)) - 5)
+    return f"{shown:.6g}"
+
+
+def _gs(values, at_most: int = 8) -> str:
+    """A list of numbers for a message, ``%.6g`` each; a long one cut (its first numbers and its length)."""
+    values = list(values)
+    shown = ", ".join(_g(v) for v in values[:at_most])
+    return f"[{shown}]" if len(values) <= at_most else f"[{shown}, … ({len(values)} numbers)]"
 
 
 @dataclass(frozen=True, eq=False)
@@ -350,12 +412,16 @@ def _orbit_data(system, T, impact_times, impulses, what: str) -> tuple[float, np
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{what}: T, impact_times and impulses must be numbers ({exc})") from None
     if not np.isfinite(T) or T <= 0:
-        raise ValueError(f"{what}: period T must be finite and > 0, got {T!r}")
+        raise ValueError(f"{what}: period T must be finite and > 0, got {_g(T)}")
+    check_long_period(system, T, what)
     if times.size == 0 or lam.shape != times.shape or not (np.all(np.isfinite(times)) and np.all(np.isfinite(lam))):
         raise ValueError(f"{what}: impact_times and impulses must be as many finite numbers (one impulse per impact), "
                          f"got {times.size} time(s) and {lam.size} impulse(s)")
     if times[0] <= 0 or np.any(np.diff(times) <= 0) or times[-1] > T * (1 + 1e-12):
-        raise ValueError(f"{what}: impact_times must satisfy 0 < t1 < ... < tk = T = {T!r}, got {times.tolist()}")
+        late = (f"; the last impact time exceeds T by {_g(times[-1] - T)}" if times[-1] > T * (1 + 1e-12) and
+                times[0] > 0 and not np.any(np.diff(times) <= 0) else "")
+        raise ValueError(f"{what}: impact_times must satisfy 0 < t1 < ... < tk = T = {_g(T)}, got "
+                         f"{_gs(times)}{late}")
     return T, times, lam
 
 
@@ -390,6 +456,9 @@ def make_orbits(system: LinearSystem, T, impact_times, impulses, certify: bool =
     except (TypeError, ValueError) as exc:
         raise ValueError(f"make_orbits: T (B,), impact_times and impulses (B, k) must be numbers of matching "
                          f"shapes ({exc})") from None
+    finite = T[np.isfinite(T)]
+    if finite.size:
+        check_long_period(system, finite.max(), "make_orbits")
     omega, b, _ = system.spectrum.contact_modes
     d = system.gap
     sh = np.sin(np.multiply.outer(T / 2, omega))  # (B, m)
@@ -510,8 +579,8 @@ def orbit_1ipp(system: LinearSystem, T: float, **options) -> PeriodicOrbit:
     Raises
     ------
     ValueError
-        ``T`` not a positive finite number, resonant (some ``ω_j T ∈ 2πℤ`` with
-        ``b_j ≠ 0``), or ``g(0) = 0`` (no impulse brings the orbit to the obstacle).
+        ``T`` not a positive finite number, too long (:func:`check_long_period`), resonant (some
+        ``ω_j T ∈ 2πℤ`` with ``b_j ≠ 0``), or ``g(0) = 0`` (no impulse brings the orbit to the obstacle).
 
     ``options`` are passed to :func:`make_orbit` (``polish``, ``probe``, ``certify``).
 
@@ -526,10 +595,12 @@ def orbit_1ipp(system: LinearSystem, T: float, **options) -> PeriodicOrbit:
     1.0
     """
     check_newton_system(system, "orbit_1ipp")
+    check_long_period(system, T, "orbit_1ipp")
     T = check_period(system, T)
     md = ModalKernel.of(system, T)
     g0 = float(np.sum(md.b**2 * np.cos(md.omega * T / 2) / (2 * md.omega * md.sin_half)))
     if g0 == 0.0 or not np.isfinite(g0):
-        raise ValueError(f"no 1-ipp orbit at T = {T!r}: the impulse response does not reach the obstacle (g(0) = {g0})")
+        raise ValueError(f"no 1-ipp orbit at T = {_g(T)}: the impulse response does not reach the obstacle "
+                         f"(g(0) = {_g(g0)})")
     lam = -system.gap / g0
     return make_orbit(system, T, [T], [lam], md, **options)

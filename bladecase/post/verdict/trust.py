@@ -5,7 +5,17 @@ from __future__ import annotations
 import math
 
 from .base import _Base
-from .words import ARTEFACT_SHARE, ENERGY_SCATTER, FREQUENCY_RTOL, _and, _length, _modes_words, rejected_words
+from .words import (
+    ARTEFACT_SHARE,
+    ENERGY_SCATTER,
+    FREQUENCY_RTOL,
+    TIP_BEYOND_RTOL,
+    _and,
+    _length,
+    _modes_words,
+    _pct,
+    rejected_words,
+)
 
 
 class _Trust(_Base):
@@ -36,7 +46,8 @@ class _Trust(_Base):
                 doubts.append(facts_or_doubts)
         self._reduced_vs_fe(facts, doubts)
         self._comparison(facts, doubts)
-        self._tip(limits)
+        self._mesh(facts, doubts)
+        self._tip(limits, doubts)
         body = "; ".join(facts + doubts)
         if self.main is None:
             head = "Nothing to verify (no admissible orbit)"
@@ -210,7 +221,28 @@ class _Trust(_Base):
             at, lo, hi = spread
             doubts.append(f"the compared models' energies at {at} range from {lo:.3g} to {hi:.3g} J")
 
-    def _tip(self, limits: list) -> None:
+    def _mesh(self, facts: list, doubts: list) -> None:
+        """The mesh error of the headline figures, measured by ``[convergence]`` (else only a reason code)."""
+        c = self.s.get("convergence")
+        if not c:
+            self.code("mesh_error_unknown")
+            return
+        meshes = ", ".join(f"×{h:g}" for h in c["meshes"])
+        figures = c["figures"]
+        if c["flagged"]:
+            self.code("mesh_error_large")
+            said = [f"{figures[k]['words']} {_pct(figures[k]['error'])} %"
+                    + ("" if figures[k]["monotone"] else " (not monotone)") for k in c["flagged"]]
+            doubts.append(f"on meshes {meshes} the study's mesh is off the mesh-converged value by {_and(said)}")
+        else:
+            self.code("mesh_converged")
+        fine = [f"{f['words']} {_pct(f['error'])} %" for f in figures.values() if not f["flag"]]
+        if fine:
+            facts.append(f"the mesh error (Richardson over meshes {meshes}) of {_and(fine)}")
+
+    def _tip(self, limits: list, doubts: list) -> None:
+        """The face mean's own limit: nodes of the face beyond the clearance. Past :data:`TIP_BEYOND_RTOL` of the
+        clearance it is a doubt too — the contact model the figures come from is not the rub that happens."""
         if self.main is None:
             return
         beyond = [a["tip_excursion"] for a in self.anims if (a.get("tip_excursion") or {}).get("nodes_beyond")]
@@ -218,6 +250,10 @@ class _Trust(_Base):
             return
         self.code("tip_not_resolved")
         x = max(beyond, key=lambda t: t["node_max_m"])
+        clearance = self.s["contact"].get("clearance_m")
+        if clearance and x["node_max_m"] > TIP_BEYOND_RTOL * clearance:
+            doubts.append(f"the face mean's contact is not the tip's: a node passes the clearance by "
+                          f"{_length(x['node_max_m'])}, {_pct(x['node_max_m'] / clearance)} % of it (limit below)")
         face = f" '{self.s['contact']['face']}'" if self.s["contact"].get("face") else ""
         mean = (f"where the mean goes {_length(x['mean_max_m'])}" if x.get("mean_max_m", 0) > 0
                 else "while the mean stays within it")

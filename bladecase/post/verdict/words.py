@@ -35,6 +35,10 @@ ARTEFACT_SHARE = 0.01
 #: An orbit of ``modes.json`` crosses the casing when its ``max_violation`` exceeds this fraction of the clearance.
 VIOLATION_RTOL = 1e-6
 
+#: A face node past the clearance by more than this fraction of it makes the face mean's figures doubtful (the
+#: verdict's "Trust it" becomes "Trust it with care").
+TIP_BEYOND_RTOL = 0.1
+
 #: The reason codes of :func:`verdict` and what each says.
 REASONS = {
     "mode_found": "a family has an admissible arc (summary families[*].admissible_arcs)",
@@ -71,7 +75,12 @@ REASONS = {
                        "finds some (comparison.rows admissible_arcs)",
     "energies_scatter": "the energies at a common period spread by more than ENERGY_SCATTER across the compared "
                         "models (comparison.rows energy_*)",
-    "tip_not_resolved": "tip nodes pass the clearance the face's mean does not (animations[*].tip_excursion)",
+    "tip_not_resolved": "tip nodes pass the clearance the face's mean does not (animations[*].tip_excursion); by more "
+                        "than TIP_BEYOND_RTOL of the clearance it is a doubt of the trust line",
+    "mesh_converged": "every headline figure's mesh error estimate is within the flag (convergence.figures error)",
+    "mesh_error_large": "a headline figure's mesh error estimate exceeds the flag, or it does not converge "
+                        "monotonically over the meshes (convergence.flagged)",
+    "mesh_error_unknown": "no [convergence] meshes: the figures' mesh error is not measured (summary convergence null)",
     "switch_contact_model": "Newton's impact law, an orbit that failed the reference check (or none animated) and "
                             "energies that scatter across models: the massless contact model is advised",
 }
