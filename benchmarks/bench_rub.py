@@ -131,7 +131,8 @@ def sweep(workers: int) -> None:
     peak = max(rows, key=lambda r: r["tip_displacement_mm"])
     print(f"   {dt:.1f} s ({'MET' if dt <= 120 else 'NOT MET'}: goal <= 120 s); {sum(r['switches'] for r in rows)} "
           f"switches; hardest rub at {peak['speed']:.0f} rpm: {peak['tip_displacement_mm']:.3f} mm, "
-          f"{peak['contact_force_n']:.2f} N, {peak['nodes_touching']} nodes; not settled at "
+          f"{peak['total_force_n']:.2f} N in total, {peak['max_pressure_mpa']:.3g} MPa, {peak['nodes_touching']} "
+          f"nodes; not settled at "
           f"{len(section['unsettled_speeds'])} of 50 speeds")
 
 

@@ -405,7 +405,7 @@ def test_random_study_edits_give_a_study_or_one_line_naming_the_key():
                 assert not any(isinstance(x, float) and not math.isfinite(x) for x in flat), (section, key, value)
         s, o = study["search"], study["output"]
         assert s["scan"] <= 2000 and o["frames"] <= 1000 and o["manifold_size"][0] * o["manifold_size"][1] <= 1e5
-    assert outcomes["study"] >= 10 and outcomes["error"] >= 300, outcomes  # both outcomes exercised
+    assert outcomes["study"] >= 5 and outcomes["error"] >= 300, outcomes  # both outcomes exercised
 
 
 def test_random_arrays_give_a_system_or_one_line():

@@ -58,7 +58,7 @@ def blade():
     return build_model(study, build_mesh(study))
 
 
-def test_rub_outputs(result):
+def test_rub_outputs(result, blade):
     res, out = result
     for name in ("rub.csv", "rub_nodes.csv", "rub.png", "rub.vtu"):
         assert (out / name).is_file()
@@ -68,17 +68,39 @@ def test_rub_outputs(result):
     force = vtu.point_data["rub_peak_force_n"]
     assert (force > 0).sum() == res.summary["rub"]["rows"][1]["nodes_touching"]       # the touching nodes, 1650 rpm
     assert vtu.point_data["rub_contact_node"].sum() == 26 and force.max() == pytest.approx(
-        res.summary["rub"]["rows"][1]["contact_force_n"], rel=1e-12)
+        res.summary["rub"]["rows"][1]["max_node_force_n"], rel=1e-12)
+    pressure = vtu.point_data["contact_pressure"]                                      # Pa, at the hardest speed
+    assert ((pressure > 0) == (force > 0)).all() and pressure.max() == pytest.approx(
+        res.summary["rub"]["rows"][1]["max_pressure_mpa"] * 1e6, rel=1e-12)
     rows = list(csv.DictReader(open(out / "rub.csv")))
     assert [float(r["speed"]) for r in rows] == [1450.0, 1650.0]
+    assert {"total_force_n", "max_pressure_mpa", "loaded_area_mm2", "load_location"} <= set(rows[0])
     nodes = list(csv.DictReader(open(out / "rub_nodes.csv")))
     assert len(nodes) == 2 * 26
     s = res.summary["rub"]
     slow, fast = s["rows"]
+    # each node's pressure is its peak force over its tributary area; their largest, the row's
+    from bladecase.reduction.contact import tributary_areas
+    from bladecase.study.stages import build_contact
+
+    contact = build_contact(loads(_study(), source="<rub>"), blade)
+    area = tributary_areas(blade, contact.nodes)
+    fast_nodes = nodes[26:]
+    np.testing.assert_allclose([float(r["contact_pressure_mpa"]) for r in fast_nodes],
+                               [float(r["peak_force_n"]) / a * 1e-6 for r, a in zip(fast_nodes, area)], rtol=1e-8)
+    assert max(float(r["contact_pressure_mpa"]) for r in fast_nodes) == pytest.approx(fast["max_pressure_mpa"],
+                                                                                        rel=1e-8)
     # past the linear resonance of mode 1 with 8 lobes (about 1626 rpm, f1 216.8 Hz at speed) the rub is far
-    # harder: measured 0.014 mm / 2.0 N at 1450 rpm and 0.69 mm / 8.5 N at 1650 rpm (30 revolutions)
+    # harder: measured (8 revolutions) 0.017 mm, 0.78 MPa, 10.6 N over 35 mm² at 1450 rpm and 0.74 mm, 3.4 MPa,
+    # 55.9 N over 41 mm² at 1650 rpm, both centred at the trailing edge
     assert fast["tip_displacement_mm"] > 10 * slow["tip_displacement_mm"] > 0
-    assert fast["contact_force_n"] > 2 * slow["contact_force_n"] > 0
+    assert fast["total_force_n"] > 2 * slow["total_force_n"] > 0
+    assert fast["max_pressure_mpa"] > 2 * slow["max_pressure_mpa"] > 0
+    for row in (slow, fast):   # the total is one instant's sum: at least the hardest node's peak, at most all peaks
+        assert row["max_node_force_n"] <= row["total_force_n"]
+        assert 0 < row["loaded_area_mm2"] <= row["peak_loaded_area_mm2"] * (1 + 1e-12)
+        assert row["peak_loaded_area_mm2"] <= s["model"]["face_area_mm2"]
+        assert row["load_location"] == "trailing edge"
     assert 0 < slow["contact_fraction"] < fast["contact_fraction"] < 1
     assert s["worst"]["speed"] == 1650 and len(s["worst"]["touching_nodes"]) == fast["nodes_touching"] > 0
     assert all(0 <= x <= 1 for x in s["worst"]["touching_along_tip"])
@@ -89,6 +111,9 @@ def test_rub_outputs(result):
     text = (out / "report.md").read_text()
     assert "## Rub response" in text and "The hardest rub is at 1650 rpm" in text
     assert "lobes excite linear mode 1" in text
+    assert f"the contact pressure peaks at {fast['max_pressure_mpa']:.3g} MPa and the total contact force at " \
+           f"{fast['total_force_n']:.3g} N, over {fast['loaded_area_mm2']:.3g} mm² of the tip's 103 mm², centred at " \
+           "the trailing edge" in text
 
 
 @pytest.mark.parametrize("casing, rub, contact, match", [

@@ -3,19 +3,44 @@ face-mean mode.
 
 >>> section = {"contact_nodes": 26, "reduced_dofs": 8, "size": 8, "orbits": 18, "stop": "internal resonance",
 ...            "frequency_range_hz": [210.5, 215.5], "energy_range_j": [0.0031, 0.026], "stable_fraction": 1.0,
-...            "first_touch_nodes": ["3"], "most_nodes_touching": 18,
-...            "rows": [{"energy_j": 0.026, "max_force_n": 3.4, "max_penetration_mm": 0.118,
-...                      "max_contact_fraction": 0.31, "nodes_touching": 18}],
+...            "first_touch_nodes": ["3"], "most_nodes_touching": 18, "face_area_mm2": 103.2,
+...            "rows": [{"energy_j": 0.026, "max_pressure_mpa": 0.41, "total_force_n": 36.0, "loaded_area_mm2": 70.1,
+...                      "peak_loaded_area_mm2": 74.0, "load_centre": 0.45, "load_location": "mid-chord",
+...                      "max_penetration_mm": 0.118, "max_contact_fraction": 0.31, "nodes_touching": 18}],
 ...            "face_mean": {"energy_j": [0.0082, 0.07], "node_beyond_clearance_mm": [0.06, 0.18]}}
->>> nodal_report(section)[5][:58]
+>>> lines = nodal_report(section)
+>>> lines[5][:58]
 '- From 210.5 Hz, where node 3 touches first, to 215.5 Hz: '
+>>> lines[5].split("; ")[1].split(", ")
+['at the top (0.026 J) the contact pressure peaks at 0.41 MPa and the total contact force at 36 N', \
+"over 70.1 mm² of the tip's 103 mm²", 'centred mid-chord (0.45 of the chord from the leading edge)']
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["nodal_report"]
+__all__ = ["load_words", "nodal_report"]
+
+
+def load_words(row: dict, face_mm2: float | None = None) -> str:
+    """The casing's load in words from a row with ``max_pressure_mpa``, ``total_force_n``, ``loaded_area_mm2``,
+    ``load_centre`` and ``load_location`` (a row of ``nodal_modes.csv`` or ``rub.csv``): the peak contact pressure,
+    the peak total force, the area in contact then and where its centre sits along the chord.
+
+    >>> load_words({"max_pressure_mpa": 2.5, "total_force_n": 12.0, "loaded_area_mm2": 9.5, "load_centre": 0.9,
+    ...             "load_location": "trailing edge"}).split(", ")
+    ['the contact pressure peaks at 2.5 MPa and the total contact force at 12 N', 'over 9.5 mm² of the tip', \
+'centred at the trailing edge (0.90 of the chord from the leading edge)']
+    """
+    if not row.get("total_force_n"):
+        return "the casing carries no load"
+    where = row.get("load_location")
+    at = "" if where is None else (f", centred {'' if where == 'mid-chord' else 'at the '}{where} "
+                                   f"({row['load_centre']:.2f} of the chord from the leading edge)")
+    face = f" of the tip's {face_mm2:.3g} mm²" if face_mm2 else " of the tip"
+    return (f"the contact pressure peaks at {row['max_pressure_mpa']:.3g} MPa and the total contact force at "
+            f"{row['total_force_n']:.3g} N, over {row['loaded_area_mm2']:.3g} mm²{face}{at}")
 
 
 def nodal_report(section: dict | None) -> list[str]:
@@ -36,8 +61,8 @@ def nodal_report(section: dict | None) -> list[str]:
              "",
              f"- From {lo:.5g} Hz, where node{'s' if len(first) > 1 else ''} {', '.join(first[:6])} "
              f"touch{'' if len(first) > 1 else 'es'} first, to {hi:.5g} Hz: {len(rows)} orbits, up to "
-             f"{section['most_nodes_touching']} nodes touching; at the top ({top['energy_j']:.3g} J) the hardest "
-             f"node carries {top['max_force_n']:.3g} N, a node is in contact for up to "
+             f"{section['most_nodes_touching']} nodes touching; at the top ({top['energy_j']:.3g} J) "
+             f"{load_words(top, section.get('face_area_mm2'))}; a node is in contact for up to "
              f"{top['max_contact_fraction']:.0%} of the period and the casing yields up to "
              f"{top['max_penetration_mm'] * 1e3:.0f} µm"
              + ("" if stable is None else f"; {stable:.0%} of the orbits are linearly stable") + ".",

@@ -129,6 +129,7 @@ def report(summary: dict) -> str:
     narrow = narrow_words(summary)
     if narrow:
         lines += ["", f"**Narrow:** {narrow}."]
+    lines += _validity_words(summary.get("validity"))
     files = summary["files"]
     if not files.get("animations") and not with_arcs:
         lines += ["", "**No orbit animated:** no family has an admissible arc in the search range (the verdict at the "
@@ -185,6 +186,22 @@ def report(summary: dict) -> str:
             lines.append(f"\n  ![{a['gif']}]({a['gif']})\n")
     lines += ["", "Timings (s): " + ", ".join(f"{k} {v:.2f}" for k, v in summary["timings_s"].items()), ""]
     return "\n".join(lines)
+
+
+def _validity_words(v: dict | None) -> list[str]:
+    """Where the admissible arcs were cut at the small-displacement limit (nothing when none was)."""
+    if not v or not v.get("cuts"):
+        return []
+    where = []
+    for c in v["cuts"]:
+        at = (f"ends at {1 / c['T_cut']:.6g} Hz (T = {c['T_cut']:.8g} s, tip amplitude "
+              f"{c['tip_amplitude_cut'] * 1e3:.4g} mm)" if c.get("T_cut") else "is dropped whole")
+        where.append(f"family {c['family']}'s arc {at}; beyond it the tip moves {c['tip_amplitude_beyond'] * 1e3:.4g} "
+                     f"mm at {1 / c['T_beyond']:.6g} Hz")
+    return ["", f"**Cut at the small-displacement limit:** the model is linear elastic about the undeformed blade, "
+            f"valid while the tip moves less than {v['limit_m'] * 1e3:.4g} mm ({100 * v['amplitude_limit']:g} % of the "
+            f"blade's {v['span_m'] * 1e3:.4g} mm span, `[search] amplitude_limit`): " + "; ".join(where) + ". The "
+            "orbits beyond stay in `modes.json` but are no part of any admissible arc."]
 
 
 def _mesh_words(mesh: dict) -> str:

@@ -1,14 +1,14 @@
-"""The interaction diagram of a rub sweep: peak tip displacement and peak contact force against speed, with the
-speeds where the casing's lobes excite a linear mode (``n·Ω = ω_k``, dashed) and where they excite a nonsmooth
-mode's frequency band (shaded).
+"""The interaction diagram of a rub sweep: peak tip displacement, peak total contact force and peak contact
+pressure against speed, with the speeds where the casing's lobes excite a linear mode (``n·Ω = ω_k``, dashed) and
+where they excite a nonsmooth mode's frequency band (shaded).
 
 >>> section = {"speed_unit": "rpm", "lobes": 3, "rows": [
-...     {"speed": s, "tip_displacement_mm": d, "contact_force_n": f, "settled": True}
+...     {"speed": s, "tip_displacement_mm": d, "total_force_n": f, "max_pressure_mpa": f / 20, "settled": True}
 ...     for s, d, f in [(3000, 0.05, 1.0), (4000, 0.4, 9.0), (5000, 0.1, 2.0)]],
 ...     "resonances": [{"mode": 1, "speed": 4100.0}], "nonsmooth_bands_hz": [(210.0, 216.0)]}
 >>> fig = interaction_plot(section)
 >>> [ax.get_ylabel() for ax in fig.axes]
-['peak tip displacement (mm)', 'peak contact force (N)']
+['peak tip displacement (mm)', 'peak total contact force (N)', 'peak contact pressure (MPa)']
 """
 
 from __future__ import annotations
@@ -33,9 +33,10 @@ def interaction_plot(section: dict, title: str | None = None) -> Figure:
     speed = np.array([r["speed"] for r in rows])
     settled = np.array([r["settled"] for r in rows], dtype=bool)
     campbell = bool(section.get("open_hz"))
-    fig = new_figure(figsize=(7.0, 7.8 if campbell else 5.6), layout="constrained")
-    axes = fig.subplots(3 if campbell else 2, 1, sharex=True)
-    series = [("tip_displacement_mm", "peak tip displacement (mm)"), ("contact_force_n", "peak contact force (N)")]
+    series = [("tip_displacement_mm", "peak tip displacement (mm)"), ("total_force_n", "peak total contact force (N)"),
+              ("max_pressure_mpa", "peak contact pressure (MPa)")]
+    fig = new_figure(figsize=(7.0, 9.6 if campbell else 7.4), layout="constrained")
+    axes = fig.subplots(len(series) + int(campbell), 1, sharex=True)
     lobes = section["lobes"]
     for ax, (key, label) in zip(axes, series):
         y = np.array([r[key] for r in rows], dtype=float)
@@ -55,7 +56,7 @@ def interaction_plot(section: dict, title: str | None = None) -> Figure:
                 ax.annotate(f"mode {res['mode']}", (res["speed"], 1.0), xycoords=("data", "axes fraction"),
                             rotation=90, va="top", ha="right", fontsize=8, color="0.3")
     if campbell:  # the Campbell diagram on the same speed axis: the modes at each speed, the lobes' order line
-        ax = axes[2]
+        ax = axes[len(series)]
         f = np.asarray(section["open_hz"], dtype=float)
         excite = lobes * speed * scale / (2 * math.pi)
         lo = 0.9 * min(float(excite.min()), float(f[:, 0].min()))

@@ -23,6 +23,13 @@ is then exact at any size. The reduced model is
 casing compliance per unit area (``k_j = k_A·A_j``, ``A_j`` the node's tributary area) grows faster (``1/h²``)
 and keeps the contact forces and the penetrations converging. A rigid casing (``k_j = inf``) at every node of a
 fine mesh has no converged limit: the results then depend on the mesh (as for any node-to-surface contact).
+
+**Pressure, not per-node forces.** A node's force falls like its tributary area as the tip mesh is refined: it is
+a mesh quantity. The model keeps each node's tributary area ``A_j`` (:attr:`NodalReducedModel.areas`, the shares
+the area weights of :meth:`Contact.face <bladecase.reduction.Contact.face>` are made of) and its position along the
+tip's chord (:attr:`NodalReducedModel.chord`, :func:`chord_positions`), and turns the nodes' forces at an instant
+into what converges (:func:`contact_load`): the **contact pressure** ``p_j = λ_j / A_j``, the **total force**
+``Σ λ_j``, the **loaded area** ``Σ_{λ_j > 0} A_j`` and **where the load sits** along the chord.
 """
 
 from __future__ import annotations
@@ -37,11 +44,12 @@ from ..checks import integer
 from ..fe import FEModel
 from ..linalg import DENSE_LIMIT, SPDFactor, check_factor, spd_factor
 from ..nsm.massless.nodes import NodalSystem
-from .contact import Contact
+from .contact import Contact, tributary_areas
 from .massless import _HINT, _K, _check_lumped, _interior_modes, _Split, massless_masses
 from .model import ReducedModel
 
-__all__ = ["NodalReducedModel", "nodal_extension", "nodal_model"]
+__all__ = ["NodalReducedModel", "chord_positions", "chord_region", "contact_load", "contact_pressure",
+           "nodal_extension", "nodal_model"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -52,7 +60,10 @@ class NodalReducedModel(ReducedModel):
     ``normal_map`` (``m × n_free``, sparse) gives each node's normal displacement ``ν_j·u_j``; ``closed_shapes``
     (``n_free × m``) the free-dof displacement per unit force on each node with the interior held, added
     ``λ_j`` times where a node is pressed; ``masses`` the redistributed lumped masses; ``interior`` the interior
-    basis ``V_i`` (reusable at another speed: :func:`nodal_model`'s ``interior``).
+    basis ``V_i`` (reusable at another speed: :func:`nodal_model`'s ``interior``); ``areas`` each node's tributary
+    area (m²; in 2-D a length times the thickness; 0 for a node on no face facet, e.g. a mid-side node) and
+    ``chord`` its position along the tip's chord (0 at the leading edge, 1 at the trailing edge:
+    :func:`chord_positions`).
     """
 
     closed_shapes: np.ndarray = field(default=None, repr=False)  # type: ignore[assignment]
@@ -60,6 +71,13 @@ class NodalReducedModel(ReducedModel):
     normal_map: sp.csr_array = field(default=None, repr=False)  # type: ignore[assignment]
     interior: np.ndarray = field(default=None, repr=False)  # type: ignore[assignment]
     residual: bool = False
+    areas: np.ndarray = field(default=None, repr=False)  # type: ignore[assignment]
+    chord: np.ndarray = field(default=None, repr=False)  # type: ignore[assignment]
+
+    def contact_load(self, forces) -> dict:
+        """The contact pressure, total force, loaded area and where the load sits for the nodes' ``forces`` at one
+        instant (N, ``(m,)``): :func:`contact_load` with this model's areas and chord positions."""
+        return contact_load(forces, self.areas, self.chord)
 
     @property
     def mass_matrix(self) -> sp.dia_array:
@@ -190,8 +208,10 @@ def nodal_model(model: FEModel, contact: Contact, size: int, factor: SPDFactor |
         closed[c] = -X
     k = _node_casing(contact, m, casing)
     system = NodalSystem(M_r, S_r, V.T @ Wfull, Hs, d, k, nodes=tuple(model.mesh.node_id(k) for k in nodes))
+    areas = _areas(model, nodes)
     return NodalReducedModel("massless-nodes", size, system, V, model, contact, closed_shapes=closed,
-                             masses=masses, normal_map=N, interior=V_i, residual=residual)
+                             masses=masses, normal_map=N, interior=V_i, residual=residual, areas=areas,
+                             chord=chord_positions(model.mesh.points[nodes], areas))
 
 
 def nodal_extension(nodal: NodalReducedModel, count: int, factor: SPDFactor | None = None) -> NodalReducedModel:
@@ -249,3 +269,92 @@ def _node_casing(contact: Contact, m: int, casing) -> np.ndarray:
     if k.shape != (m,) or np.any(np.isnan(k)) or np.any(k <= 0):
         raise ValueError(f"casing stiffness per node must be {m} values > 0 (N/m; inf: rigid), got shape {k.shape}")
     return k
+
+
+# ----------------------------------------------------------------------------- contact pressure
+
+
+def _areas(model: FEModel, nodes: np.ndarray) -> np.ndarray:
+    """Each contact node's tributary area (m²), from the facets whose corners are all contact nodes — the shares
+    ``Contact.face(..., weights="area")`` divides by the face's total; zeros for a set of nodes that holds no facet
+    (a line of nodes, a single node): no pressure there."""
+    try:
+        return tributary_areas(model, nodes)
+    except ValueError:  # no boundary facet among the nodes
+        return np.zeros(len(nodes))
+
+
+def chord_positions(points, areas) -> np.ndarray:
+    """Each point's position along the face's chord, 0 at the leading edge and 1 at the trailing edge.
+
+    The chord is the face's longest in-plane extent: the first principal direction of the points. Its leading
+    edge is the end on the side of the face's area centroid (the weights ``areas``): an aerofoil's rounded nose is
+    its thick end, its centroid lies at about 40 % of the chord from the nose (on the demo blade's tip, 44 %), and
+    the blunt trailing edge is thin. A face with no thick end (its centroid within 1 % of the chord of the middle,
+    e.g. a rectangular plate's edge) has no leading edge to find: its ``0`` end is the one of lowest coordinate
+    along the principal direction, taken with its largest component positive.
+
+    >>> chord_positions([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [4.0, 0.0, 0.0]], [3.0, 2.0, 1.0]).tolist()  # thick at x=0
+    [0.0, 0.25, 1.0]
+    >>> chord_positions([[4.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.0]], [3.0, 2.0, 1.0]).tolist()  # thick at x=4
+    [0.0, 0.75, 1.0]
+    """
+    P = np.asarray(points, dtype=float)
+    a = np.asarray(areas, dtype=float)
+    C = P - P.mean(axis=0)
+    if P.shape[0] < 2 or not np.any(C):
+        return np.zeros(P.shape[0])
+    direction = np.linalg.svd(C, full_matrices=False)[2][0]
+    direction = direction * np.sign(direction[np.argmax(np.abs(direction))])
+    s = C @ direction
+    s = (s - s.min()) / float(np.ptp(s))
+    if a.sum() > 0 and float(a @ s) / float(a.sum()) > 0.51:  # the thick end is at s = 1: the leading edge
+        s = 1.0 - s
+    return s
+
+
+def chord_region(centre) -> str | None:
+    """A position along the chord (0 leading edge – 1 trailing edge) in words, by thirds: ``"leading edge"``
+    (below 1/3), ``"mid-chord"``, ``"trailing edge"`` (above 2/3); ``None`` for ``None`` (no load).
+
+    >>> [chord_region(x) for x in (0.1, 0.5, 0.9, None)]
+    ['leading edge', 'mid-chord', 'trailing edge', None]
+    """
+    if centre is None or not np.isfinite(centre):
+        return None
+    return "leading edge" if centre < 1 / 3 else "mid-chord" if centre <= 2 / 3 else "trailing edge"
+
+
+def contact_pressure(forces, areas) -> np.ndarray:
+    """The contact pressure of each node (Pa): its force over its tributary area, ``forces`` ``(m,)`` or ``(m, k)``
+    (``k`` instants); NaN on a node without area (a mid-side node of a quadratic face: it carries no share of the
+    face). Summed over the nodes, pressure × area is the total force.
+
+    >>> contact_pressure([2.0, 4.0, 2.0], [1e-6, 2e-6, 1e-6]).tolist()   # a uniform 2 MPa, forces ∝ areas
+    [2000000.0, 2000000.0, 2000000.0]
+    """
+    f = np.asarray(forces, dtype=float)
+    a = np.asarray(areas, dtype=float).reshape((-1,) + (1,) * (f.ndim - 1))
+    return np.divide(f, a, out=np.full(np.broadcast_shapes(f.shape, a.shape), np.nan), where=a > 0)
+
+
+def contact_load(forces, areas, chord) -> dict:
+    """What the casing's load on the face is at one instant, from the nodes' ``forces`` (N, ``(m,)``), their
+    tributary ``areas`` (m²) and positions along the ``chord`` (0 leading edge – 1 trailing edge):
+
+    ``{"max_pressure_pa", "total_force_n", "loaded_area_m2", "centre", "location"}``: the largest contact pressure
+    over the nodes (:func:`contact_pressure`), the total force ``Σ λ_j``, the area of the nodes in contact
+    (``λ_j > 0``), the force-weighted centroid along the chord ``Σ λ_j s_j / Σ λ_j`` and its third of the chord in
+    words (:func:`chord_region`); ``centre`` and ``location`` are ``None`` without load.
+
+    >>> load = contact_load([0.0, 3.0, 1.0], [1e-6, 1e-6, 2e-6], [1.0, 0.1, 0.0])
+    >>> load["total_force_n"], round(load["loaded_area_m2"] * 1e6, 12), round(load["centre"], 12), load["location"]
+    (4.0, 3.0, 0.075, 'leading edge')
+    """
+    f = np.asarray(forces, dtype=float)
+    a = np.asarray(areas, dtype=float)
+    total = float(f.sum())
+    p = contact_pressure(f, a)
+    centre = float(f @ np.asarray(chord, dtype=float)) / total if total > 0 else None
+    return {"max_pressure_pa": float(np.nanmax(p)) if np.isfinite(p).any() else 0.0, "total_force_n": total,
+            "loaded_area_m2": float(a[f > 0].sum()), "centre": centre, "location": chord_region(centre)}

@@ -6,7 +6,12 @@ clearance while the tip's corners may run far past it. With ``points = "nodes"``
 massless contact per face node (:func:`bladecase.reduction.nodes.nodal_model`, the residual correction, ``[reduction]
 size`` modes) and its nonsmooth mode is followed from the first node's grazing
 (:func:`bladecase.nsm.massless.nodal_modes.nodal_family`): each orbit's frequency, energy, the nodes that touch,
-each node's peak force, contact fraction and casing yield, its Floquet verdict; with ``[output] reference``, up to
+the contact pressure (each node's force over its tributary area; the largest over the nodes and the period), the
+total contact force (the sum over the nodes, its peak over the period), the loaded area (the area of the nodes in
+contact at the instant of that peak, and the largest over the period) and where the load sits along the chord
+(:func:`bladecase.reduction.nodes.contact_load`), the contact fraction and casing yield, its Floquet verdict — a
+node's own force falls like its area as the tip mesh is refined, so it is no figure of the mode; with ``[output]
+reference``, up to
 :data:`REFERENCE_CHECKS` orbits, evenly spread, re-simulated for one period in the nodal model's Krylov extension
 (four times its dofs, :func:`bladecase.reduction.nodes.nodal_extension`). Outputs: ``nodal_modes.csv`` (one
 row per orbit), ``nodal_modes.png`` (frequency–energy of both models, and the largest penetration over the face's
@@ -22,13 +27,27 @@ import numpy as np
 from .. import log
 from ..io import save_figure, write_text
 from ..nsm.massless.nodal_modes import nodal_family
-from ..reduction.nodes import nodal_extension, nodal_model
+from ..reduction.nodes import contact_pressure, nodal_extension, nodal_model
 from .reference import REFERENCE_FACTOR, check_nodal_in_reference
 
-__all__ = ["nodal_stage"]
+__all__ = ["nodal_stage", "orbit_load"]
 
-COLUMNS = ("frequency_hz", "period_s", "energy_j", "nodes_touching", "touching_nodes", "max_force_n",
+COLUMNS = ("frequency_hz", "period_s", "energy_j", "nodes_touching", "touching_nodes", "max_pressure_mpa",
+           "total_force_n", "loaded_area_mm2", "peak_loaded_area_mm2", "load_centre", "load_location",
            "max_contact_fraction", "max_penetration_mm", "max_tip_mm", "stable", "residual", "reference_drift")
+
+
+def orbit_load(nodal, orbit) -> dict:
+    """The casing's load on the face over one orbit of the every-node model ``nodal``: the largest contact pressure
+    over the nodes and the period (MPa), the peak total force (N), the area in contact at that instant and the
+    largest over the period (mm²), and where the load sits then along the chord (the force-weighted centroid,
+    0 leading edge – 1 trailing edge, and its third in words: :func:`bladecase.reduction.nodes.contact_load`)."""
+    at = nodal.contact_load(orbit.forces(orbit.total_force_time)[:, 0])
+    peak = contact_pressure(orbit.peak_force, nodal.areas)
+    return {"max_pressure_mpa": float(np.nanmax(peak)) * 1e-6 if np.isfinite(peak).any() else 0.0,
+            "total_force_n": float(orbit.total_force), "loaded_area_mm2": at["loaded_area_m2"] * 1e6,
+            "peak_loaded_area_mm2": orbit.loaded_area(nodal.areas) * 1e6,
+            "load_centre": at["centre"], "load_location": at["location"]}
 
 
 def _face_penetration(reduced, contact, model, family) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -94,7 +113,7 @@ def nodal_stage(study, model, contact, families, reduced, *, factor=None, folder
         rows.append({"frequency_hz": float(o.frequency), "period_s": float(o.T), "energy_j": float(o.energy),
                      "nodes_touching": int(len(o.touching_nodes)),
                      "touching_nodes": " ".join(str(n) for n in o.touching_nodes),
-                     "max_force_n": float(np.max(o.peak_force)),
+                     **orbit_load(nodal, o),
                      "max_contact_fraction": float(np.max(o.contact_fraction)),
                      "max_penetration_mm": float(np.max(pen)) * 1e3 if np.isfinite(pen).all() else 0.0,
                      "max_tip_mm": float(o.max_tip) * 1e3, "stable": bool(o.stable()), "residual": float(o.residual),
@@ -102,6 +121,7 @@ def nodal_stage(study, model, contact, families, reduced, *, factor=None, folder
     stable = [r["stable"] for r in rows]
     section = {
         "size": size, "contact_nodes": nodal.system.m, "reduced_dofs": nodal.system.n,
+        "face_area_mm2": float(nodal.areas.sum()) * 1e6,
         "orbits": len(rows), "stop": fam.stop,
         "frequency_range_hz": [rows[0]["frequency_hz"], max(r["frequency_hz"] for r in rows)] if rows else None,
         "energy_range_j": [rows[0]["energy_j"], max(r["energy_j"] for r in rows)] if rows else None,
@@ -133,7 +153,7 @@ def nodal_stage(study, model, contact, families, reduced, *, factor=None, folder
 
 
 def _cell(value) -> str:
-    """A CSV cell: floats to 9 digits, booleans lower-case, ``None`` (not checked) empty."""
+    """A CSV cell: floats to 9 digits, booleans lower-case, ``None`` (not checked; no load) empty."""
     if value is None:
         return ""
     if isinstance(value, bool):

@@ -128,19 +128,8 @@ def orbit_engineering(reduced: ReducedModel, orbit) -> dict:
     """
     from scipy.optimize import minimize_scalar
 
-    model, contact, T = reduced.model, reduced.contact, float(orbit.T)
-    intervals = [tuple(map(float, c)) for c in getattr(orbit, "contact_intervals", [])]
-    times = np.unique(np.mod(np.concatenate([np.linspace(0.0, T, ENGINEERING_SAMPLES, endpoint=False)]
-                                            + [np.linspace(a, b, PHASE_SAMPLES) for a, b in intervals]), T))
-    x, _ = orbit.state(times)
-    nodes = list(contact.nodes) or [contact.node]
-    dofs = [np.flatnonzero(model.dofs.node == k) for k in nodes]
-    u = _rows(reduced, np.concatenate(dofs), x)
-    ends = np.cumsum([0] + [d.size for d in dofs])
-    size = np.array([np.linalg.norm(u[a:b], axis=0) for a, b in zip(ends[:-1], ends[1:])])
-    k, j = np.unravel_index(int(np.argmax(size)), size.shape)
-    out = {"tip_amplitude_mm": float(size[k, j] * 1e3), "tip_amplitude_node_id": int(model.mesh.node_ids[nodes[k]]),
-           "tip_amplitude_t_over_T": float(times[j] / T)}
+    T = float(orbit.T)
+    out, times, x = _tip_amplitude(reduced, orbit)
     if not is_massless(orbit):
         return out | {"contact_fraction": 0.0, "contact_force_n": None,
                       "contact_impulse_ns": float(np.max(orbit.impulses)) if orbit.impulses.size else 0.0}
@@ -158,6 +147,30 @@ def orbit_engineering(reduced: ReducedModel, orbit) -> dict:
     if np.isfinite(casing):
         out["casing_penetration_m"] = peak / casing
     return out
+
+
+def _tip_amplitude(reduced: ReducedModel, orbit) -> tuple[dict, np.ndarray, np.ndarray]:
+    """:func:`orbit_engineering`'s tip amplitude (with its node and instant), the sampled instants and states."""
+    model, contact, T = reduced.model, reduced.contact, float(orbit.T)
+    intervals = [tuple(map(float, c)) for c in getattr(orbit, "contact_intervals", [])]
+    times = np.unique(np.mod(np.concatenate([np.linspace(0.0, T, ENGINEERING_SAMPLES, endpoint=False)]
+                                            + [np.linspace(a, b, PHASE_SAMPLES) for a, b in intervals]), T))
+    x, _ = orbit.state(times)
+    nodes = list(contact.nodes) or [contact.node]
+    dofs = [np.flatnonzero(model.dofs.node == k) for k in nodes]
+    u = _rows(reduced, np.concatenate(dofs), x)
+    ends = np.cumsum([0] + [d.size for d in dofs])
+    size = np.array([np.linalg.norm(u[a:b], axis=0) for a, b in zip(ends[:-1], ends[1:])])
+    k, j = np.unravel_index(int(np.argmax(size)), size.shape)
+    out = {"tip_amplitude_mm": float(size[k, j] * 1e3), "tip_amplitude_node_id": int(model.mesh.node_ids[nodes[k]]),
+           "tip_amplitude_t_over_T": float(times[j] / T)}
+    return out, times, x
+
+
+def tip_amplitude(reduced: ReducedModel, orbit) -> float:
+    """The largest displacement magnitude ``|u|`` (m) of a contact node over the period of ``orbit`` (as
+    :func:`orbit_engineering` samples it)."""
+    return _tip_amplitude(reduced, orbit)[0]["tip_amplitude_mm"] * 1e-3
 
 
 def _rows(reduced: ReducedModel, rows: np.ndarray, x: np.ndarray) -> np.ndarray:

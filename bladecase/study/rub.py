@@ -8,8 +8,15 @@ interior basis for every speed, computed at the middle of the range: each speed'
 the contact rows and the residual flexibility computed with that speed's stiffness); then simulated from rest
 (:func:`bladecase.nsm.massless.rub.rub_response`). The speeds run through the study's executor. Outputs:
 ``rub.csv`` (one row per speed), ``rub_nodes.csv`` (one row per speed and node), ``rub.png`` (the interaction
-diagram: peak tip displacement and peak contact force against speed, with the speeds where the casing's lobes
-excite a linear mode and, when the study found nonsmooth modes, where they excite the nonsmooth mode's band).
+diagram: peak tip displacement, peak total contact force and peak contact pressure against speed, with the speeds
+where the casing's lobes excite a linear mode and, when the study found nonsmooth modes, where they excite the
+nonsmooth mode's band).
+
+How hard the tip rubs is said by what converges as the tip mesh is refined: the **contact pressure** (each node's
+force over its tributary area), the **total contact force** (the sum over the nodes; its peak over the window),
+the **loaded area** (the area of the nodes in contact at that peak, and the largest over the window) and where
+the load sits along the chord (:func:`bladecase.reduction.nodes.contact_load`). A node's own force falls like its
+area under refinement: it stays in ``rub_nodes.csv`` and ``rub.vtu`` as data, not as a figure of the rub.
 """
 
 from __future__ import annotations
@@ -24,7 +31,7 @@ from ..io import save_figure, write_text
 from ..nsm.damping import Damping
 from ..nsm.massless.rub import rub_response
 from ..reduction.contact import Contact, tributary_areas
-from ..reduction.nodes import nodal_model
+from ..reduction.nodes import chord_positions, contact_pressure, nodal_model
 from .keys import StudyError
 
 __all__ = ["node_angles", "rub_stage"]
@@ -34,7 +41,13 @@ COLUMNS = {
     "speed": "the speed, in [rub] speed_unit",
     "speed_rad_s": "the speed (rad/s)",
     "tip_displacement_mm": "the largest peak outward normal displacement over the contact nodes (mm)",
-    "contact_force_n": "the largest peak contact force over the nodes (N)",
+    "max_pressure_mpa": "the largest contact pressure over the nodes and the window (MPa): force over tributary area",
+    "total_force_n": "the peak over the window of the total contact force, the sum over the nodes (N)",
+    "loaded_area_mm2": "the area of the nodes in contact at the instant of that peak (mm²)",
+    "peak_loaded_area_mm2": "the largest area in contact over the window (mm²)",
+    "load_centre": "the force-weighted centroid at that peak along the chord: 0 leading edge, 1 trailing edge",
+    "load_location": "that centroid's third of the chord: leading edge, mid-chord or trailing edge",
+    "max_node_force_n": "the largest peak force on one node (N; a mesh quantity: it falls like the node's area)",
     "contact_fraction": "the largest fraction of a revolution a node spends in contact",
     "penetration_mm": "the casing's largest yield under a node (mm; 0 for a rigid casing)",
     "nodes_touching": "how many contact nodes touch the casing",
@@ -116,9 +129,14 @@ def _rub_point(speed: float, *, model, contact: Contact, interior: np.ndarray, s
     hot = _running(model, contact, state.displacement, speed)
     reduced = nodal_model(state.model, hot, size, factor=state.factor, casing=casing, interior=interior, residual=True)
     try:
-        out = rub_response(reduced.system, speed, lobes, amplitude, angles, damping, revolutions, window).as_dict()
+        response = rub_response(reduced.system, speed, lobes, amplitude, angles, damping, revolutions, window,
+                                areas=reduced.areas)
     except ValueError as exc:  # the simulation refused this speed (e.g. a grazing switch): the others go on
         out = {"error": str(exc), "nodes": list(reduced.system.nodes)}
+    else:
+        out = response.as_dict()
+        out["load"] = reduced.contact_load(response.force_at_peak)
+        out["peak_pressure"] = np.nan_to_num(contact_pressure(response.peak_force, reduced.areas)).tolist()
     out["open_hz"] = (reduced.system.modes[0][:6] / (2 * np.pi)).tolist()
     out["clearances_m"] = reduced.system.gap.tolist()
     return out
@@ -194,7 +212,8 @@ def rub_stage(study, model, contact: Contact, *, families=None, executor=None, p
 
 def _write_vtu(path: Path, model, contact: Contact, section: dict, points: list[dict]) -> str:
     """The mesh with the rub's per-node figures as point data, for ParaView: at the hardest speed (``rub_*``) and
-    the largest over every speed (``rub_max_*``); zero off the contact nodes."""
+    the largest over every speed (``rub_max_*``) — the peak contact pressure as ``contact_pressure`` (Pa, at the
+    hardest speed) and ``contact_pressure_max``; zero off the contact nodes."""
     import meshio
 
     from ..io import atomic_path
@@ -205,12 +224,15 @@ def _write_vtu(path: Path, model, contact: Contact, section: dict, points: list[
     worst = points[int(np.argmax([r["tip_displacement_mm"] for r in section["rows"]]))]
     data = {}
     for key, scale, unit in (("peak_displacement", 1e3, "mm"), ("peak_force", 1.0, "n"),
-                             ("contact_fraction", 1.0, ""), ("penetration", 1e3, "mm")):
+                             ("contact_fraction", 1.0, ""), ("penetration", 1e3, "mm"), ("peak_pressure", 1.0, "")):
         name = f"{key}_{unit}" if unit else key
         at, top = np.zeros(n), np.zeros(n)
         at[idx] = np.asarray(worst[key]) * scale
         top[idx] = np.max([np.asarray(p[key]) for p in points], axis=0) * scale
-        data[f"rub_{name}"], data[f"rub_max_{name}"] = at, top
+        if key == "peak_pressure":  # Pa: the figure to read, where a node's force is a mesh quantity
+            data["contact_pressure"], data["contact_pressure_max"] = at, top
+        else:
+            data[f"rub_{name}"], data[f"rub_max_{name}"] = at, top
     mask = np.zeros(n, dtype=np.uint8)
     mask[idx] = 1
     data["rub_contact_node"] = mask
@@ -234,9 +256,13 @@ def _summary(study, speeds: np.ndarray, points: list[dict], families, contact: C
             failed.append({"speed": float(given), "reason": p["error"]})
             continue
         frac = np.array(p["contact_fraction"])
+        load = p["load"]
         rows.append({"speed": float(given), "speed_rad_s": float(w),
                      "tip_displacement_mm": 1e3 * max(p["peak_displacement"]),
-                     "contact_force_n": max(p["peak_force"]), "contact_fraction": float(frac.max()),
+                     "max_pressure_mpa": 1e-6 * max(p["peak_pressure"]), "total_force_n": float(p["total_force"]),
+                     "loaded_area_mm2": 1e6 * load["loaded_area_m2"], "peak_loaded_area_mm2": 1e6 * p["loaded_area"],
+                     "load_centre": load["centre"], "load_location": load["location"],
+                     "max_node_force_n": max(p["peak_force"]), "contact_fraction": float(frac.max()),
                      "penetration_mm": 1e3 * max(p["penetration"]), "nodes_touching": int((frac > 0).sum()),
                      "switches": p["switches"], "settled": bool(p["settled"])})
     if not rows:
@@ -267,6 +293,7 @@ def _summary(study, speeds: np.ndarray, points: list[dict], families, contact: C
         "nonsmooth_bands_hz": _bands(families),
         "bands_at": _bands_at(study),
         "model": {"size": r["size"], "contact_nodes": len(contact.nodes),
+                  "face_area_mm2": float(tributary_areas(model, contact.nodes).sum()) * 1e6,
                   "casing_n_per_m": None if np.isinf(casing).all() else float(casing.sum())},
     }
 
@@ -281,31 +308,38 @@ def _bands_at(study) -> str:
 
 
 def _along_tip(model, contact: Contact, touching: list[int]) -> list[float] | None:
-    """Where the touching nodes sit along the tip (0–1 along its longest extent)."""
+    """Where the touching nodes sit along the tip's chord (0 leading edge – 1 trailing edge:
+    :func:`bladecase.reduction.nodes.chord_positions`)."""
     if not touching:
         return None
-    P = np.asarray(model.mesh.points, dtype=float)[list(contact.nodes)]
-    C = P - P.mean(axis=0)
-    direction = np.linalg.svd(C, full_matrices=False)[2][0]
-    s = C @ direction
-    s = (s - s.min()) / max(float(np.ptp(s)), 1e-300)
+    nodes = list(contact.nodes)
+    s = chord_positions(np.asarray(model.mesh.points, dtype=float)[nodes], tributary_areas(model, nodes))
     return [float(np.round(s[i], 3)) for i in touching]
+
+
+def _csv_cell(value) -> str:
+    """A CSV cell: floats to 9 digits, booleans lower-case, ``None`` (no load) empty."""
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return str(value).lower()
+    return f"{value:.9g}" if isinstance(value, float) else str(value)
 
 
 def _write(folder: Path, section: dict, points: list[dict], figures: bool, title: str | None) -> dict:
     rows = section["rows"]
     lines = [",".join(COLUMNS)]
     for row in rows:
-        lines.append(",".join(f"{row[c]:.9g}" if isinstance(row[c], float) else str(row[c]).lower()
-                              if isinstance(row[c], bool) else str(row[c]) for c in COLUMNS))
+        lines.append(",".join(_csv_cell(row[c]) for c in COLUMNS))
     write_text(folder / "rub.csv", "\n".join(lines) + "\n")
-    node_lines = ["speed,speed_rad_s,node,peak_displacement_mm,peak_force_n,contact_fraction,penetration_mm,"
-                  "clearance_mm"]
+    node_lines = ["speed,speed_rad_s,node,peak_displacement_mm,peak_force_n,contact_pressure_mpa,contact_fraction,"
+                  "penetration_mm,clearance_mm"]
     for row, p in zip(rows, points):
         for j, n in enumerate(p["nodes"]):
             node_lines.append(f"{row['speed']:.9g},{row['speed_rad_s']:.9g},{n},{p['peak_displacement'][j] * 1e3:.9g},"
-                              f"{p['peak_force'][j]:.9g},{p['contact_fraction'][j]:.9g},"
-                              f"{p['penetration'][j] * 1e3:.9g},{p['clearances_m'][j] * 1e3:.9g}")
+                              f"{p['peak_force'][j]:.9g},{p['peak_pressure'][j] * 1e-6:.9g},"
+                              f"{p['contact_fraction'][j]:.9g},{p['penetration'][j] * 1e3:.9g},"
+                              f"{p['clearances_m'][j] * 1e3:.9g}")
     write_text(folder / "rub_nodes.csv", "\n".join(node_lines) + "\n")
     files = {"csv": "rub.csv", "nodes_csv": "rub_nodes.csv"}
     if figures:

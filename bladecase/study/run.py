@@ -243,6 +243,7 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         # a parallel executor sends the families back without their system (light records): attach it again
         found = [[b if b.system is not None else b.bind(r.system) for b in fams]
                  for r, (fams, _) in zip(searched, timed)]
+        found, validity = _small_displacements(study, model, searched, found)
         families, compare_families = found[0], found[1:1 + len(compares)]
         names = [None] * (1 + len(compares)) + ([f"{reference.method}-{reference.size} (reference)"] if extra else [])
         models = [ModelResult(r, fams, b, t, name) for r, fams, b, (_, t), name in
@@ -328,9 +329,35 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         "nodal_modes": nodal,
         "comparison": None if comparison is None else summary_section(comparison),
         "convergence": convergence,
+        "validity": validity,
         "files": files,
     }
     return summary, families, {m.name: m for m in models}
+
+
+def _small_displacements(study: Study, model, searched: list, found: list) -> tuple[list, dict]:
+    """Every model's families with their arcs cut at ``[search] amplitude_limit`` × the span
+    (:mod:`~bladecase.study.validity`), and the summary's ``validity`` section (the main model's cuts)."""
+    from .render import tip_amplitude
+    from .validity import blade_span, cut_arcs
+
+    span = blade_span(model)
+    limit = study["search"]["amplitude_limit"] * span
+    out, main_cuts = [], []
+    for n, (r, fams) in enumerate(zip(searched, found)):
+        cut, cuts = cut_arcs(fams, [functools.partial(tip_amplitude, r)] * len(fams), limit)
+        out.append(cut)
+        if n == 0:
+            main_cuts = cuts
+    for c in main_cuts:
+        at = (f"its last orbit within it, T = {c['T_cut']:.8g} s ({1 / c['T_cut']:.6g} Hz)" if c["T_cut"] else
+              "none of its orbits is within it")
+        log.warning("family %d: an admissible arc is cut at the small-displacement limit: the tip moves %.4g mm at "
+                    "T = %.8g s, more than %.4g mm (%g %% of the %.4g mm span); %s", c["family"],
+                    c["tip_amplitude_beyond"] * 1e3, c["T_beyond"], limit * 1e3,
+                    100 * study["search"]["amplitude_limit"], span * 1e3, at)
+    return out, {"span_m": span, "amplitude_limit": study["search"]["amplitude_limit"], "limit_m": limit,
+                 "cuts": main_cuts}
 
 
 def _convergence(study: Study, model, reduced, families, f1: float, animations: list, executor, progress: bool

@@ -223,6 +223,10 @@ SCHEMA: dict[str, dict[str, Key]] = {
                     lambda v: None if 1e-6 <= v <= 1 else "must be in [1e-06, 1] (scaled arclength: impact times / T)"),
         "max_points": Key(_INT, 400, "Cap on continuation points per direction of each family.",
                           _int_between(2, LIMITS["max_points"])),
+        "amplitude_limit": Key(_NUM, 0.05, "Tip amplitude, as a fraction of the blade's span, beyond which a "
+                               "linear-elastic, small-displacement model no longer holds: admissible arcs are cut "
+                               "there (the report says where).",
+                               lambda v: None if 0 < v <= 1 else "must be in (0, 1] (a fraction of the span)"),
     },
     "forcing": FORCING_KEYS,
     "output": {

@@ -274,7 +274,7 @@ class NodalOrbit:
             for closed, sign in ((True, 1.0), (False, -1.0)):
                 for j in np.flatnonzero(A == closed):
                     for i in np.flatnonzero(F[:, j] + slack[j] >= best[closed][j]):
-                        out[closed][j] = max(out[closed][j], _polish(sig, grid, int(i), int(j), sign))
+                        out[closed][j] = max(out[closed][j], _polish(sig, grid, int(i), sign * _unit(m, j))[0])
         lam = np.maximum(out[True], 0.0)
         closed = np.isfinite(out[True])
         e = np.maximum(np.where(closed, np.where(closed, out[True], 0.0) * k_inv, -np.inf), out[False])
@@ -284,6 +284,46 @@ class NodalOrbit:
     def peak_force(self) -> np.ndarray:
         """Largest contact force on each node over the period (N), ``(m,)``."""
         return self._peaks[0]
+
+    @cached_property
+    def _total_peak(self) -> tuple[float, float]:
+        """``(peak Σ_j λ_j, its instant)`` over the period, from the closed phases' force signals: each phase sampled
+        as in :attr:`_peaks`, the grid points within ``(Σ_{j∈A} B₂_j)h²/8`` of the best polished (:func:`_polish`);
+        ``(0, 0)`` when no node touches."""
+        best, when = 0.0, 0.0
+        for _, A, t0, tau, ph, a in self._phase_data():
+            if not A.any():
+                continue
+            sig = ph.signals(a, t0)
+            h = min(sig.step / 4, tau / 8) if np.isfinite(sig.step) else tau / 8
+            grid = np.linspace(0.0, tau, int(min(np.ceil(tau / h), 20000)) + 1)
+            w = A.astype(float)  # the closed nodes' signals are their forces
+            F = sig.values(grid)[0] @ w
+            slack = float(sig.bound @ w) * (grid[1] - grid[0]) ** 2 / 8
+            for i in np.flatnonzero(F + slack >= max(F.max(), best)):
+                value, at = _polish(sig, grid, int(i), w)
+                if value > best:
+                    best, when = value, t0 + at
+        return best, when
+
+    @property
+    def total_force(self) -> float:
+        """Largest total contact force over the period, ``max_t Σ_j λ_j(t)`` (N): the casing's whole load on the
+        face, which converges under mesh refinement where a node's share does not."""
+        return self._total_peak[0]
+
+    @property
+    def total_force_time(self) -> float:
+        """The instant of :attr:`total_force` in ``[0, T)`` (s; 0 when no node touches)."""
+        return self._total_peak[1]
+
+    def loaded_area(self, areas) -> float:
+        """The largest area in contact over the period, ``max over the phases of Σ_{j closed} A_j``, for the nodes'
+        tributary ``areas`` ``(m,)`` (exact: a closed node carries a positive force inside its phase)."""
+        a = np.asarray(areas, dtype=float)
+        if a.shape != (self.system.m,):
+            raise ValueError(f"areas must hold one value per contact node ({self.system.m}), got shape {a.shape}")
+        return float((self.active @ a).max(initial=0.0))
 
     @property
     def peak_displacement(self) -> np.ndarray:
@@ -351,6 +391,7 @@ class NodalOrbit:
                 "mode": self.mode, "q0": self.q0.tolist(), "p0": self.p0.tolist(),
                 "nodes": list(self.system.nodes), "touching": self.touching.tolist(),
                 "contact_fraction": self.contact_fraction.tolist(), "peak_force": self.peak_force.tolist(),
+                "total_force": self.total_force, "total_force_time": self.total_force_time,
                 "peak_displacement": self.peak_displacement.tolist(), "max_tip": self.max_tip,
                 "sequence": [list(s) for s in self.sequence], "starts": self.starts.tolist(),
                 "multipliers": [[float(z.real), float(z.imag)] for z in self.multipliers],
@@ -362,21 +403,29 @@ class NodalOrbit:
                 f"residual {self.residual:.1e})")
 
 
-def _polish(sig, grid: np.ndarray, i: int, j: int, sign: float) -> float:
-    """The largest ``sign·f_j`` between ``grid[i − 1]`` and ``grid[i + 1]``: nested grids of 9 points, each
-    spanning the best point's two neighbours on the previous one (shrinking 4-fold), down to round-off (a
-    derivative root would pick a local minimum where two maxima flank it)."""
+def _unit(m: int, j: int) -> np.ndarray:
+    e = np.zeros(m)
+    e[j] = 1.0
+    return e
+
+
+def _polish(sig, grid: np.ndarray, i: int, w: np.ndarray) -> tuple[float, float]:
+    """The largest ``Σ_j w_j f_j`` between ``grid[i − 1]`` and ``grid[i + 1]`` and where (``(value, τ)``): nested
+    grids of 9 points, each spanning the best point's two neighbours on the previous one (shrinking 4-fold), down
+    to round-off (a derivative root would pick a local minimum where two maxima flank it). ``w = ±e_j``: one signal
+    (or its opposite); ``w`` the closed set's indicator: the total force."""
     lo, hi = float(grid[max(i - 1, 0)]), float(grid[min(i + 1, grid.size - 1)])
-    best = -np.inf
+    best, where = -np.inf, lo
     for _ in range(40):
         ts = np.linspace(lo, hi, 9)
-        vals = sign * sig.values(ts)[0][:, j]
+        vals = sig.values(ts)[0] @ w
         k = int(np.argmax(vals))
-        best = max(best, float(vals[k]))
+        if vals[k] > best:
+            best, where = float(vals[k]), float(ts[k])
         if hi - lo <= 4 * np.finfo(float).eps * max(abs(hi), abs(lo), np.finfo(float).tiny):
             break
         lo, hi = float(ts[max(k - 1, 0)]), float(ts[min(k + 1, 8)])
-    return best
+    return best, where
 
 
 def _deflate(Y: np.ndarray, f: np.ndarray, e: np.ndarray) -> tuple[float, float, np.ndarray]:

@@ -7,7 +7,9 @@ sees the clearance ``g_j(t) = d_j − a cos(n(Ωt + φ_j))``. Starting at rest, 
 ``revolutions`` turns; the last ``window`` turns give the figures an engineer reads — the peak normal
 displacement of each node (m, outwards), the peak contact force on each node (N), the fraction of the
 revolution each node spends in contact, the casing's peak penetration at each node (compliant casing, m), the
-nodes that touch — and whether the response has settled (the window's peaks against the previous window's).
+nodes that touch, the peak of the total force ``Σ_j λ_j`` and the nodes' forces at that instant, and — given the
+nodes' tributary areas — the largest area in contact — and whether the response has settled (the window's peaks
+against the previous window's).
 
 A sweep in speed (:func:`rub_sweep`) runs the speeds through an executor (each speed on its own).
 
@@ -20,6 +22,8 @@ A sweep in speed (:func:`rub_sweep`) runs the speeds through an executor (each s
 ...                  revolutions=30, window=5)
 >>> r.touching, bool(r.peak_force.max() > 0), r.settled
 ((0, 1), True, True)
+>>> bool(r.peak_force.max() <= r.total_force <= r.peak_force.sum()), bool(r.total_force == r.force_at_peak.sum())
+(True, True)
 """
 
 from __future__ import annotations
@@ -56,6 +60,9 @@ class RubResponse:
     switches: int
     settled: bool
     change: float
+    total_force: float = 0.0
+    force_at_peak: np.ndarray | None = None
+    loaded_area: float | None = None
 
     @property
     def touching(self) -> tuple:
@@ -75,19 +82,30 @@ class RubResponse:
 
 
 def _peaks(tr, flight: NodalFlight, t0: float, t1: float, samples: int) -> tuple[np.ndarray, ...]:
+    """Per node over ``[t0, t1]`` (sampled, the switches included): peak normal displacement, force and casing
+    yield; then the nodes' forces at the sample of the largest total force."""
     s = flight.system
     t = np.unique(np.r_[np.linspace(t0, t1, samples), tr.starts[(tr.starts >= t0) & (tr.starts <= t1)]])
     x, _, lam = tr.sample(t)
     u = s.W.T @ x - s.flexibility @ lam  # the nodes' own normal displacements
     pen = lam / s.casing[:, None]
-    return u.max(axis=1), lam.max(axis=1), pen.max(axis=1)
+    return u.max(axis=1), lam.max(axis=1), pen.max(axis=1), lam[:, int(np.argmax(lam.sum(axis=0)))]
+
+
+def _loaded_area(tr, areas: np.ndarray, t0: float, t1: float) -> float:
+    """The largest ``Σ_{j closed} A_j`` over the phases that overlap ``[t0, t1]`` (exact: from the phases)."""
+    ends = np.r_[tr.starts[1:], tr.t_end]
+    live = (ends > t0) & (tr.starts < t1)
+    return float((tr.active[live] @ areas).max(initial=0.0))
 
 
 def rub_response(system: NodalSystem, speed: float, lobes: int, amplitude: float, angles, damping=None,
-                 revolutions: int = 40, window: int = 10, max_switches: int = 2_000_000) -> RubResponse:
+                 revolutions: int = 40, window: int = 10, max_switches: int = 2_000_000,
+                 areas=None) -> RubResponse:
     """The rub response at ``speed`` (rad/s) from rest, over ``revolutions`` turns, read on the last ``window``
     (module docstring). ``angles``: each contact node's angle about the engine axis (rad); ``damping``: a
-    :class:`~bladecase.nsm.damping.Damping` of the open-phase modes (``None``: undamped)."""
+    :class:`~bladecase.nsm.damping.Damping` of the open-phase modes (``None``: undamped); ``areas``: each node's
+    tributary area (m², ``(m,)``) for the largest loaded area (``loaded_area``; ``None`` without)."""
     if isinstance(revolutions, bool) or int(revolutions) != revolutions or revolutions < 2:
         raise ValueError(f"revolutions must be an integer >= 2, got {revolutions!r}")
     if isinstance(window, bool) or int(window) != window or not 1 <= window <= revolutions // 2:
@@ -112,8 +130,15 @@ def rub_response(system: NodalSystem, speed: float, lobes: int, amplitude: float
     scale = max(float(np.abs(now[0]).max()), float(system.gap.max()))
     change = float(max(np.abs(now[0] - before[0]).max() / scale,
                        np.abs(now[1] - before[1]).max() / max(float(now[1].max()), 1e-300)))
+    loaded = None
+    if areas is not None:
+        areas = np.asarray(areas, dtype=float)
+        if areas.shape != (system.m,):
+            raise ValueError(f"areas must hold one value per contact node ({system.m}), got shape {areas.shape}")
+        loaded = _loaded_area(tr, areas, end - window * turn, end)
     return RubResponse(speed, int(lobes), float(amplitude), int(revolutions), int(window), system.nodes, now[0],
-                       now[1], fraction, now[2], int(tr.switch_times.size), change <= SETTLED_RTOL, change)
+                       now[1], fraction, now[2], int(tr.switch_times.size), change <= SETTLED_RTOL, change,
+                       float(now[3].sum()), now[3], loaded)
 
 
 def _one(args) -> RubResponse:

@@ -59,8 +59,8 @@ def verdict(summary: dict, modes: dict | str | os.PathLike | None = None) -> dic
     ...      "reference": None, "search": {"ipp": [1], "periods": [0.5, 0.6], "period_unit": "T1",
     ...      "period_unit_s": 0.01}, "families": [], "files": {"animations": []}}
     >>> v = verdict(s)
-    >>> v["reasons"]
-    ['no_family_in_range', 'grazing_outside_range']
+    >>> v["reasons"]   # and no [convergence] in the summary: the mesh error is not measured
+    ['no_family_in_range', 'mesh_error_unknown', 'grazing_outside_range']
     >>> print(v["found"].replace(": ", ":\\n"))
     No nonsmooth mode in the searched periods [0.5, 0.6] × T1 (= [0.005, 0.006] s):
     the search found no family of orbits with one contact phase per period there.

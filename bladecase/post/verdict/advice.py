@@ -5,7 +5,16 @@ from __future__ import annotations
 import math
 
 from .base import _Base
-from .words import GRAZING_RTOL, NARROW_RTOL, RESONANCE_NEAR, STIFF_CASING, WEAK_B2, _modes_words, rejected_words
+from .words import (
+    GRAZING_RTOL,
+    NARROW_RTOL,
+    RESONANCE_NEAR,
+    STIFF_CASING,
+    WEAK_B2,
+    _length,
+    _modes_words,
+    rejected_words,
+)
 
 
 class _Next(_Base):
@@ -210,6 +219,13 @@ class _Next(_Base):
             if casing:
                 self.code("stiff_casing")
                 steps.append(casing)
+        v = self.s.get("validity") or {}
+        if self.fams and v.get("cuts") and not steps:
+            steps.append(f"Every admissible orbit found moves the tip more than {_length(v['limit_m'])} "
+                         f"({100 * v['amplitude_limit']:g} % of the span), where the linear-elastic, small-"
+                         "displacement model no longer holds: this mode exists here only at amplitudes the model "
+                         "cannot follow. A larger limit (`[search] amplitude_limit`) is for a blade that really "
+                         "moves that far elastically.")
         if not steps:
             self.code("no_reason_in_data")
             j = strong[0]

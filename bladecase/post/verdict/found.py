@@ -37,6 +37,13 @@ class _Found(_Base):
             lo, hi = min(ends), max(ends)
             j = self.grown_from(lo, hi)
             at = f" at {_freq_span(lo, hi)} Hz" + (f", {self.where(lo, hi, j)}" if j is not None else "")
+        v = self.s.get("validity") or {}
+        if v.get("cuts"):  # admissible orbits, but all beyond the small-displacement limit
+            self.code("cut_at_amplitude_limit")
+            return (f"No admissible nonsmooth mode within the small-displacement limit in the searched periods "
+                    f"{where}: {_plural(len(self.fams), 'family', 'families')} of orbits with {what}{at}, whose "
+                    f"admissible orbits all move the tip more than {_length(v['limit_m'])} "
+                    f"({100 * v['amplitude_limit']:g} % of the span).")
         text = (f"No admissible nonsmooth mode in the searched periods {where}: "
                 f"{_plural(len(self.fams), 'family', 'families')} of orbits with {what}{at}, none of "
                 f"{'its' if len(self.fams) == 1 else 'their'} {n_orbits} orbits admissible")

@@ -48,6 +48,7 @@ class _Trust(_Base):
         self._comparison(facts, doubts)
         self._mesh(facts, doubts)
         self._tip(limits, doubts)
+        self._small_displacements(limits)
         body = "; ".join(facts + doubts)
         if self.main is None:
             head = "Nothing to verify (no admissible orbit)"
@@ -239,6 +240,15 @@ class _Trust(_Base):
         fine = [f"{f['words']} {_pct(f['error'])} %" for f in figures.values() if not f["flag"]]
         if fine:
             facts.append(f"the mesh error (Richardson over meshes {meshes}) of {_and(fine)}")
+
+    def _small_displacements(self, limits: list) -> None:
+        v = self.s.get("validity") or {}
+        if not v.get("cuts"):
+            return
+        self.code("cut_at_amplitude_limit")
+        limits.append(f"{'t' if not limits else 'T'}he arcs end where the tip moves more than {_length(v['limit_m'])} "
+                      f"({100 * v['amplitude_limit']:g} % of the span): beyond, a linear-elastic small-displacement "
+                      "model does not hold.")
 
     def _tip(self, limits: list, doubts: list) -> None:
         """The face mean's own limit: nodes of the face beyond the clearance. Past :data:`TIP_BEYOND_RTOL` of the

@@ -1,0 +1,83 @@
+"""Where the model stops being the blade: the small-displacement limit of the nonsmooth modes' arcs.
+
+The FE model is linear elastic about an undeformed blade (small displacements), and the contact model adds only the
+casing. Followed far enough, a family reaches energies no blade survives — tip amplitudes of a large part of the span
+— and its figures stop meaning anything. A study cuts every admissible arc at ``[search] amplitude_limit`` (a
+fraction of the blade's span, 5 % by default: a cantilever's linear tip deflection is within about 0.6 % of the
+large-deflection (elastica) answer up to 10 % of the span, so 5 % leaves a margin for twisted and plate-like
+blades): an orbit whose tip amplitude (the largest ``|u|`` of a contact node
+over the period, :func:`~bladecase.study.render.orbit_engineering`) exceeds it is not part of an arc, and the report
+says where each arc was cut and why. The span is the distance from the clamp's centroid to the farthest node.
+
+>>> from bladecase.nsm import backbone, chain
+>>> branch = backbone(chain(2, k=1.0, m=0.5, gap=1.0), [4.0, 4.5, 5.0, 5.5, 6.0, 6.5, 7.0])
+>>> [(a.start, a.stop) for a in branch.arcs]
+[(0, 2), (4, 6)]
+>>> cut, cuts = cut_arcs([branch], [lambda o: 10.0 / o.T], limit=2.0)   # "amplitude" 10/T: above 2 for T < 5
+>>> [(a.start, a.stop, a.T_lo, a.refined_lo) for a in cut[0].arcs]       # the first arc now starts at T = 5
+[(2, 2, 5.0, False), (4, 6, 5.650148507207632, True)]
+>>> cuts[0]["T_cut"], cuts[0]["T_beyond"], cuts[0]["tip_amplitude_beyond"]
+(5.0, 4.5, 2.2222222222222223)
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+__all__ = ["blade_span", "cut_arcs"]
+
+
+def blade_span(model) -> float:
+    """The blade's span (m): the distance from the centroid of its clamped nodes to the farthest node."""
+    points = model.mesh.points
+    clamped = np.unique(np.asarray(model.clamped, dtype=int)) if model.clamped is not None else np.array([], int)
+    root = points[clamped].mean(axis=0) if clamped.size else points.min(axis=0)
+    return float(np.linalg.norm(points - root, axis=1).max())
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """``(first, last)`` of each run of ``True`` in ``mask``."""
+    edges = np.diff(np.concatenate([[0], mask.astype(int), [0]]))
+    return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1))
+
+
+def cut_arcs(families: Sequence, amplitudes: Sequence[Callable], limit: float) -> tuple[list, list[dict]]:
+    """Every family's arcs cut where ``amplitude(orbit) > limit`` (one function per family, its model's); returns the
+    families with their cut arcs and one record per cut (family, the first orbit beyond: its period and amplitude).
+    An arc's end that is kept keeps its refined period; a new end is the last orbit within the limit (not refined)."""
+    out, cuts = [], []
+    for i, (fam, amplitude) in enumerate(zip(families, amplitudes)):
+        arcs = []
+        for arc in fam.arcs:
+            index = np.arange(arc.start, arc.stop + 1)
+            orbits = [fam.orbits[j] for j in index]
+            values = np.array([amplitude(o) if o is not None and o.admissible else np.nan for o in orbits])
+            within = ~(values > limit)  # nan (not admissible, or no orbit): left as the arc had it
+            if within.all():
+                arcs.append(arc)
+                continue
+            onset = int(np.nanargmin(np.where(within, np.nan, values)))  # the least amplitude beyond the limit
+            kept = np.flatnonzero(within & np.isfinite(values))
+            edge = int(kept[np.argmin(np.abs(kept - onset))]) if kept.size else None
+            cuts.append({"family": i, "ipp": int(fam.k), "T_beyond": float(orbits[onset].T),
+                         "tip_amplitude_beyond": float(values[onset]),
+                         "T_cut": None if edge is None else float(orbits[edge].T),
+                         "tip_amplitude_cut": None if edge is None else float(values[edge])})
+            for a, b in _runs(within):
+                arcs.append(_sub_arc(fam, arc, int(index[a]), int(index[b])))
+        out.append(dataclasses.replace(fam, arcs=arcs) if arcs != fam.arcs else fam)
+    return out, cuts
+
+
+def _sub_arc(fam, arc, start: int, stop: int):
+    """The part ``start..stop`` of ``arc``: its periods from the orbits, the original (refined) ends where kept."""
+    T = np.array([fam.orbits[j].T for j in range(start, stop + 1)])
+    whole = np.array([fam.orbits[j].T for j in range(arc.start, arc.stop + 1)])
+    keep_lo, keep_hi = T.min() == whole.min(), T.max() == whole.max()
+    return dataclasses.replace(
+        arc, start=start, stop=stop, T_lo=arc.T_lo if keep_lo else float(T.min()),
+        T_hi=arc.T_hi if keep_hi else float(T.max()), refined_lo=bool(arc.refined_lo and keep_lo),
+        refined_hi=bool(arc.refined_hi and keep_hi))
