@@ -53,8 +53,10 @@ def tip_excursion(reduced, orbit, samples: int = SAMPLES) -> dict | None:
             "nodes": int(nodes.size)}
 
 
-def words(x: dict) -> str:
-    """The excursion in a sentence: what the face mean does, and what its nodes do."""
+def words(x: dict, nodes: bool = False) -> str:
+    """The excursion in a sentence: what the face mean does, and what its nodes do; ``nodes``: the study computes
+    the mode with every node a contact too (``[contact] points = "nodes"``), so the sentence points there instead
+    of advising it."""
     um = 1e6
     mean = x["mean_max_m"] * um
     mean_words = (f"the face mean goes {mean:.0f} µm beyond the {x['clearance_m'] * um:.0f} µm clearance" if mean > 0.5
@@ -65,5 +67,6 @@ def words(x: dict) -> str:
     return (f"{mean_words}, but {x['nodes_beyond']} of its {x['nodes']} nodes pass the clearance, node "
             f"{x['node_id']} (at {', '.join(f'{c:.4g}' for c in x['position_mm'])} mm) by "
             f"{x['node_max_m'] * um:.0f} µm at t/T = {x['t_over_T']:.3f}: the casing sees the face's mean only, so "
-            "where and how hard the tip rubs is not resolved by this contact model ([contact] points = \"nodes\" "
-            "makes every node a contact)")
+            "where and how hard the tip rubs is not resolved by this contact model"
+            + (" — the mode with every node a contact, computed beside it, resolves it" if nodes else
+               " ([contact] points = \"nodes\" makes every node a contact)"))

@@ -67,6 +67,7 @@ def write_time_series(
     *,
     point_data: dict[str, np.ndarray] | None = None,
     field_data: dict[str, float] | None = None,
+    frame_data: dict[str, np.ndarray] | None = None,
 ) -> Path:
     """Write a time series of fields on ``mesh`` as a ParaView ``.pvd`` collection of ``.vtu`` frames.
 
@@ -92,6 +93,10 @@ def write_time_series(
     field_data : dict[str, float], optional
         Finite real scalars recorded in every frame (e.g. ``period``,
         ``energy``).
+    frame_data : dict[str, array_like], optional
+        Extra per-node scalars that change from frame to frame,
+        ``(n_nodes, F)`` (e.g. each contact node's gap to the casing and
+        its contact pressure; NaN where a node has none).
 
     Returns
     -------
@@ -153,6 +158,9 @@ def write_time_series(
     extra = _check_point_data(point_data, (n_nodes,), "(n_nodes,) or (n_nodes, c)", TIME_SERIES_ARRAYS,
                               reserved_prefix=GROUP_PREFIX)
     scalars = _check_field_data(field_data)
+    varying = _check_point_data(frame_data, (n_nodes, n_frames), "(n_nodes, n_frames)", TIME_SERIES_ARRAYS
+                                + tuple(extra), reserved_prefix=GROUP_PREFIX)
+    varying = {name: np.asarray(a, dtype=float) for name, a in varying.items()}
     target = directory / stem
     if target.exists() and not target.is_dir():
         raise ValueError(f"cannot write the frames of stem {stem!r}: {target} exists and is not a folder")
@@ -177,7 +185,8 @@ def write_time_series(
             grid.point_data.clear()
             grid.field_data.clear()
             for name, a in {"displacement": disp, "velocity": vel,
-                            "displacement_magnitude": np.sqrt(np.einsum("ij,ij->i", disp, disp)), **constant}.items():
+                            "displacement_magnitude": np.sqrt(np.einsum("ij,ij->i", disp, disp)), **constant,
+                            **{name: a[:, j] for name, a in varying.items()}}.items():
                 grid.point_data[name] = a
             for name, x in {"time": float(times[j]), **scalars}.items():
                 grid.field_data[name] = np.array([x], dtype=np.int64 if isinstance(x, int) else float)

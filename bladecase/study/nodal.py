@@ -73,12 +73,12 @@ def _face_penetration(reduced, contact, model, family) -> tuple[np.ndarray, np.n
 REFERENCE_CHECKS = 5
 
 
-def _reference_checks(study, nodal, orbits, factor) -> dict | None:
-    """Up to :data:`REFERENCE_CHECKS` orbits checked in the nodal model's Krylov extension (``REFERENCE_FACTOR`` ×
-    its dofs; :func:`~bladecase.study.reference.check_nodal_in_reference`), when ``[output] reference``."""
-    if not study["output"]["reference"] or not orbits:
+def _reference_checks(study, nodal, orbits, reference) -> dict | None:
+    """Up to :data:`REFERENCE_CHECKS` orbits checked in the nodal model's Krylov extension ``reference``
+    (``REFERENCE_FACTOR`` × its dofs; :func:`~bladecase.study.reference.check_nodal_in_reference`), when
+    ``[output] reference``."""
+    if reference is None or not orbits:
         return None
-    reference = nodal_extension(nodal, REFERENCE_FACTOR * nodal.n, factor)
     picked = np.unique(np.linspace(0, len(orbits) - 1, min(REFERENCE_CHECKS, len(orbits))).round().astype(int))
     drifts, survived, name = {}, [], f"{reference.method} ({reference.n} dofs)"
     for n in picked:
@@ -97,27 +97,34 @@ def _reference_checks(study, nodal, orbits, factor) -> dict | None:
             "drifts": drifts}
 
 
+def _row(nodal, o) -> dict:
+    """An orbit's figures (a row of ``nodal_modes.csv`` but its reference drift)."""
+    pen = np.asarray(o.penetration)
+    return {"frequency_hz": float(o.frequency), "period_s": float(o.T), "energy_j": float(o.energy),
+            "nodes_touching": int(len(o.touching_nodes)),
+            "touching_nodes": " ".join(str(n) for n in o.touching_nodes),
+            **orbit_load(nodal, o),
+            "max_contact_fraction": float(np.max(o.contact_fraction)),
+            "max_penetration_mm": float(np.max(pen)) * 1e3 if np.isfinite(pen).all() else 0.0,
+            "max_tip_mm": float(o.max_tip) * 1e3, "stable": bool(o.stable()), "residual": float(o.residual)}
+
+
 def nodal_stage(study, model, contact, families, reduced, *, factor=None, folder: str | Path | None = None,
-                figures: bool = True, title: str | None = None) -> dict:
+                figures: bool = True, title: str | None = None, target_energy: float | None = None) -> dict:
     """The nonsmooth mode with one contact per face node of ``contact`` on ``model`` (module docstring), beside
     the study's face-mean ``families`` on ``reduced``; writes ``nodal_modes.csv`` (and ``nodal_modes.png``) into
-    ``folder``; returns the summary section."""
+    ``folder`` and, with ``[output] formats``, animates the family's orbit nearest in energy to ``target_energy``
+    (the face mean's animated orbit's; :func:`~bladecase.study.nodal_render.animate_nodal`); returns the summary
+    section (its animations under ``"animations"``)."""
     size = study["reduction"]["size"] or 8
     nodal = nodal_model(model, contact, size, factor=factor, residual=True)
     fam = nodal_family(nodal.system, 0)
     orbits = fam.orbits
-    checks = _reference_checks(study, nodal, orbits, factor)
-    rows = []
-    for n, o in enumerate(orbits):
-        pen = np.asarray(o.penetration)
-        rows.append({"frequency_hz": float(o.frequency), "period_s": float(o.T), "energy_j": float(o.energy),
-                     "nodes_touching": int(len(o.touching_nodes)),
-                     "touching_nodes": " ".join(str(n) for n in o.touching_nodes),
-                     **orbit_load(nodal, o),
-                     "max_contact_fraction": float(np.max(o.contact_fraction)),
-                     "max_penetration_mm": float(np.max(pen)) * 1e3 if np.isfinite(pen).all() else 0.0,
-                     "max_tip_mm": float(o.max_tip) * 1e3, "stable": bool(o.stable()), "residual": float(o.residual),
-                     "reference_drift": (checks["drifts"].get(n) if checks else None)})
+    reference = (nodal_extension(nodal, REFERENCE_FACTOR * nodal.n, factor) if study["output"]["reference"]
+                 and orbits else None)
+    checks = _reference_checks(study, nodal, orbits, reference)
+    rows = [dict(_row(nodal, o), reference_drift=(checks["drifts"].get(n) if checks else None))
+            for n, o in enumerate(orbits)]
     stable = [r["stable"] for r in rows]
     section = {
         "size": size, "contact_nodes": nodal.system.m, "reduced_dofs": nodal.system.n,
@@ -143,6 +150,10 @@ def nodal_stage(study, model, contact, families, reduced, *, factor=None, folder
              ", ".join(section["first_touch_nodes"]), section["frequency_range_hz"][1] if rows else np.nan, fam.stop)
     if folder is not None:
         folder = Path(folder)
+        from .nodal_render import animate_nodal
+
+        section["animations"] = animate_nodal(study, nodal, fam, folder, target_energy, reference,
+                                              lambda o: _row(nodal, o))
         lines = [",".join(COLUMNS)] + [",".join(_cell(r[c]) for c in COLUMNS) for r in rows]
         write_text(folder / "nodal_modes.csv", "\n".join(lines) + "\n")
         section["files"] = {"csv": "nodal_modes.csv"}

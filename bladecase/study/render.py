@@ -89,7 +89,7 @@ def render(study: Study, reduced: ReducedModel, families: list[Branch], choice: 
     excursion = tip_excursion(reduced, orbit)
     if excursion is not None:
         entry["tip_excursion"] = excursion
-        entry["tip_excursion"]["words"] = tip_words(excursion)
+        entry["tip_excursion"]["words"] = tip_words(excursion, nodes=study["contact"].get("points") == "nodes")
         if excursion["nodes_beyond"]:
             log.warning("orbit T = %.8g s: %s", orbit.T, entry["tip_excursion"]["words"])
     stability = orbit_stability(orbit)

@@ -285,9 +285,12 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         with stage("nodes"):
             from .nodal import nodal_stage
 
+            anims = files["animations"]
             nodal = nodal_stage(study, model, contact, families, reduced, factor=factor, folder=staging,
-                                figures="png" in o["formats"], title=study.name)
+                                figures="png" in o["formats"], title=study.name,
+                                target_energy=anims[0]["energy_j"] if anims else None)
             files.update({f"nodal_{k}": v for k, v in nodal.pop("files").items()})
+            files["nodal_animations"] = nodal.pop("animations", [])
     sweep = None
     if casing_sweep_values(study):
         with stage("casing"):

@@ -101,10 +101,15 @@ class OrbitScene:
     #: (``(k,)``, ``(k, n_frames)``; ``None``: a one-node contact).
     face_points: np.ndarray | None = None
     face_beyond: np.ndarray | None = None
+    #: Extra point data of the VTK frames: constant ``(n_points,)`` and per frame ``(n_points, n_frames)``.
+    point_data: dict | None = None
+    frame_data: dict | None = None
+    #: The clearance drawn at ``contact_node`` (m); ``None``: the orbit's system's gap.
+    casing_gap: float | None = None
 
     @property
     def gap(self) -> float:
-        return self.orbit.system.gap
+        return self.orbit.system.gap if self.casing_gap is None else self.casing_gap
 
     @property
     def contact_displacement(self) -> np.ndarray:

@@ -17,7 +17,8 @@ from .registry import OrbitScene
 def write(scene: OrbitScene, folder: Path, formats: set[str]) -> dict[str, str]:
     orbit = scene.orbit
     pvd = write_time_series(folder / "vtk", scene.stem, scene.mesh, scene.times, scene.u, scene.v,
-                            field_data={"period": orbit.T, "energy": orbit.energy, "scale": scene.scale})
+                            field_data={"period": orbit.T, "energy": orbit.energy, "scale": scene.scale},
+                            point_data=scene.point_data, frame_data=scene.frame_data)
     written = {"pvd": f"vtk/{pvd.name}"}
     o = scene.options
     if o.get("manifold") and scene.branch is not None:

@@ -44,6 +44,7 @@ class _Trust(_Base):
                 else:
                     facts_or_doubts = "no orbit was animated, so none was re-simulated"
                 doubts.append(facts_or_doubts)
+        self._nodal_checks(facts)
         self._reduced_vs_fe(facts, doubts)
         self._comparison(facts, doubts)
         self._mesh(facts, doubts)
@@ -221,6 +222,15 @@ class _Trust(_Base):
             self.code("energies_scatter")
             at, lo, hi = spread
             doubts.append(f"the compared models' energies at {at} range from {lo:.3g} to {hi:.3g} J")
+
+    def _nodal_checks(self, facts: list) -> None:
+        """The checks of the animated orbit of the mode with every face node a contact."""
+        for a in (self.s.get("files") or {}).get("nodal_animations") or []:
+            ref = a.get("reference_check") or {}
+            facts.append(f"the animated every-node orbit ({a['nodes_touching']} nodes touching) re-simulates back to "
+                         f"itself to {a['verification']['return_error']:.1e}"
+                         + (f" and survives in {ref['reference']} ({ref['drift']:.1e})" if ref.get("drift") is not None
+                            else ""))
 
     def _mesh(self, facts: list, doubts: list) -> None:
         """The mesh error of the headline figures, measured by ``[convergence]`` (else only a reason code)."""
