@@ -120,3 +120,14 @@ def test_the_every_node_orbit_is_animated_checked_and_its_frames_show_the_casing
     assert "- every face node a contact, T = " in text and "`casing_yield`" in text
     assert "the animated every-node orbit" in res.summary["verdict"]["trust"]
     assert 'points = "nodes" makes every node a contact' not in (out / "run.log").read_text()
+
+
+def test_the_every_node_orbit_is_checked_in_a_reference_converged_in_size(nodal_run):
+    """The FE model's drift of the animated every-node orbit, from nested Krylov extensions of 4, 8, 16 × the nodal
+    model's dofs: the estimate has settled (its change is a small part of it) and is well inside survival."""
+    res, out = nodal_run
+    (a,) = res.summary["files"]["nodal_animations"]
+    full = a["full_model_check"]
+    assert full["dofs"] == sorted(full["dofs"]) and len(full["dofs"]) == 3
+    assert full["drift"] < 5e-3 and full["bound"] < 0.1 * full["drift"]
+    assert "In the FE model (a reference converged in size" in (out / "report.md").read_text()

@@ -201,6 +201,11 @@ def _nodal_animation_words(anims: list[dict]) -> list[str]:
                      f"returns to it to {check['return_error']:.1e}"
                      + (f", and in the reference model {ref['reference']} to {ref['drift']:.1e}" if ref.get("drift")
                         is not None else "") + f"): {what}")
+        full = a.get("full_model_check") or {}
+        if full.get("drift") is not None:
+            lines.append(f"  - In the FE model (a reference converged in size: {', '.join(map(str, full['dofs']))} "
+                         f"dofs) it comes back within {full['drift']:.2e} after one period (energy norm), to "
+                         f"±{full['bound']:.1e}.")
         lines.append(f"  - Casing: the largest penetration {a['max_penetration_mm'] * 1e3:.4g} µm (the frames show "
                      f"{a['frames_max_penetration_mm'] * 1e3:.4g} µm), contact pressure up to "
                      f"{a.get('max_pressure_mpa', float('nan')):.3g} MPa, total force {a.get('total_force_n', 0):.4g} N"

@@ -153,7 +153,8 @@ def nodal_stage(study, model, contact, families, reduced, *, factor=None, folder
         from .nodal_render import animate_nodal
 
         section["animations"] = animate_nodal(study, nodal, fam, folder, target_energy, reference,
-                                              lambda o: _row(nodal, o))
+                                              lambda o: _row(nodal, o),
+                                              extend=lambda count: nodal_extension(nodal, count, factor))
         lines = [",".join(COLUMNS)] + [",".join(_cell(r[c]) for c in COLUMNS) for r in rows]
         write_text(folder / "nodal_modes.csv", "\n".join(lines) + "\n")
         section["files"] = {"csv": "nodal_modes.csv"}
