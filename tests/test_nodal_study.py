@@ -119,7 +119,10 @@ def test_the_every_node_orbit_is_animated_checked_and_its_frames_show_the_casing
     text = (out / "report.md").read_text()
     assert "- every face node a contact, T = " in text and "`casing_yield`" in text
     assert "the animated every-node orbit" in res.summary["verdict"]["trust"]
-    assert 'points = "nodes" makes every node a contact' not in (out / "run.log").read_text()
+    log = (out / "run.log").read_text()
+    assert 'points = "nodes" makes every node a contact' not in log
+    # what each node's casing is: the face's 1e6 N/m shared by area, i.e. a stiffness per unit area
+    assert "the casing's 1e+06 N/m shared by the nodes' tributary areas (the face's 103.2 mm²) is 9.689e+09 N/m³" in log
 
 
 def test_the_every_node_orbit_is_checked_in_a_reference_converged_in_size(nodal_run):

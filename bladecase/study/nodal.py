@@ -97,6 +97,18 @@ def _reference_checks(study, nodal, orbits, reference) -> dict | None:
             "drifts": drifts}
 
 
+def _log_casing(nodal) -> None:
+    """What casing each node gets: the face's stiffness shared by tributary area is a stiffness per unit area."""
+    k = np.asarray(nodal.system.casing, dtype=float)
+    if not np.isfinite(k).all() or not (nodal.areas > 0).any():
+        return
+    has = nodal.areas > 0
+    per_area = k[has] / nodal.areas[has]
+    log.info("every face node a contact: the casing's %.4g N/m shared by the nodes' tributary areas (the face's "
+             "%.4g mm²) is %.4g N/m³; each node gets %.4g to %.4g N/m", k.sum(), nodal.areas.sum() * 1e6,
+             float(np.median(per_area)), k.min(), k.max())
+
+
 def _row(nodal, o) -> dict:
     """An orbit's figures (a row of ``nodal_modes.csv`` but its reference drift)."""
     pen = np.asarray(o.penetration)
@@ -118,6 +130,7 @@ def nodal_stage(study, model, contact, families, reduced, *, factor=None, folder
     section (its animations under ``"animations"``)."""
     size = study["reduction"]["size"] or 8
     nodal = nodal_model(model, contact, size, factor=factor, residual=True)
+    _log_casing(nodal)
     fam = nodal_family(nodal.system, 0)
     orbits = fam.orbits
     reference = (nodal_extension(nodal, REFERENCE_FACTOR * nodal.n, factor) if study["output"]["reference"]
