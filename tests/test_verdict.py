@@ -80,12 +80,20 @@ def test_demo_finds_a_stiffening_mode_and_trusts_it_with_care(demo):
     summary, text = demo
     v = summary["verdict"]
     _check(v)
-    assert v["reasons"][:4] == ["mode_found", "verified", "reference_survived", "reduced_model_matches_fe"]
+    assert v["reasons"][:5] == ["mode_found", "band_to_tongue", "verified", "reference_survived",
+                                "reduced_model_matches_fe"]
     assert not {"verification_failed", "reference_failed", "not_animated", "no_reference_check"} & set(v["reasons"])
     arc = summary["families"][0]["admissible_arcs"][0]
     f1 = summary["reduction"]["frequencies_hz"][0]
+    # the band is quoted up to the 8:1 tongue of mode 3 (its place moves with the mesh), the arc's top beyond it
+    t = arc["tongue"]
+    assert (t["mode"], round(t["ratio"]), t["own_mode"]) == (3, 8, 1) and t["own_share"] < 0.9
+    assert arc["backbone_f_lo"] == arc["f_lo"] and arc["backbone_f_hi"] < t["frequency_hz"] < arc["f_hi"]
     assert v["found"].startswith(f"A stiffening nonsmooth mode of mode 1 (one contact phase per period): "
-                                 f"{arc['f_lo']:.1f} → {arc['f_hi']:.1f} Hz (from grazing to ")
+                                 f"{arc['f_lo']:.1f} → {arc['backbone_f_hi']:.1f} Hz (from grazing to ")
+    assert "up to the tongue of the internal resonance 8:1 with mode 3" in v["found"]
+    assert "band_to_tongue" in v["reasons"]
+    assert f"**Family 0 enters a resonance tongue at {t['frequency_hz']:.2f} Hz**" in text
     assert f"above the linear frequency of mode 1, {f1:.1f} Hz" in v["found"]
     lo, hi = arc["tip_amplitude_range_mm"]
     assert f"tip amplitude {lo:.3g}–{hi:.3g} mm" in v["found"]

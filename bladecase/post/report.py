@@ -126,6 +126,7 @@ def report(summary: dict) -> str:
                          f"{'—' if stable is None else f'{stable:.0%} of its orbits'} |")
     lines += _arc_engineering_table(with_arcs, massless)
     lines += [w for i, f in with_arcs if (w := _resonance_words(i, f))]
+    lines += [w for i, f in with_arcs for a in f["admissible_arcs"] if (w := _tongue_words(i, a))]
     narrow = narrow_words(summary)
     if narrow:
         lines += ["", f"**Narrow:** {narrow}."]
@@ -338,8 +339,9 @@ def _arc_engineering_table(with_arcs: list, massless: bool) -> list[str]:
         return "—" if lo is None else f"{lo * scale:{fmt}} – {hi * scale:{fmt}}"
 
     for i, a in rows:
-        cells = [str(i), f"{a['f_lo']:.4f} – {a['f_hi']:.4f}", str(a["engineering_orbits"]),
-                 span(a, "tip_amplitude_range_mm")]
+        band = (f"{a['f_lo']:.4f} – {a['f_hi']:.4f}" if "tongue" not in a else
+                f"{a['backbone_f_lo']:.4f} – {a['backbone_f_hi']:.4f} (backbone; to {a['f_hi']:.4f} in a tongue)")
+        cells = [str(i), band, str(a["engineering_orbits"]), span(a, "tip_amplitude_range_mm")]
         if massless:
             cells += [span(a, "contact_force_range_n"), span(a, "contact_fraction_range", 100, ".3g")]
             cells += [span(a, "casing_penetration_range_m", 1e6)] * casing
@@ -362,6 +364,20 @@ def _resonance_words(index: int, fam: dict) -> str | None:
             f"({res['mode_frequency_hz']:.1f} Hz, {res['ratio']:.2f} × the orbit's frequency: near the "
             f"{round(res['ratio'])}:1 resonance). Read the backbone below that frequency; the energies next to it "
             "are the exchange with that mode.")
+
+
+def _tongue_words(index: int, arc: dict) -> str | None:
+    """Where an admissible arc enters an internal-resonance tongue, and that its figures are read below it."""
+    t = arc.get("tongue")
+    if not t:
+        return None
+    return (f"\n**Family {index} enters a resonance tongue at {t['frequency_hz']:.2f} Hz** "
+            f"(E = {t['energy_j']:.3g} J): "
+            f"there its own mode {t['own_mode']} holds {t['own_share']:.0%} of the energy and mode {t['mode']} "
+            f"({t['mode_frequency_hz']:.1f} Hz, {t['ratio']:.2f} × the orbit's frequency: the {round(t['ratio'])}:1 "
+            f"resonance) takes the rest. The arc's figures above are read on its backbone, "
+            f"{arc['backbone_f_lo']:.2f}–{arc['backbone_f_hi']:.2f} Hz: the tongue's place and its figures move with "
+            "the mesh (the higher mode's frequency does).")
 
 
 def _counterpart(mt: dict | None) -> str:

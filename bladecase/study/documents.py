@@ -22,6 +22,14 @@ from ..fe import FEModel, Mesh
 from ..fe.select import held_nodes
 from ..nsm import Branch, LinearSystem, MasslessSystem, PeriodicOrbit
 from ..reduction import Contact, ReducedModel
+from .arc_figures import (  # noqa: F401 (ENGINEERING_*, TONGUE_SHARE: documented here before)
+    ENGINEERING_RANGES,
+    ENGINEERING_SAMPLES,
+    TONGUE_SHARE,
+    _arc_picks,
+    _backbone,
+    _range,
+)
 
 #: Largest scale-free residual of an orbit's equations (impact conditions ``ΠΛ = 0``, ``ΣΛ = d``; the massless
 #: closing conditions) accepted when a modes file is read back: solved orbits are at round-off (~1e-13).
@@ -287,12 +295,6 @@ def _check_arcs(fam: Branch, i: int, where: str) -> None:
                              "which is not admissible: an arc spans admissible orbits only")
 
 
-def _range(values: np.ndarray) -> list[float | None]:
-    """``[min, max]`` of the finite values; ``[None, None]`` (JSON ``null``: no value) when there is none."""
-    values = values[np.isfinite(values)]
-    return [float(values.min()), float(values.max())] if values.size else [None, None]
-
-
 def family_summary(fam: Branch, engineering=None) -> dict:
     """Period, frequency and energy ranges of a branch, and its admissible arcs (each with the share of its orbits
     that are linearly stable, :func:`stability_records`).
@@ -315,7 +317,7 @@ def family_summary(fam: Branch, engineering=None) -> dict:
              "energy_range_j": _range(E[a.start:a.stop + 1][fam.admissible[a.start:a.stop + 1]]),
              "refined_lo": bool(a.refined_lo), "refined_hi": bool(a.refined_hi),
              "stable_fraction": _stable_fraction(records[a.start:a.stop + 1]),
-             **({} if engineering is None else _arc_engineering(fam, a, engineering))} for a in fam.arcs
+             **_backbone(fam, a, engineering)} for a in fam.arcs
         ],
     }
     out["resonance"] = _resonance(fam, E)
@@ -352,10 +354,6 @@ STABILITY_DOFS = 100
 #: Orbits per admissible arc whose Floquet multipliers are computed on a system above :data:`STABILITY_DOFS` dofs.
 STABILITY_SAMPLES = 50
 
-#: Orbits per admissible arc (evenly spread, both ends included) whose engineering quantities give the summary's
-#: ranges: each is expanded to the FE model at a few hundred instants.
-ENGINEERING_SAMPLES = 16
-
 #: Why an orbit has no Floquet verdict in the modes file: it is not a motion of the blade against the casing.
 NOT_ADMISSIBLE = "not computed: the orbit is not admissible (it crosses the casing, or the casing would pull)"
 
@@ -384,14 +382,6 @@ def orbit_stability(orbit) -> dict:
     except TypeError:  # an orbit record that takes no weak reference: not cached
         pass
     return out
-
-
-def _arc_picks(fam: Branch, arc, cap: int | None) -> list[int]:
-    """Indices of the admissible orbits of ``arc``; at most ``cap`` of them (evenly spread, both ends kept)."""
-    pool = [j for j in range(arc.start, arc.stop + 1) if fam.orbits[j] is not None and fam.orbits[j].admissible]
-    if cap is None or len(pool) <= cap:
-        return pool
-    return [pool[i] for i in np.unique(np.linspace(0, len(pool) - 1, cap).round().astype(int))]
 
 
 def _sampled(fam: Branch) -> bool:
@@ -430,27 +420,6 @@ def _stable_fraction(records: list[dict | None]) -> float | None:
     ``None`` when none has a verdict."""
     verdicts = [r["stable"] for r in records if r is not None and r["stable"] is not None]
     return float(np.mean(verdicts)) if verdicts else None
-
-
-def _arc_engineering(fam: Branch, arc, engineering) -> dict:
-    """Ranges ``[min, max]`` of the engineering quantities (``engineering(orbit)``, a dict of numbers or ``None``)
-    over the admissible orbits of ``arc`` — at most :data:`ENGINEERING_SAMPLES`, evenly spread, both ends included
-    (``engineering_orbits``: how many)."""
-    picks = _arc_picks(fam, arc, ENGINEERING_SAMPLES)
-    values = [engineering(fam.orbits[j]) for j in picks]
-    out: dict = {"engineering_orbits": len(picks)}
-    for key, ranged in ENGINEERING_RANGES.items():
-        nums = np.array([v[key] for v in values if isinstance(v.get(key), (int, float))], dtype=float)
-        if nums.size:
-            out[ranged] = _range(nums)
-    return out
-
-
-#: The engineering quantities of an orbit whose ranges over an arc the summary gives, and the ranges' keys (the
-#: unit stays last, as in ``energy_range_j``).
-ENGINEERING_RANGES = {"tip_amplitude_mm": "tip_amplitude_range_mm", "contact_force_n": "contact_force_range_n",
-                      "contact_impulse_ns": "contact_impulse_range_ns", "contact_fraction": "contact_fraction_range",
-                      "casing_penetration_m": "casing_penetration_range_m"}
 
 
 def reduced_summary(reduced: ReducedModel, reference_hz: np.ndarray, fe=None) -> dict:

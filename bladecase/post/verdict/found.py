@@ -59,12 +59,22 @@ class _Found(_Base):
         mode's linear frequency, tip amplitude, contact force (Newton: impulses), stable share."""
         arcs = self.arcs(fam)
         lo, hi = min(a["f_lo"] for a in arcs), max(a["f_hi"] for a in arcs)
+        tongue = next((a["tongue"] for a in sorted(arcs, key=lambda a: a["f_lo"]) if a.get("tongue")), None)
+        if tongue is not None:  # the band an engineer can quote ends where the tongue starts
+            self.code("band_to_tongue")
+            hi = max(a.get("backbone_f_hi", a["f_lo"]) for a in arcs)
         j = self.grown_from(lo, hi)
         kind = "stiffening" if j is None or math.sqrt(lo * hi) >= self.f[j] else "softening"
         head = f"A {kind} nonsmooth mode" + (f" of mode {j + 1}" if j is not None else "")
         words = [f"{head} ({self.phases(fam['ipp'])}): {_freq_span(lo, hi, ' → ')} Hz"
                  + (f" ({self.where(lo, hi, j)}" if j is not None else " (")
                  + (f"; admissible on {len(arcs)} separate arcs)" if len(arcs) > 1 else ")")]
+        if tongue is not None:
+            top = max(a["f_hi"] for a in arcs)
+            words[0] += (f" up to the tongue of the internal resonance {round(tongue['ratio'])}:1 with mode "
+                         f"{tongue['mode']} ({tongue['mode_frequency_hz']:.5g} Hz) at {tongue['frequency_hz']:.5g} Hz, "
+                         f"whose place moves with the mesh (the arc runs on in it to {top:.5g} Hz; its figures are "
+                         "not quoted)")
         tips = [x for a in arcs for x in (a.get("tip_amplitude_range_mm") or []) if x is not None]
         if tips:
             words.append(f"tip amplitude {_range(min(tips), max(tips), 'mm')}")
