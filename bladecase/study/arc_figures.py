@@ -63,20 +63,12 @@ def _backbone(fam: Branch, arc, engineering) -> dict:
     own = int(np.argmax(first.shares))
     if first.shares[own] < TONGUE_SHARE:  # no mode of its own at its start: not a backbone, no tongue to read below
         return {} if engineering is None else _arc_engineering(fam, arc, engineering)
-    picks = _arc_picks(fam, arc, ENGINEERING_SAMPLES)
-    shares = {j: _own_share(fam, j, own) for j in picks}
-    low = [j for j in pool if j in shares and shares[j] < TONGUE_SHARE]
+    shares = np.array([_own_share(fam, j, own) for j in pool])  # every orbit: a thin tongue holds few (ms each)
+    below = np.flatnonzero(shares < TONGUE_SHARE)
     out: dict = {}
     keep = pool
-    if low:  # bisect (in energy order) between the last pick above the share and the first below it
-        hi = pool.index(min(low, key=pool.index))
-        lo = max((pool.index(j) for j in shares if shares[j] >= TONGUE_SHARE and pool.index(j) < hi), default=-1)
-        while hi - lo > 1:
-            mid = (lo + hi) // 2
-            if _own_share(fam, pool[mid], own) >= TONGUE_SHARE:
-                lo = mid
-            else:
-                hi = mid
+    if below.size:
+        hi = int(below[0])
         inside = fam.orbits[pool[hi]]
         split = modal_energy_split(inside)
         other = int(np.argmax(np.where(np.arange(split.shares.size) == own, -1.0, split.shares)))
