@@ -190,3 +190,20 @@ def test_a_soft_casing_on_a_stiff_plate_still_grows_its_mode(casing):
     assert len(branch) == 60                                   # measured before the fix: 1 (the grazing orbit)
     assert all(o.T <= T1 * (1 + 1e-9) for o in branch) and branch[-1].T < branch[0].T
     assert abs(branch[0].T / T1 - 1) < 1e-5                     # it starts at grazing
+
+
+def test_the_massless_model_brings_its_reduction_and_mass_by_default():
+    """[contact] model = "massless" alone: the massless reduction and the lumped mass are its defaults; a study that
+    sets them otherwise is still refused, naming the key."""
+    from _studies import PLATE, absolute
+
+    text = absolute(PLATE).replace('method = "modal"\nsize = 10\n', "size = 10\n").replace(
+        'mass = "lumped"\n', "").replace("clearance = 1e-4", 'clearance = 1e-4\nmodel = "massless"')
+    from bladecase.study.schema import loads
+
+    s = loads(text.replace("ipp = [1]\n", "ipp = [1]\n"))
+    assert s["reduction"]["method"] == "massless" and s["fem"]["mass"] == "lumped"
+    with pytest.raises(StudyError, match=r"\[fem\] mass: the massless contact model moves lumped masses"):
+        loads(text.replace("[fem]\n", '[fem]\nmass = "consistent"\n'))
+    with pytest.raises(StudyError, match=r"\[reduction\] method: the massless contact model needs a massless method"):
+        loads(text.replace("size = 10\n", 'size = 10\nmethod = "modal"\n'))

@@ -520,8 +520,24 @@ def validate(raw: dict, source: str = "<string>", base: str | os.PathLike | None
         if section in ("output", "forcing"):
             _cap_animate(out, section)
         config[section] = out
+    _follow_contact_model(config, raw)
     cross_checks(config, model=model)
     return Study(config=config, source=source, base=Path(base) if base is not None else Path.cwd())
+
+
+def _follow_contact_model(config: dict, raw: dict) -> None:
+    """Defaults that follow ``[contact] model = "massless"``: the massless reduction and the lumped mass it moves,
+    where the study does not set them (logged); a value the study sets is kept (and checked)."""
+    if config["contact"]["model"] != "massless":
+        return
+    r, f = raw.get("reduction") or {}, raw.get("fem") or {}
+    if "method" not in r and "methods" not in r:
+        config["reduction"]["method"] = "massless"
+        log.info("[reduction] method: 'massless' (the default with [contact] model = 'massless')")
+    if "mass" not in f:
+        config["fem"]["mass"] = "lumped"
+        log.info("[fem] mass: 'lumped' (the default with [contact] model = 'massless': its contact dofs' mass is "
+                 "moved to their neighbours, which needs a diagonal mass)")
 
 
 def _cap_animate(o: dict, section: str = "output") -> None:
