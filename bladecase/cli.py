@@ -252,10 +252,10 @@ class _BarSafeHandler(logging.StreamHandler):
             self.handleError(record)
 
 
-def _study(path: Path, model: bool = True):
+def _study(path: Path, model: bool = True, contact: bool = True):
     from .study import load_study
 
-    return load_study(path, model=model)
+    return load_study(path, model=model, contact=contact)
 
 
 @contextmanager
@@ -316,7 +316,7 @@ def _cmd_mesh(args) -> int:
 
     _setup(args)
     _check_outputs(args.output)
-    study = _study(args.study)
+    study = _study(args.study, contact=False)  # meshing needs no contact
     _not_onto_inputs({"-o": args.output}, {"STUDY": args.study,
                                            "[mesh] path": None if study.parametric else study.mesh_path()})
     with written_together(args.output) as (out,):  # the mesh's groups are checked before it appears
@@ -340,7 +340,7 @@ def _cmd_assemble(args) -> int:
     _check_outputs(args.output, args.calculix)
     if args.calculix is not None and args.calculix.suffix != ".inp":
         raise ValueError(f"--calculix {args.calculix}: a CalculiX deck is an .inp file, e.g. model.inp")
-    study = _study(args.study)
+    study = _study(args.study, contact=False)  # assembling needs no contact
     _not_onto_inputs({"-o": args.output, "--calculix": args.calculix},
                      {"STUDY": args.study, "--mesh": args.mesh,
                       "[mesh] path": None if study.parametric else study.mesh_path()})

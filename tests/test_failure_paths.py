@@ -249,3 +249,14 @@ def test_run_that_fails_into_a_new_folder_leaves_no_folder(plate, tmp_path, caps
     code = _run("run", study, "--out", tmp_path / "new" / "out")
     assert code == 2 and "no group 'nosuch'" in capsys.readouterr().err
     assert not (tmp_path / "new").exists()
+
+
+def test_mesh_and_assemble_need_no_contact(plate, tmp_path, capsys):
+    """Assembling needs no casing: a study without [contact] clearance meshes and assembles; run still needs it."""
+    study = plate / "nocontact.toml"
+    study.write_text(PLATE.replace("[contact]\nclearance = 1e-4\n", ""))
+    assert _run("assemble", study, "-o", tmp_path / "m.npz") == 0
+    assert _run("mesh", study, "-o", tmp_path / "m.vtu") == 0
+    capsys.readouterr()
+    assert _run("reduce", study, "--model", tmp_path / "m.npz", "-o", tmp_path / "r.npz") == 2
+    assert "[contact] clearance: required" in capsys.readouterr().err

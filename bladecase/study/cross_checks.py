@@ -57,8 +57,9 @@ def _cell_checks(c: dict) -> None:
                      f"more than [limits] cells = {cap}: {fix}, or raise [limits] cells")
 
 
-def cross_checks(c: dict, model: bool = True) -> None:
-    """Every check across keys and sections of a validated study ``c`` (its sections filled in)."""
+def cross_checks(c: dict, model: bool = True, contact: bool = True) -> None:
+    """Every check across keys and sections of a validated study ``c`` (its sections filled in); ``contact=False``:
+    the contact's clearance is not needed (the stages before the contact)."""
     m = c["material"]
     given = [k for k in ("E", "nu", "rho") if m[k] is not None]
     if given and len(given) != 3:
@@ -92,7 +93,7 @@ def cross_checks(c: dict, model: bool = True) -> None:
     forcing_checks(c)
     execution_checks(c)
     rotation_checks(c)
-    casing_checks(c, model)
+    casing_checks(c, model and contact)
     rub_checks(c)
     convergence_checks(c)
     o, s = c["output"], c["search"]

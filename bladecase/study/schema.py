@@ -469,12 +469,14 @@ def _geometry_section(raw: dict) -> dict:
 
 
 def validate(raw: dict, source: str = "<string>", base: str | os.PathLike | None = None,
-             model: bool = True) -> Study:
+             model: bool = True, contact: bool = True) -> Study:
     """Check a parsed study (a dict as from ``tomllib``) and fill in the defaults.
 
     ``model=False`` is for studies that only drive the search on a given
     system (``bladecase modes --matrices``): the blade (``[geometry]`` /
     ``[mesh]``) and the contact clearance may then be left out.
+    ``contact=False`` is for the stages before the contact (``bladecase mesh``,
+    ``bladecase assemble``): the contact clearance may be left out.
 
     Raises
     ------
@@ -521,7 +523,7 @@ def validate(raw: dict, source: str = "<string>", base: str | os.PathLike | None
             _cap_animate(out, section)
         config[section] = out
     _follow_contact_model(config, raw)
-    cross_checks(config, model=model)
+    cross_checks(config, model=model, contact=contact)
     return Study(config=config, source=source, base=Path(base) if base is not None else Path.cwd())
 
 
@@ -599,7 +601,8 @@ def content_size(text: str, stop: int | None = None) -> int:
     return size
 
 
-def loads(text: str, source: str = "<string>", base: str | os.PathLike | None = None, model: bool = True) -> Study:
+def loads(text: str, source: str = "<string>", base: str | os.PathLike | None = None, model: bool = True,
+          contact: bool = True) -> Study:
     """Parse and validate a study from TOML text (``model``: see :func:`validate`).
 
     >>> loads("x = " + "[" * 10000 + "]" * 10000)
@@ -622,15 +625,16 @@ def loads(text: str, source: str = "<string>", base: str | os.PathLike | None = 
     except RecursionError:
         raise StudyError(f"{source}: not valid TOML: nested too deeply (arrays or tables inside each other)") from None
     try:
-        return validate(raw, source=source, base=base, model=model)
+        return validate(raw, source=source, base=base, model=model, contact=contact)
     except RecursionError:
         raise StudyError(f"{source}: nested too deeply (arrays or tables inside each other)") from None
 
 
-def load_study(path: str | os.PathLike, model: bool = True) -> Study:
+def load_study(path: str | os.PathLike, model: bool = True, contact: bool = True) -> Study:
     """Read and validate a study file; relative paths in it are relative to its folder.
 
-    ``model=False``: a search-only study (see :func:`validate`).
+    ``model=False``: a search-only study; ``contact=False``: a study for the stages before the contact (see
+    :func:`validate`).
 
     Examples
     --------
@@ -667,7 +671,8 @@ def load_study(path: str | os.PathLike, model: bool = True) -> Study:
         line = data[:exc.start].count(b"\n") + 1
         raise StudyError(f"cannot read study file {str(path)!r}: not UTF-8 text (byte {exc.start}, line {line}); "
                          "save it as UTF-8") from None
-    return loads(text.removeprefix("\ufeff"), source=str(path), base=path.resolve().parent, model=model)
+    return loads(text.removeprefix("\ufeff"), source=str(path), base=path.resolve().parent, model=model,
+                 contact=contact)
 
 
 def _read_study_bytes(path: Path) -> bytes:
