@@ -24,6 +24,25 @@ from .plots import new_figure
 __all__ = ["campbell_figure"]
 
 
+#: A nonsmooth-mode band narrower than this fraction of the frequency axis is drawn this wide (its true width in
+#: the legend): a band of a few tenths of a percent would not show at the figure's scale.
+MIN_BAND = 0.012
+
+
+def _band(ax, band, j: int, color: str, top: float) -> None:
+    """One mode's band, at least :data:`MIN_BAND` of the axis wide, hatched where widened, its width labelled."""
+    w, lo, hi = (np.asarray(x, dtype=float) for x in band)
+    ok = np.isfinite(lo) & np.isfinite(hi)
+    if not ok.any():
+        return
+    w, lo, hi = w[ok] * 60 / (2 * math.pi), lo[ok], hi[ok]
+    widest = float(np.max((hi - lo) / lo))
+    drawn = np.maximum(hi, lo + MIN_BAND * top)
+    widened = bool(np.any(drawn > hi))
+    label = f"mode {j + 1}: nonsmooth mode, up to +{100 * widest:.2g} %" + (" (drawn wider)" if widened else "")
+    ax.fill_between(w, lo, drawn, color=color, alpha=0.3, lw=0, hatch="///" if widened else None, label=label)
+
+
 def campbell_figure(campbell, bands: dict | None = None, title: str | None = None, ax=None) -> Figure:
     """Frequencies (Hz) of the tracked modes against speed (rpm), engine orders (dashed, labelled ``EO n``),
     their crossings (circles), and ``bands`` (mode → ``(speeds rad/s, low Hz, high Hz)``) shaded: the
@@ -33,16 +52,15 @@ def campbell_figure(campbell, bands: dict | None = None, title: str | None = Non
     ax = ax if ax is not None else fig.add_subplot()
     rpm = campbell.speeds * 60 / (2 * math.pi)
     top = float(np.nanmax(campbell.frequencies)) * 1.08 if campbell.frequencies.size else 1.0
+    for j in (bands or {}):
+        hi = np.asarray(bands[j][2], dtype=float)
+        if np.isfinite(hi).any():
+            top = max(top, float(np.nanmax(hi)) * 1.05)
     for j in range(campbell.frequencies.shape[1]):
         color = f"C{j % 10}"
         ax.plot(rpm, campbell.frequencies[:, j], "-", color=color, lw=1.6, label=f"mode {j + 1}")
         if bands and j in bands:
-            w, lo, hi = (np.asarray(x, dtype=float) for x in bands[j])
-            ok = np.isfinite(lo) & np.isfinite(hi)
-            if ok.any():
-                ax.fill_between(w[ok] * 60 / (2 * math.pi), lo[ok], hi[ok], color=color, alpha=0.25, lw=0,
-                                label=f"mode {j + 1}: nonsmooth mode")
-                top = max(top, float(np.nanmax(hi[ok])) * 1.05)
+            _band(ax, bands[j], j, color, top)
     x_end = float(rpm[-1]) if rpm.size else 1.0
     for n in campbell.engine_orders:
         y = n * campbell.speeds / (2 * math.pi)
