@@ -540,9 +540,41 @@ def _facet_measure(P: np.ndarray, face: np.ndarray) -> np.ndarray:
 def _area_weights(model: FEModel, group, nodes: np.ndarray) -> np.ndarray:
     """Tributary weights of ``nodes``: each boundary facet of the body cells whose corners all lie in ``group`` (a
     name or node indices) gives ``|f|/c`` to each of its ``c`` corners; divided by the face's total measure (see
-    :meth:`Contact.face`)."""
-    share, total = _tributary(model, group)
+    :meth:`Contact.face`). A set of nodes that holds no facet — a line of nodes along the tip, as a published
+    benchmark lists them — is weighted by each node's tributary length along the line (:func:`tributary_lengths`),
+    and the log says so."""
+    try:
+        share, total = _tributary(model, group)
+    except ValueError:
+        members = _members(model, group)[0]
+        if members.size < 2:
+            raise
+        from .. import log
+
+        lengths = tributary_lengths(model.mesh.points[nodes])
+        log.info("contact: the %d contact nodes hold no facet of the body (a line of nodes): each is weighted by its "
+                 "tributary length along the line (%.4g to %.4g mm of %.4g mm)", len(nodes), lengths.min() * 1e3,
+                 lengths.max() * 1e3, lengths.sum() * 1e3)
+        return lengths / lengths.sum()
     return share[nodes] / total
+
+
+def tributary_lengths(points) -> np.ndarray:
+    """Each point's tributary length along the line through ``points`` (ordered along their first principal
+    direction): half the distance to each neighbour — the ends take half a segment.
+
+    >>> tributary_lengths([[0.0, 0, 0], [2.0, 0, 0], [1.0, 0, 0], [4.0, 0, 0]]).tolist()
+    [0.5, 1.5, 1.0, 1.0]
+    """
+    P = np.asarray(points, dtype=float)
+    if P.shape[0] < 2:
+        return np.ones(P.shape[0])
+    C = P - P.mean(axis=0)
+    order = np.argsort(C @ np.linalg.svd(C, full_matrices=False)[2][0])
+    seg = np.linalg.norm(np.diff(P[order], axis=0), axis=1)
+    out = np.empty(P.shape[0])
+    out[order] = 0.5 * (np.r_[0.0, seg] + np.r_[seg, 0.0])
+    return out
 
 
 def tributary_areas(model: FEModel, nodes) -> np.ndarray:
@@ -586,7 +618,9 @@ def _tributary(model: FEModel, group) -> tuple[np.ndarray, float]:
     if total == 0:
         what = _members(model, group)[1]
         raise ValueError(f"{what} {'holds' if what.startswith('group') else 'hold'} no boundary facet of the body "
-                         "cells: weights='area' needs a face (use weights='equal' for a set of nodes)")
+                         "cells (a line of nodes, or scattered nodes): they have no area — give the casing's "
+                         "stiffness as casing_stiffness (N/m, shared by the nodes' tributary lengths along the line), "
+                         "not per unit area")
     return share, total
 
 
