@@ -162,3 +162,19 @@ def test_a_large_model_tracks_its_modes_on_a_sample_of_dofs(monkeypatch, tmp_pat
     assert (sampled.rank == exact.rank).all()
     assert abs(sampled.link_mac - exact.link_mac).max() < 0.02
     assert sampled.frequencies == pytest.approx(exact.frequencies, rel=1e-12)
+
+
+def test_a_clearance_closed_at_speed_names_both_ways_out():
+    """The blade's centrifugal growth closes a 1 µm cold clearance at 8000 rpm: the message gives the touch speed,
+    and says how to give a clearance measured at speed."""
+    from bladecase.fe import stiffness_factor
+    from bladecase.study.rotation import operating_point
+    from bladecase.study.schema import StudyError
+    from bladecase.study.stages import build_contact, build_mesh, build_model
+
+    study = _study(text=PLATE.replace("clearance = 1e-4", "clearance = 1e-6"))
+    model = build_model(study, build_mesh(study))
+    with pytest.raises(StudyError, match=r"touches its casing statically from about .* rpm; lower the speed or widen "
+                                         r"\[contact\] clearance \(a clearance measured at speed, not cold: set "
+                                         r"\[contact\] clearance_at = \"speed\"\)"):
+        operating_point(study, model, build_contact(study, model), stiffness_factor(model))

@@ -105,7 +105,8 @@ def operating_point(study: Study, model, contact, factor=None):
                          f"contact normal ({info['closure_m'] * 1e3:.4g} mm) closes the clearance "
                          f"({info['clearance_cold_m'] * 1e3:.4g} mm cold): it touches its casing statically from "
                          f"about {info.get('touches_at_rpm', float('nan')):.6g} rpm; lower the speed or widen "
-                         "[contact] clearance")
+                         "[contact] clearance (a clearance measured at speed, not cold: set [contact] clearance_at = "
+                         "\"speed\")")
     log.info("rotation: %.6g rpm (%.6g rad/s) about %s through %s; running clearance %.4g mm (cold %.4g mm, "
              "centrifugal closure %.4g mm)", info["speed_rpm"], omega, axis.direction.round(6).tolist(),
              axis.origin.tolist(), info["clearance_running_m"] * 1e3, info["clearance_cold_m"] * 1e3,
