@@ -29,6 +29,7 @@ speeds = [1450, 1650]
 ratio = 0.005
 revolutions = 8
 window = 3
+max_revolutions = 8
 """
 
 
@@ -108,8 +109,20 @@ def test_rub_outputs(result, blade):
     assert 1600 < s["resonances"][0]["speed"] < 1650
     # the casing's yield is the force over each node's share of the 1e6 N/m casing
     assert s["model"]["casing_n_per_m"] == pytest.approx(1e6, rel=1e-9)
+    # each speed over the crossing speed of mode 1 (8 lobes: 8Ω/2π = f1(Ω)), found here on f1 at the two speeds
+    from scipy.optimize import brentq
+
+    w, f1 = [r["speed_rad_s"] for r in s["rows"]], [hz[0] for hz in s["open_hz"]]
+    crossing = brentq(lambda x: 8 * x / (2 * np.pi) - np.interp(x, w, f1), w[0], w[1])
+    assert s["crossing"]["speed_rad_s"] == pytest.approx(crossing, rel=1e-4)
+    assert s["crossing"]["speed"] == pytest.approx(s["resonances"][0]["speed"], rel=1e-12)
+    for row, line in zip(s["rows"], rows):
+        assert float(line["speed_ratio"]) == pytest.approx(row["speed_rad_s"] / crossing, rel=1e-4)
+        assert line["response"] == row["response"] and int(line["revolutions_run"]) == 8   # max_revolutions = 8
+    assert s["rows"][0]["speed_ratio"] < 1 < s["rows"][1]["speed_ratio"]
     text = (out / "report.md").read_text()
     assert "## Rub response" in text and "The hardest rub is at 1650 rpm" in text
+    assert f"1650 rpm ({fast['speed_ratio']:.3g} × the crossing speed of mode 1)" in text
     assert "lobes excite linear mode 1" in text
     assert f"the contact pressure peaks at {fast['max_pressure_mpa']:.3g} MPa and the total contact force at " \
            f"{fast['total_force_n']:.3g} N, over {fast['loaded_area_mm2']:.3g} mm² of the tip's 103 mm², centred at " \

@@ -1,6 +1,8 @@
 """The interaction diagram of a rub sweep: peak tip displacement, peak total contact force and peak contact
 pressure against speed, with the speeds where the casing's lobes excite a linear mode (``n·Ω = ω_k``, dashed) and
-where they excite a nonsmooth mode's frequency band (shaded).
+where they excite a nonsmooth mode's frequency band (shaded); on top, the ratio of the speed to the crossing speed
+of mode 1. Each point says what the response is: settled, periodic over another period (a sub-harmonic), or not
+settled.
 
 >>> section = {"speed_unit": "rpm", "lobes": 3, "rows": [
 ...     {"speed": s, "tip_displacement_mm": d, "total_force_n": f, "max_pressure_mpa": f / 20, "settled": True}
@@ -9,6 +11,10 @@ where they excite a nonsmooth mode's frequency band (shaded).
 >>> fig = interaction_plot(section)
 >>> [ax.get_ylabel() for ax in fig.axes]
 ['peak tip displacement (mm)', 'peak total contact force (N)', 'peak contact pressure (MPa)']
+>>> section["crossing"] = {"mode": 1, "speed": 4100.0}
+>>> section["rows"][1]["response"] = "periodic-6"
+>>> interaction_plot(section).axes[0].child_axes[0].get_xlabel()
+'speed / crossing speed of mode 1'
 """
 
 from __future__ import annotations
@@ -32,6 +38,7 @@ def interaction_plot(section: dict, title: str | None = None) -> Figure:
     scale = SPEED_UNITS[unit.lower()]
     speed = np.array([r["speed"] for r in rows])
     settled = np.array([r["settled"] for r in rows], dtype=bool)
+    periodic = np.array([str(r.get("response", "")).startswith("periodic-") for r in rows], dtype=bool)
     campbell = bool(section.get("open_hz"))
     series = [("tip_displacement_mm", "peak tip displacement (mm)"), ("total_force_n", "peak total contact force (N)"),
               ("max_pressure_mpa", "peak contact pressure (MPa)")]
@@ -41,7 +48,10 @@ def interaction_plot(section: dict, title: str | None = None) -> Figure:
     for ax, (key, label) in zip(axes, series):
         y = np.array([r[key] for r in rows], dtype=float)
         ax.plot(speed, y, "-", color="C0", lw=1.2)
-        ax.plot(speed[settled], y[settled], "o", color="C0", ms=4, label="settled")
+        plain = settled & ~periodic
+        ax.plot(speed[plain], y[plain], "o", color="C0", ms=4, label="settled")
+        if periodic.any():
+            ax.plot(speed[periodic], y[periodic], "s", color="C2", ms=5, label="periodic over another period")
         if (~settled).any():
             ax.plot(speed[~settled], y[~settled], "o", mfc="none", color="C3", ms=5, label="not settled")
         ax.set_ylabel(label)
@@ -72,6 +82,10 @@ def interaction_plot(section: dict, title: str | None = None) -> Figure:
         ax.grid(True, alpha=0.3)
         ax.legend(loc="upper left", fontsize=8)
     axes[0].legend(loc="upper left", fontsize=8)
+    crossing = (section.get("crossing") or {}).get("speed")
+    if crossing:  # the speed over the crossing speed: the axis to compare meshes on
+        top = axes[0].secondary_xaxis("top", functions=(lambda s: s / crossing, lambda r: r * crossing))
+        top.set_xlabel(f"speed / crossing speed of mode {section['crossing'].get('mode', 1)}")
     axes[-1].set_xlabel(f"speed ({unit}); casing with {lobes} lobes: excitation at {lobes} × the speed")
     if title:
         fig.suptitle(title)

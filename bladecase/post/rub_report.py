@@ -1,5 +1,6 @@
 """The report's words on the rub response over speeds — written from ``summary["rub"]`` alone: where on the tip it
-rubs, how hard, at which speed, and whether each figure can be trusted (a response that had not settled).
+rubs, how hard, at which speed and at what ratio to the crossing speed of mode 1, and whether each figure can be
+trusted (a speed that ran on to settle, a sub-harmonic, a response that never settled and what it is).
 
 >>> rows = [{"speed": s, "speed_rad_s": s * 0.10472, "tip_displacement_mm": d, "max_pressure_mpa": q,
 ...          "total_force_n": f, "loaded_area_mm2": a, "peak_loaded_area_mm2": a, "load_centre": x,
@@ -8,14 +9,18 @@ rubs, how hard, at which speed, and whether each figure can be trusted (a respon
 ...         for s, d, q, f, a, x, where, c, p, n, ok in [
 ...             (1400, 0.01, 0.07, 4.4, 30.0, 0.1, "leading edge", 0.2, 0.07, 11, True),
 ...             (1650, 0.69, 0.3, 21.0, 40.0, 0.05, "leading edge", 0.4, 0.31, 13, False)]]
+>>> rows[1]["speed_ratio"] = 1650 / 1626.3
 >>> section = {"speed_unit": "rpm", "lobes": 8, "amplitude_m": 3e-4, "revolutions": 30, "window": 10,
 ...            "damping": {"ratio": 0.005}, "nodes": list(range(26)), "rows": rows,
 ...            "worst": {**rows[1], "touching_nodes": [3, 5, 98], "touching_along_tip": [0.0, 0.05, 0.1]},
 ...            "unsettled_speeds": [1650], "resonances": [{"mode": 1, "speed": 1626.3, "frequency_hz": 216.8}],
+...            "crossing": {"mode": 1, "speed": 1626.3, "frequency_hz": 216.8, "how": "interpolated"},
+...            "characterised": [{"speed": 1650, "response": "transient", "settled": False, "revolutions_run": 300,
+...                               "read_revolutions": 10, "change": 0.05, "decay": 0.5}],
 ...            "nonsmooth_bands_hz": [], "model": {"size": 8, "casing_n_per_m": 1e6, "face_area_mm2": 103.2}}
 >>> lines = rub_report(section)
 >>> lines[5].split(':')[0]
-'- The hardest rub is at 1650 rpm'
+'- The hardest rub is at 1650 rpm (1.01 × the crossing speed of mode 1)'
 >>> where, load, rest = lines[5].split("; ")
 >>> where.split(", ")[1:]
 ['13 nodes touch (nodes 3', '5', '98) — all near the leading edge (0.00–0.10 of the chord from it)']
@@ -25,6 +30,8 @@ rubs, how hard, at which speed, and whether each figure can be trusted (a respon
 """
 
 from __future__ import annotations
+
+import numpy as np
 
 from .nodal_report import load_words
 
@@ -63,7 +70,10 @@ def rub_report(section: dict | None) -> list[str]:
     touching = w["touching_nodes"]
     if w["total_force_n"] > 0:
         face = (section.get("model") or {}).get("face_area_mm2")
-        lines.append(f"- The hardest rub is at {w['speed']:.6g} {unit}: the tip reaches {w['tip_displacement_mm']:.4g} "
+        ratio = (f" ({w['speed_ratio']:.3g} × the crossing speed of mode 1)" if w.get("speed_ratio") is not None
+                 else "")
+        lines.append(f"- The hardest rub is at {w['speed']:.6g} {unit}{ratio}: the tip reaches "
+                     f"{w['tip_displacement_mm']:.4g} "
                      f"mm outwards, {w['nodes_touching']} nodes touch (nodes {', '.join(map(str, touching[:12]))}"
                      f"{', …' if len(touching) > 12 else ''}){_where(w.get('touching_along_tip'))}; "
                      f"{load_words(w, face)}; a node is in contact for up to {w['contact_fraction']:.0%} of a "
@@ -77,9 +87,18 @@ def rub_report(section: dict | None) -> list[str]:
     if quiet and len(quiet) < len(rows):
         lines.append(f"- No contact at {len(quiet)} of the speeds ({', '.join(f'{s:.6g}' for s in quiet[:8])}"
                      f"{', …' if len(quiet) > 8 else ''} {unit}).")
+    crossing = section.get("crossing")
     for res in section.get("resonances") or []:
         lines.append(f"- The lobes excite linear mode {res['mode']} ({res['frequency_hz']:.5g} Hz at that speed) at "
-                     f"about {res['speed']:.6g} {unit}.")
+                     f"about {res['speed']:.6g} {unit}"
+                     + (_CROSSING if res["mode"] == 1 and crossing and crossing.get("how") == "interpolated" else "")
+                     + ".")
+    if crossing and crossing.get("how") != "interpolated":
+        lines.append(f"- The lobes would excite linear mode 1 ({crossing['frequency_hz']:.5g} Hz) at about "
+                     f"{crossing['speed']:.6g} {unit}, outside the speeds run ("
+                     + ("extrapolated from mode 1's frequency at the two nearest speeds"
+                        if crossing["how"] == "extrapolated" else "mode 1's frequency at the one speed taken constant")
+                     + ")" + _CROSSING + ".")
     bands = section.get("nonsmooth_bands_hz") or []
     if bands:
         lines.append("- The study's nonsmooth modes (face-mean contact, " + section.get("bands_at", "at rest")
@@ -90,12 +109,79 @@ def rub_report(section: dict | None) -> list[str]:
     for f in section.get("failed_speeds") or []:
         lines.append(f"- **No result at {f['speed']:.6g} {unit}**: the simulation was refused there ({f['reason']}); "
                      "the other speeds are unaffected.")
+    lines += _settling(section, unit)
+    return lines
+
+
+#: Said of the crossing speed of mode 1 where the report names it.
+_CROSSING = (" — the crossing speed: `speed_ratio` in `rub.csv` is each speed over it; compare meshes at the same "
+             "ratio, which carries each mesh's error in f1 out of the comparison")
+
+
+def _settling(section: dict, unit: str) -> list[str]:
+    """Which speeds ran on to settle, which repeat over another period, and what those that never settled are."""
+    rows, window = section["rows"], section["window"]
+    out = []
+    cases = section.get("characterised") or []
+    ran = [c for c in cases if c["settled"] and c["revolutions_run"] > section["revolutions"]]
+    if ran:
+        runs = [c["revolutions_run"] for c in ran]
+        out.append(f"- {len(ran)} of {len(rows)} speeds had not settled after {section['revolutions']} revolutions and "
+                   f"ran on until they did ({min(runs)}–{max(runs)} revolutions"
+                   + (f", of at most {section['max_revolutions']}" if section.get("max_revolutions") else "") + ").")
+    for c in cases:
+        out.extend(_verdict(c, section, unit))
     unsettled = section.get("unsettled_speeds") or []
     if unsettled:
-        lines.append(f"- **Not settled** at {len(unsettled)} of {len(rows)} speeds ("
-                     f"{', '.join(f'{s:.6g}' for s in unsettled[:8])}{', …' if len(unsettled) > 8 else ''} {unit}): "
-                     f"the peaks of the last {section['window']} revolutions differ from those of the "
-                     f"{section['window']} before by more than 2 %, so the transient from rest has not died out (or "
-                     "the response is not periodic); read those figures as a lower bound of the steady state, or "
-                     "raise [rub] revolutions.")
-    return lines
+        cap = section.get("max_revolutions") or section["revolutions"]
+        out.append(f"- **Not settled** at {len(unsettled)} of {len(rows)} speeds ("
+                   f"{', '.join(f'{s:.6g}' for s in unsettled[:8])}{', …' if len(unsettled) > 8 else ''} {unit}) "
+                   f"within {cap} revolutions: the peaks of the last {window} revolutions still differ from those of "
+                   f"the {window} before by more than 2 %; what each of them is is said above — read its figures "
+                   "as that, not as a steady state.")
+    return out
+
+
+def _over(c: dict) -> str:
+    """How many lobe passings the 0-1 test had (it wants a few hundred)."""
+    n = c.get("samples")
+    return "" if not n else f" over {n} lobe passings" + (", too few to be sure" if n < 200 else "")
+
+
+def _verdict(c: dict, section: dict, unit: str) -> list[str]:
+    """One speed's response in words, when it is not a plain settled one."""
+    at, window, kind = f"At {c['speed']:.6g} {unit}", section["window"], c["response"]
+    change = f"{c['change']:.1%}"
+    if kind.startswith("periodic-"):
+        q, lobes = int(kind.split("-")[1]), section["lobes"]
+        rev = q / lobes
+        over = (f"{rev:.0f} revolution{'s' if rev != 1 else ''} ({q} lobe passings" if rev == int(rev)
+                else f"{q} lobe passings ({rev:.3g} revolutions")
+        times = round(c["read_revolutions"] / rev)
+        read = "that period" if times == 1 else f"{times} of those periods ({c['read_revolutions']:.3g} revolutions)"
+        return [f"- {at} the response is periodic over {over}: a sub-harmonic, at 1/{q} of the lobes' frequency); "
+                f"its figures are the peaks over {read}."]
+    if kind == "transient":
+        more = ""
+        if c.get("decay") and 0 < c["decay"] < 1 and c["change"] > 0:
+            windows = max(1, int(np.ceil(np.log(0.02 / c["change"]) / np.log(c["decay"]))))
+            more = (f"; at that rate about {windows * window} more revolutions would settle it (raise [rub] "
+                    "max_revolutions)")
+        return [f"- {at} the response was still settling when the cap of {c['revolutions_run']} revolutions was "
+                f"reached: its change from one window to the next falls steadily (by a factor "
+                f"{c.get('decay', float('nan')):.2g} per window of {window} revolutions) and was {change} at the end"
+                f"{more}; its figures are those of the last {window} revolutions, not yet of the steady state."]
+    if kind == "quasi-periodic":
+        turn = f" (once per lobe passing its state turns {c['rotation']:.3g} of a cycle)" if c.get("rotation") else ""
+        return [f"- {at} the response is quasi-periodic: regular (0-1 test for chaos K = {c.get('k', 0):.2f}"
+                f"{_over(c)}) but "
+                f"repeating at no period within {c['revolutions_run']} revolutions — a second frequency, "
+                f"incommensurate with the lobes', modulates it{turn}; its figures are the peaks over the last "
+                f"{window} revolutions, which change by {change} from one window to the next."]
+    if kind == "irregular":
+        return [f"- {at} the response is irregular — chaotic, or wandering among states (0-1 test for chaos K = "
+                f"{c.get('k', 1):.2f}{_over(c)}, no period within {c['revolutions_run']} revolutions); its figures are "
+                "the "
+                f"peaks over the last {window} revolutions, one sample of a fluctuating response, which change by "
+                f"{change} from one window to the next."]
+    return []

@@ -6,7 +6,12 @@ contact per node of the contact face (:func:`bladecase.reduction.nodes.nodal_mod
 ``[rub] size`` modes of the massless structure, the static flexibility they miss added to the nodes'; one
 interior basis for every speed, computed at the middle of the range: each speed's model is its Ritz projection,
 the contact rows and the residual flexibility computed with that speed's stiffness); then simulated from rest
-(:func:`bladecase.nsm.massless.rub.rub_response`). The speeds run through the study's executor. Outputs:
+(:func:`bladecase.nsm.massless.rub.rub_response`: a speed that has not settled after ``[rub] revolutions`` runs on,
+a window at a time, up to ``[rub] max_revolutions``; one that never settles is characterised — periodic over
+another period, a transient still converging, quasi-periodic or irregular). The speeds run through the study's
+executor. Each speed is also given as its ratio to the **crossing speed** of mode 1 (where the lobes' excitation
+``lobes·Ω/2π`` meets mode 1's frequency at speed, :func:`crossing_speed`): at the same ratio the rub of two meshes
+compares without the meshes' error in ``f1``. Outputs:
 ``rub.csv`` (one row per speed), ``rub_nodes.csv`` (one row per speed and node), ``rub.png`` (the interaction
 diagram: peak tip displacement, peak total contact force and peak contact pressure against speed, with the speeds
 where the casing's lobes excite a linear mode and, when the study found nonsmooth modes, where they excite the
@@ -29,17 +34,18 @@ from .. import log
 from ..fe.rotation import SPEED_UNITS, RotationAxis, spin, to_rad_s
 from ..io import save_figure, write_text
 from ..nsm.damping import Damping
-from ..nsm.massless.rub import rub_response
+from ..nsm.massless.rub import RUN_ON_FACTOR, rub_response
 from ..reduction.contact import Contact, tributary_areas
 from ..reduction.nodes import chord_positions, contact_pressure, nodal_model
 from .keys import StudyError
 
-__all__ = ["node_angles", "rub_stage"]
+__all__ = ["crossing_speed", "node_angles", "rub_stage"]
 
 #: Columns of ``rub.csv``: name (its unit is the suffix) → what it holds.
 COLUMNS = {
     "speed": "the speed, in [rub] speed_unit",
     "speed_rad_s": "the speed (rad/s)",
+    "speed_ratio": "the speed over the crossing speed of mode 1 with the lobes' excitation (empty: no crossing)",
     "tip_displacement_mm": "the largest peak outward normal displacement over the contact nodes (mm)",
     "max_pressure_mpa": "the largest contact pressure over the nodes and the window (MPa): force over tributary area",
     "total_force_n": "the peak over the window of the total contact force, the sum over the nodes (N)",
@@ -52,7 +58,12 @@ COLUMNS = {
     "penetration_mm": "the casing's largest yield under a node (mm; 0 for a rigid casing)",
     "nodes_touching": "how many contact nodes touch the casing",
     "switches": "contact switches simulated",
-    "settled": "whether the last window's peaks match the previous window's within 2 %",
+    "settled": "whether the response is steady: the last window's peaks (over a whole number of its periods) match "
+               "the span before's within 2 %",
+    "response": "settled, periodic-q (repeating every q lobe passings: a sub-harmonic), or, not settled within "
+                "max_revolutions: transient (still converging), quasi-periodic or irregular",
+    "period_revolutions": "the response's period in revolutions (q / lobes; 1 / lobes when settled; empty: none)",
+    "revolutions_run": "revolutions simulated (more than [rub] revolutions when the speed ran on)",
 }
 
 
@@ -123,14 +134,14 @@ def _running(model, contact: Contact, u: np.ndarray, speed: float) -> Contact:
 
 def _rub_point(speed: float, *, model, contact: Contact, interior: np.ndarray, size: int, casing: np.ndarray,
                angles: np.ndarray, axis: RotationAxis, static: str, lobes: int, amplitude: float, damping: Damping,
-               revolutions: int, window: int) -> dict:
+               revolutions: int, window: int, max_revolutions: int) -> dict:
     """One speed (module level: an executor ships it to its workers)."""
     state = spin(model, speed, axis, static=static)
     hot = _running(model, contact, state.displacement, speed)
     reduced = nodal_model(state.model, hot, size, factor=state.factor, casing=casing, interior=interior, residual=True)
     try:
         response = rub_response(reduced.system, speed, lobes, amplitude, angles, damping, revolutions, window,
-                                areas=reduced.areas)
+                                areas=reduced.areas, max_revolutions=max_revolutions)
     except ValueError as exc:  # the simulation refused this speed (e.g. a grazing switch): the others go on
         out = {"error": str(exc), "nodes": list(reduced.system.nodes)}
     else:
@@ -142,19 +153,62 @@ def _rub_point(speed: float, *, model, contact: Contact, interior: np.ndarray, s
     return out
 
 
-def _resonances(speeds: np.ndarray, open_hz: np.ndarray, lobes: int) -> list[dict]:
-    """Speeds where ``lobes·Ω/2π`` crosses an open-phase frequency (linear interpolation between speeds)."""
+def _meet(X: np.ndarray, F: np.ndarray, c2: float) -> float | None:
+    """Where the line through ``(X[0], F[0])`` and ``(X[1], F[1])`` (a constant ``F`` with one point) meets
+    ``F = c2·X``: ``X = Ω²``, ``F = f²``."""
+    slope = (F[1] - F[0]) / (X[1] - X[0]) if X.size > 1 else 0.0
+    if c2 == slope:
+        return None
+    return float((F[0] - slope * X[0]) / (c2 - slope))
+
+
+def _crossings(speeds: np.ndarray, f_hz: np.ndarray, lobes: int) -> list[float]:
+    """The speeds (rad/s) between two given speeds where ``lobes·Ω/2π`` meets ``f(Ω)``, with ``f²`` linear in
+    ``Ω²`` between them (Southwell's law of stress stiffening and spin softening)."""
+    X, F, c2 = speeds**2, f_hz**2, (lobes / (2 * np.pi)) ** 2
+    h = F - c2 * X
     out = []
-    excite = lobes * speeds / (2 * np.pi)
-    for k in range(open_hz.shape[1]):
-        d = excite - open_hz[:, k]
-        for i in np.flatnonzero(np.sign(d[:-1]) * np.sign(d[1:]) <= 0):
-            if d[i] == d[i + 1]:
-                continue
-            w = speeds[i] + (speeds[i + 1] - speeds[i]) * d[i] / (d[i] - d[i + 1])
-            f = float(np.interp(w, speeds, open_hz[:, k]))
-            out.append({"mode": k + 1, "speed_rad_s": float(w), "frequency_hz": f})
+    for i in np.flatnonzero(np.sign(h[:-1]) * np.sign(h[1:]) <= 0):
+        if h[i] == h[i + 1]:
+            continue
+        out.append(float(np.sqrt(_meet(X[i:i + 2], F[i:i + 2], c2))))
     return out
+
+
+def crossing_speed(speeds, f1_hz, lobes: int) -> dict | None:
+    """The crossing speed of mode 1: where the lobes' excitation ``lobes·Ω/2π`` meets mode 1's frequency at speed
+    ``f1(Ω)``, from ``f1`` at the given speeds (rad/s), ``f1²`` taken linear in ``Ω²`` (Southwell's law: exact for
+    a stiffness linear in ``Ω²``): interpolated between the two speeds around it (the first, from below), or
+    extrapolated from the two nearest speeds (``how``); with one speed, ``f1`` taken constant. ``None`` when ``f1``
+    grows as fast as the excitation (no crossing).
+
+    >>> w = np.array([700.0, 800.0, 900.0])                 # rad/s; f1² = 200² + 0.5 (Ω/2π)²
+    >>> c = crossing_speed(w, np.sqrt(200**2 + 0.5 * (w / 2 / np.pi) ** 2), lobes=1)
+    >>> round(c["speed_rad_s"] / (2 * np.pi), 6), c["how"]   # 200 / sqrt(1 - 0.5) Hz
+    (282.842712, 'extrapolated')
+    """
+    w = np.asarray(speeds, dtype=float).reshape(-1)
+    f = np.asarray(f1_hz, dtype=float).reshape(-1)
+    order = np.argsort(w)
+    w, f = w[order], f[order]
+    c = lobes / (2 * np.pi)
+    inside = _crossings(w, f, lobes)
+    if inside:
+        speed, how = inside[0], "interpolated"
+    else:
+        below = f[0] < c * w[0]  # every speed above the crossing: from the lowest two
+        near = slice(0, 2) if below else slice(-2, None)
+        met = _meet(w[near] ** 2, f[near] ** 2, c**2)
+        if met is None or met <= 0 or (met > w[0] ** 2 if below else met < w[-1] ** 2):
+            return None
+        speed, how = float(np.sqrt(met)), "extrapolated" if w.size > 1 else "one speed"
+    return {"mode": 1, "speed_rad_s": speed, "frequency_hz": float(c * speed), "how": how}
+
+
+def _resonances(speeds: np.ndarray, open_hz: np.ndarray, lobes: int) -> list[dict]:
+    """Speeds where ``lobes·Ω/2π`` crosses an open-phase frequency between two speeds (:func:`_crossings`)."""
+    return [{"mode": k + 1, "speed_rad_s": w, "frequency_hz": float(lobes * w / (2 * np.pi))}
+            for k in range(open_hz.shape[1]) for w in _crossings(speeds, open_hz[:, k], lobes)]
 
 
 def _bands(families) -> list[tuple[float, float]]:
@@ -189,13 +243,14 @@ def rub_stage(study, model, contact: Contact, *, families=None, executor=None, p
     except ValueError as exc:
         raise StudyError(f"[rub] {exc}") from None
     damping = _damping(r)
+    cap = max_revolutions(r)
     log.info("rub: %d speeds %.6g–%.6g %s, casing with %d lobes of %.4g mm, %d contact nodes (%s casing), %d "
-             "revolutions each (the last %d read)", speeds.size, min(r["speeds"]), max(r["speeds"]), unit,
-             k["lobes"], k["amplitude"] * 1e3, len(nodes),
-             "rigid" if np.isinf(casing).all() else f"{casing.sum():.4g} N/m", r["revolutions"], r["window"])
+             "revolutions each (the last %d read; on to at most %d until settled)", speeds.size, min(r["speeds"]),
+             max(r["speeds"]), unit, k["lobes"], k["amplitude"] * 1e3, len(nodes),
+             "rigid" if np.isinf(casing).all() else f"{casing.sum():.4g} N/m", r["revolutions"], r["window"], cap)
     shared = dict(model=model, contact=contact, interior=interior, size=r["size"], casing=casing, angles=angles,
                   axis=axis, static=static, lobes=k["lobes"], amplitude=k["amplitude"], damping=damping,
-                  revolutions=r["revolutions"], window=r["window"])
+                  revolutions=r["revolutions"], window=r["window"], max_revolutions=cap)
     try:
         points = executor.map(_rub_point, [float(w) for w in speeds], shared=shared, desc="rub speeds",
                               progress=progress)
@@ -208,6 +263,11 @@ def rub_stage(study, model, contact: Contact, *, families=None, executor=None, p
         if "vtu" in study["output"]["formats"]:
             section["files"]["vtu"] = _write_vtu(Path(folder) / "rub.vtu", model, contact, section, points)
     return section
+
+
+def max_revolutions(r: dict) -> int:
+    """``[rub] max_revolutions``, or its default: ``10 × revolutions``."""
+    return int(r.get("max_revolutions") or RUN_ON_FACTOR * r["revolutions"])
 
 
 def _write_vtu(path: Path, model, contact: Contact, section: dict, points: list[dict]) -> str:
@@ -250,43 +310,45 @@ def _summary(study, speeds: np.ndarray, points: list[dict], families, contact: C
     r, k = study["rub"], study["casing"]
     unit = r["speed_unit"]
     scale = SPEED_UNITS[unit.lower()]
-    rows, failed = [], []
+    ok = np.array(["error" not in q for q in points])
+    good = [p for p in points if "error" not in p]
+    open_hz = np.array([q["open_hz"] for q in good]) if good else np.zeros((0, 1))
+    crossing = crossing_speed(speeds[ok], open_hz[:, 0], k["lobes"]) if good else None
+    if crossing is not None:
+        crossing["speed"] = crossing["speed_rad_s"] / scale
+    rows, failed, characterised = [], [], []
     for given, w, p in zip(r["speeds"], speeds, points):
         if "error" in p:
             failed.append({"speed": float(given), "reason": p["error"]})
             continue
-        frac = np.array(p["contact_fraction"])
-        load = p["load"]
-        rows.append({"speed": float(given), "speed_rad_s": float(w),
-                     "tip_displacement_mm": 1e3 * max(p["peak_displacement"]),
-                     "max_pressure_mpa": 1e-6 * max(p["peak_pressure"]), "total_force_n": float(p["total_force"]),
-                     "loaded_area_mm2": 1e6 * load["loaded_area_m2"], "peak_loaded_area_mm2": 1e6 * p["loaded_area"],
-                     "load_centre": load["centre"], "load_location": load["location"],
-                     "max_node_force_n": max(p["peak_force"]), "contact_fraction": float(frac.max()),
-                     "penetration_mm": 1e3 * max(p["penetration"]), "nodes_touching": int((frac > 0).sum()),
-                     "switches": p["switches"], "settled": bool(p["settled"])})
+        row = _row(float(given), float(w), p, crossing, k["lobes"])
+        rows.append(row)
+        if row["response"] != "settled" or row["revolutions_run"] > r["revolutions"]:
+            characterised.append({"speed": row["speed"], "response": p["response"], "settled": bool(p["settled"]),
+                                  "period_lobe_passings": p["period"], "period_revolutions": row["period_revolutions"],
+                                  "revolutions_run": p["revolutions_run"], "read_revolutions": p["read_revolutions"],
+                                  "change": p["change"], **p["detail"]})
     if not rows:
         raise StudyError(f"[rub] speeds: the simulation was refused at every speed; at {failed[0]['speed']:.6g} "
                          f"{unit}: {failed[0]['reason']}")
-    good = [p for p in points if "error" not in p]
     worst = int(np.argmax([row["tip_displacement_mm"] for row in rows]))
     p = good[worst]
     touching = [i for i, f in enumerate(p["contact_fraction"]) if f > 0]
     where = _along_tip(model, contact, touching)
-    ok = np.array(["error" not in q for q in points])
-    open_hz = np.array([q["open_hz"] for q in good])
     resonances = _resonances(speeds[ok], open_hz, k["lobes"]) if ok.sum() > 1 else []
     for res in resonances:
         res["speed"] = res["speed_rad_s"] / scale
     return {
         "speed_unit": unit, "lobes": k["lobes"], "amplitude_m": k["amplitude"], "revolutions": r["revolutions"],
-        "window": r["window"], "damping": ({"ratio": r["ratio"]} if r["ratio"] is not None
-                                           else {"rayleigh": r["rayleigh"]}),
+        "window": r["window"], "max_revolutions": max_revolutions(r),
+        "damping": {"ratio": r["ratio"]} if r["ratio"] is not None else {"rayleigh": r["rayleigh"]},
         "nodes": [int(n) for n in points[0]["nodes"]],
         "rows": rows,
         "worst": {**rows[worst], "touching_nodes": [int(p["nodes"][i]) for i in touching],
                   "touching_along_tip": where},
         "unsettled_speeds": [row["speed"] for row in rows if not row["settled"]],
+        "characterised": characterised,
+        "crossing": crossing,
         "failed_speeds": failed,
         "resonances": resonances,
         "open_hz": open_hz[:, :3].tolist(),
@@ -296,6 +358,23 @@ def _summary(study, speeds: np.ndarray, points: list[dict], families, contact: C
                   "face_area_mm2": float(tributary_areas(model, contact.nodes).sum()) * 1e6,
                   "casing_n_per_m": None if np.isinf(casing).all() else float(casing.sum())},
     }
+
+
+def _row(speed: float, w: float, p: dict, crossing: dict | None, lobes: int) -> dict:
+    """One speed's row of ``rub.csv`` (:data:`COLUMNS`) from its point (:func:`_rub_point`)."""
+    frac = np.array(p["contact_fraction"])
+    load = p["load"]
+    return {"speed": speed, "speed_rad_s": w,
+            "speed_ratio": None if crossing is None else w / crossing["speed_rad_s"],
+            "tip_displacement_mm": 1e3 * max(p["peak_displacement"]),
+            "max_pressure_mpa": 1e-6 * max(p["peak_pressure"]), "total_force_n": float(p["total_force"]),
+            "loaded_area_mm2": 1e6 * load["loaded_area_m2"], "peak_loaded_area_mm2": 1e6 * p["loaded_area"],
+            "load_centre": load["centre"], "load_location": load["location"],
+            "max_node_force_n": max(p["peak_force"]), "contact_fraction": float(frac.max()),
+            "penetration_mm": 1e3 * max(p["penetration"]), "nodes_touching": int((frac > 0).sum()),
+            "switches": p["switches"], "settled": bool(p["settled"]), "response": p["response"],
+            "period_revolutions": None if p["period"] is None else p["period"] / lobes,
+            "revolutions_run": p["revolutions_run"]}
 
 
 def _bands_at(study) -> str:

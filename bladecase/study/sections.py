@@ -348,6 +348,10 @@ RUB_KEYS: dict[str, Key] = {
     "revolutions": Key(_INT, 40, "Revolutions simulated at each speed (from rest).", _int_between(2, 100_000)),
     "window": Key(_INT, 10, "The last revolutions read for the figures; the window before them tells whether the "
                   "response has settled (at most revolutions / 2).", _int_between(1, 50_000)),
+    "max_revolutions": Key(_INT, None, "A speed that has not settled after 'revolutions' runs on, a window at a time, "
+                           "up to this many revolutions in all (default: 10 × revolutions); one that never settles is "
+                           "characterised (periodic over another period, transient, quasi-periodic or irregular).",
+                           _int_between(2, 1_000_000)),
     "rayleigh": Key(_LIST, None, "Rayleigh damping [alpha, beta]: C = alpha K + beta M (alpha in s, beta in 1/s); "
                     "give this or 'ratio'.", _rayleigh),
     "ratio": Key(_NUM, None, "Modal damping ratio of every mode of the blade with its contacts open (e.g. 0.005); "
@@ -359,7 +363,7 @@ RUB_KEYS: dict[str, Key] = {
 
 def rub_checks(c: dict) -> None:
     """``[rub]`` (when its speeds are given): an out-of-round [casing], a face contact, the massless model, one
-    damping, a window of at most half the revolutions."""
+    damping, a window of at most half the revolutions, a cap of at least the revolutions."""
     r = c.get("rub")
     if not r:
         return
@@ -383,6 +387,9 @@ def rub_checks(c: dict) -> None:
     if r["window"] > r["revolutions"] // 2:
         raise StudyError(f"[rub] window: at most revolutions / 2 = {r['revolutions'] // 2} (the window before it "
                          f"tells whether the response settled), got {r['window']}")
+    if r["max_revolutions"] is not None and r["max_revolutions"] < r["revolutions"]:
+        raise StudyError(f"[rub] max_revolutions: at least revolutions = {r['revolutions']} (the cap of a speed that "
+                         f"runs on to settle), got {r['max_revolutions']}")
     r["speed_unit"] = {"hz": "Hz"}.get(r["speed_unit"].lower(), r["speed_unit"])
 
 

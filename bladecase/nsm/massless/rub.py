@@ -60,14 +60,24 @@ RUN_ON_FACTOR = 10
 #: smallest distance between the ``q`` points of one period (a quasi-periodic map comes back near itself after
 #: ``q`` steps where its rotation number is near ``p/q``, but then its ``q`` points are spread along a curve about
 #: as far apart as that error).
-DISTINCT = 0.25
+DISTINCT = 0.5
+
+#: A response whose peaks have settled while its state still differs from one lobe passing to the next follows the
+#: period ``q`` whose recurrence error is below this share of the error at one passing (its transient has not died
+#: out, yet it clearly repeats every ``q``).
+SUBHARMONIC_SHARE = 0.25
 
 #: The 0-1 test's ``K`` above which a response that repeats at no period is ``irregular`` (chaotic).
 CHAOS_K = 0.5
 
-#: A transient: the change from one window to the next falls by at least this factor per window, steadily (the
-#: log of the change fits a line with R² of at least ``TRANSIENT_R2``).
-TRANSIENT_DECAY, TRANSIENT_R2 = 0.8, 0.6
+#: A transient: what is left of it falls by at least ``TRANSIENT_DECAY`` per window — either the return map is a
+#: linear map (an affine least-squares fit on its leading principal components predicts the next sample with R² of
+#: at least ``LINEAR_R2``: the response is close to its fixed point) whose slowest mode decays that fast, or the log
+#: of the change from one window to the next falls along a line (R² of at least ``TRANSIENT_R2``).
+TRANSIENT_DECAY, TRANSIENT_R2, LINEAR_R2 = 0.8, 0.6, 0.99
+
+#: Principal components of the return map fitted by a linear map.
+LINEAR_RANK = 6
 
 
 @dataclass(frozen=True)
@@ -79,7 +89,8 @@ class Character:
     every ``lag`` samples), ``"quasi-periodic"`` (regular — the 0-1 test's ``k`` near 0 — without a period;
     ``rotation``: the strongest line of the sampled sequence, in cycles per forcing period) or ``"irregular"``
     (``k`` near 1). ``error``: the recurrence error at ``period`` (relative to the state's size), or the last
-    change over ``lag`` samples."""
+    change over ``lag`` samples; ``samples``: how many samples it was told from (the 0-1 test wants a few
+    hundred)."""
 
     kind: str
     period: int | None = None
@@ -87,6 +98,7 @@ class Character:
     k: float | None = None
     decay: float | None = None
     rotation: float | None = None
+    samples: int | None = None
 
     @property
     def label(self) -> str:
@@ -125,6 +137,20 @@ def _period(y: np.ndarray, scale: float, rtol: float, max_period: int) -> tuple[
                 continue
         return q, err
     return None
+
+
+def _linear_decay(y: np.ndarray, lag: int) -> tuple[float, float]:
+    """The return map fitted by an affine map on its leading principal components: the factor its slowest mode is
+    multiplied by over ``lag`` samples, and the fit's R² (one step ahead)."""
+    centred = y - y.mean(axis=0)
+    _, sv, vt = np.linalg.svd(centred, full_matrices=False)
+    r = int(min(LINEAR_RANK, (sv > 1e-6 * sv[0]).sum(), max(1, (y.shape[0] - 2) // 4)))
+    z = centred @ vt[:r].T
+    X = np.c_[z[:-1], np.ones(z.shape[0] - 1)]
+    coef = np.linalg.lstsq(X, z[1:], rcond=None)[0]
+    spread = ((z[1:] - z[1:].mean(axis=0)) ** 2).sum()
+    r2 = 1 - ((z[1:] - X @ coef) ** 2).sum() / spread if spread > 0 else 0.0
+    return float(np.abs(np.linalg.eigvals(coef[:r].T)).max() ** lag), float(r2)
 
 
 def zero_one_test(phi, cs: int = 64) -> float:
@@ -187,27 +213,29 @@ def characterise(samples, rtol: float = SETTLED_RTOL, max_period: int | None = N
         return Character("periodic", 1, 0.0)
     found = _period(y, scale, rtol, N // 3 if max_period is None else int(max_period))
     if found is not None:
-        return Character("periodic", found[0], found[1])
+        return Character("periodic", found[0], found[1], samples=N)
     lag = max(1, N // 8 if lag is None else min(int(lag), N // 2))
     change = np.linalg.norm(y[lag:] - y[:-lag], axis=1) / scale
     decay = None
+    if N >= 8 and np.ptp(y, axis=0).max() > 0:
+        decay, r2 = _linear_decay(y, lag)
+        if decay < TRANSIENT_DECAY and r2 >= LINEAR_R2:
+            return Character("transient", None, float(change[-1]), decay=decay, samples=N)
     if change.size >= 4 and change.min() > 0:
         k = np.arange(change.size)
         slope, icept = np.polyfit(k, np.log(change), 1)
-        fit = icept + slope * k
-        resid = np.log(change) - fit
+        resid = np.log(change) - (icept + slope * k)
         r2 = 1 - (resid**2).sum() / max(((np.log(change) - np.log(change).mean()) ** 2).sum(), 1e-300)
-        decay = float(np.exp(slope * lag))
-        if decay < TRANSIENT_DECAY and r2 >= TRANSIENT_R2:
-            return Character("transient", None, float(change[-1]), decay=decay)
+        if np.exp(slope * lag) < TRANSIENT_DECAY and r2 >= TRANSIENT_R2:
+            return Character("transient", None, float(change[-1]), decay=float(np.exp(slope * lag)), samples=N)
     centred = y - y.mean(axis=0)
     pc = centred @ np.linalg.svd(centred, full_matrices=False)[2][0]
     K = zero_one_test(pc)
     if K >= CHAOS_K:
-        return Character("irregular", None, float(change[-1]), k=K, decay=decay)
+        return Character("irregular", None, float(change[-1]), k=K, samples=N)
     spectrum = np.abs(np.fft.rfft(pc * np.hanning(N))) ** 2
     rotation = float(np.fft.rfftfreq(N)[1 + int(np.argmax(spectrum[1:]))]) if N > 2 else None
-    return Character("quasi-periodic", None, float(change[-1]), k=K, decay=decay, rotation=rotation)
+    return Character("quasi-periodic", None, float(change[-1]), k=K, rotation=rotation, samples=N)
 
 
 @dataclass(frozen=True)
@@ -332,6 +360,10 @@ def rub_response(system: NodalSystem, speed: float, lobes: int, amplitude: float
     open-phase modes (``None``: undamped); ``areas``: each node's tributary area (m², ``(m,)``) for the largest
     loaded area (``loaded_area``; ``None`` without); ``max_switches``: over the whole run."""
     cap, speed = _checked(revolutions, window, max_revolutions, speed)
+    if areas is not None:
+        areas = np.asarray(areas, dtype=float)
+        if areas.shape != (system.m,):
+            raise ValueError(f"areas must hold one value per contact node ({system.m}), got shape {areas.shape}")
     rub = Rub(lobes, amplitude, speed, angles)
     fl = NodalFlight(system, damping, rub)
     turn = 2 * np.pi / speed
@@ -360,18 +392,19 @@ def rub_response(system: NodalSystem, speed: float, lobes: int, amplitude: float
         x, v = seg.x_end, seg.v_end
         now, before = peaks(W)
         change, span, period = _change(now, before, system.gap), W, 1
-        if change <= SETTLED_RTOL:
-            break
         y = np.concatenate(strobes)[-2 * W:]
-        found = _period(y, float(np.linalg.norm(y, axis=1).max()) or 1.0, SETTLED_RTOL, (2 * W) // 3)
-        if found is not None and found[0] > 1:  # a sub-harmonic: compare whole numbers of periods
+        scale = float(np.linalg.norm(y, axis=1).max()) or 1.0
+        found = _period(y, scale, SETTLED_RTOL, (2 * W) // 3)
+        if found is None and change <= SETTLED_RTOL:  # settled by its peaks: the period its state follows
+            found = _period(y, scale, SUBHARMONIC_SHARE * _recurrence(y, 1, scale), (2 * W) // 3)
+        if found is not None and found[0] > 1:  # a sub-harmonic: its peaks over whole numbers of periods
             q = found[0]
             q_now, q_before = peaks(q * (W // q))
             q_change = _change(q_now, q_before, system.gap)
             if q_change <= SETTLED_RTOL:
                 now, change, span, period = q_now, q_change, q * (W // q), q
                 break
-        if done + window > cap:
+        if change <= SETTLED_RTOL or done + window > cap:
             break
         run = window
     settled = change <= SETTLED_RTOL
@@ -385,13 +418,9 @@ def rub_response(system: NodalSystem, speed: float, lobes: int, amplitude: float
     end = tail.t_end
     t0 = end - span * passing
     fraction = tail.contact_time(t0, end) / (span * passing)
-    loaded = None
-    if areas is not None:
-        areas = np.asarray(areas, dtype=float)
-        if areas.shape != (system.m,):
-            raise ValueError(f"areas must hold one value per contact node ({system.m}), got shape {areas.shape}")
-        loaded = _loaded_area(tail, areas, t0, end)
-    detail = {k: getattr(character, k) for k in ("k", "decay", "rotation") if getattr(character, k) is not None}
+    loaded = None if areas is None else _loaded_area(tail, areas, t0, end)
+    detail = {k: getattr(character, k) for k in ("k", "decay", "rotation", "samples")
+              if getattr(character, k) is not None}
     return RubResponse(speed, int(lobes), float(amplitude), int(revolutions), int(window), system.nodes, now[0],
                        now[1], fraction, now[2], switches, settled, change, float(now[3].sum()), now[3], loaded,
                        character.label, period, int(done), span / lobes, cap, detail)
