@@ -15,10 +15,13 @@ from ... import log
 from ..arcs import admissible_arcs, check_period_range
 from .model import MasslessSystem
 from .orbits import (
+    GRAZING_BETA_MAX,
+    GRAZING_RESOLUTION,
     SymmetricOrbit,
     _correct,
     check_massless_system,
     closing_residual,
+    contact_share,
     follow_from_grazing,
     orbit_at_period,
 )
@@ -50,8 +53,14 @@ def massless_modes(system: MasslessSystem, T_range: tuple[float, float], max_poi
     for j in np.flatnonzero(2 * np.pi / system.open.omega >= T_lo):
         if abs(system.open.b[j]) <= 1e-12 * np.abs(system.open.b).max():
             continue  # the contact does not see this mode: no branch grows from it
-        orbits = follow_from_grazing(system, T_lo, mode=int(j), ds=ds, ds_max=ds_max,
-                                     max_points=max_points + _entry(system, j, T_hi))
+        try:
+            orbits = follow_from_grazing(system, T_lo, mode=int(j), ds=ds, ds_max=ds_max,
+                                         max_points=max_points + _entry(system, j, T_hi))
+        except ValueError as exc:
+            if contact_share(system, int(j)) * GRAZING_BETA_MAX >= GRAZING_RESOLUTION:
+                raise
+            log.warning("massless branch of open mode %d skipped: %s", j + 1, exc)  # the contact barely sees it
+            continue
         Ts = np.array([o.T for o in orbits])
         inside = np.flatnonzero((Ts >= T_lo) & (Ts <= T_hi))
         if inside.size < 2:

@@ -16,12 +16,13 @@ The closing condition leaves ONE scalar equation ``r(α, β) = b_oᵀ diag(cos �
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 
 import numpy as np
 import scipy.linalg as sla
 
+from ... import log
 from ..signals import TrigSum, certified_max
 from ..system import LinearSystem
 from .model import BoundOrbit, MasslessSystem
@@ -184,16 +185,28 @@ class SymmetricOrbit(BoundOrbit):
 
     @cached_property
     def proofs(self):
-        """Certified ``max(y - d)`` over the open phase and ``max(d - y)`` over the closed phase."""
+        """Certified ``max(y - d)`` over the open phase and ``max(d - y)`` over the closed phase.
+
+        Both phases end where the contact switches, at ``y = d + r`` (``r``: the orbit's closing residual, at most
+        ``1e-8 d`` from the solvers; next to grazing against a soft casing it is the rounding of ``α``, up to a few
+        ``1e-9 d``): on the side it lies, each proof is of ``y`` against ``d + r`` (``r`` capped at ``1e-8 d``) with
+        the tolerance :data:`ADMISSIBILITY_RTOL`, so the solver's residual at the switch is not read as a
+        violation; the values reported are still of ``y - d`` and ``d - y``."""
         s = self._bound()
         d = s.gap
         tol = ADMISSIBILITY_RTOL * d
-        y = s.open.contact(self.x_mid_open, np.zeros(s.n))
-        open_ = certified_max(TrigSum(y.alpha, y.beta, y.omega, y.const - d), self.alpha, tol)
         x1, v1 = self.closing_state()
+        r = min(max(float(s.w @ x1) - d, -1e-8 * d), 1e-8 * d)
+
+        def proof(f: TrigSum, length: float, shift: float):
+            out = certified_max(TrigSum(f.alpha, f.beta, f.omega, f.const - shift), length, tol)
+            return replace(out, value=out.value + shift, upper=out.upper + shift) if shift else out
+
+        y = s.open.contact(self.x_mid_open, np.zeros(s.n))
+        open_ = proof(TrigSum(y.alpha, y.beta, y.omega, y.const - d), self.alpha, max(r, 0.0))
         xm, vm = s.closed.advance(x1, v1, self.beta)
         y = s.closed.contact(xm, vm)
-        closed = certified_max(TrigSum(-y.alpha, -y.beta, y.omega, d - y.const), self.beta, tol)
+        closed = proof(TrigSum(-y.alpha, -y.beta, y.omega, d - y.const), self.beta, max(-r, 0.0))
         return open_, closed
 
     @property
@@ -242,61 +255,145 @@ def orbit_at_period(system: MasslessSystem, T: float, beta0: float, maxiter: int
     return None
 
 
-def _correct(system: MasslessSystem, z: np.ndarray, scale: float = 1.0) -> tuple[np.ndarray, bool, int]:
-    """Newton on ``r = 0`` with steps along ``∇r`` (orthogonal to the tangent); ``scale``: the time scale of ``z``."""
+def _correct(system: MasslessSystem, z: np.ndarray, scale: float = 1.0, narrow: bool = False
+             ) -> tuple[np.ndarray, bool, int]:
+    """Newton on ``r = 0`` with steps along ``∇r`` (orthogonal to the tangent); ``scale``: the time scale of ``z``.
+
+    ``narrow``: the valley of ``r`` is narrower than the step criterion (a contact that stiffens the mode by a small
+    ``κ``: ``r`` goes from ``-d`` to its pole within ``κβ``), so a step below it with ``|r|`` still above its
+    tolerance goes on to round-off instead of failing (which halved the continuation's step down to nothing)."""
     for it in range(10):
         _, r, g = closing_residual(system, *z, True)
         dz = -r * g / (g @ g)
         z = z + dz
-        if np.hypot(*dz) <= 1e-11 * (scale + np.hypot(*z)):
-            return z, abs(r) <= 1e-8 * system.gap, it
+        step = np.hypot(*dz)
+        if step <= 1e-11 * (scale + np.hypot(*z)):
+            if abs(r) <= 1e-8 * system.gap or not narrow or step <= 1e-15 * np.hypot(*z):
+                return z, abs(r) <= 1e-8 * system.gap, it
     return z, False, 10
 
 
-def _grazing_start(system: MasslessSystem, w: float) -> np.ndarray:
-    """The first point ``(α, β₀)`` of the branch by bracketing: ``r(α, β₀)`` has a pole at about half the linear
-    period and its root beside it, closer the softer the contact's spring (a soft casing: within 1e-7 of ``π/ω``
-    at 1e7 N/m on a stiff plate, where Newton from ``π/ω`` goes astray). ``α`` approaches the pole from each side
-    geometrically, a sign change with ``|r|`` small at the refined root is the start; ``β₀`` grows tenfold while
-    none is found."""
+def contact_share(system: MasslessSystem, mode: int = 0) -> float:
+    """``κ = k b_j² / ω_j²``: the contact's spring (``system.kc``) seen by open-phase mode ``mode``, as a fraction
+    of the mode's own stiffness — how much the contact phase stiffens it (its frequency rises by about ``κ/2``
+    when ``κ`` is small).
+
+    Next to grazing (contact half-time ``β``, ``δ = α - π/ω_j``) the closing residual is, to leading order,
+    ``r/d = κβ / (δ + β(1 + κ)) - 1``: its root at ``δ = -β`` (``T = 2π/ω_j``), its pole (``L`` singular) at
+    ``δ = -β(1 + κ)``; the two are ``κβ`` apart whatever the other modes (measured on FE strips within 3e-4 κβ
+    up to ``βω = 0.03``)."""
+    o = system.open
+    return float(system.kc * o.b[mode] ** 2 / o.omega[mode] ** 2)
+
+
+#: The grazing root of the closing residual is resolved to ``|r| <= 1e-8 d`` once ``κβω`` is at least this (its
+#: distance from the pole, ``κβ``, against the rounding of ``α``: measured ``|r|/d ≈ 2e-16 / (κβω)``; 10× margin).
+GRAZING_RESOLUTION = 2e-7
+#: Longest contact half-time ``βω`` the first point of a branch may take when grazing is not resolved closer (the
+#: contact then lasts ``βω/π`` of the period: 3 %).
+GRAZING_BETA_MAX = 0.1
+
+
+def _grazing_root(system: MasslessSystem, mode: int, beta: float) -> np.ndarray | None:
+    """``(α, β)`` on the branch grown from grazing of ``mode`` at contact half-time ``beta``, or ``None``.
+
+    The root is bracketed from the closed-form structure (:func:`contact_share`): with ``m = min(κ, 1)``,
+    ``r = +d`` at ``δ = -β(1 + m/2)`` (between the pole and the root) and ``r = -d/2`` at ``δ = -β(1 - m)`` (beyond
+    the root); if higher-order terms move the pole (fast closed-phase modes with ``βω_c`` not small), points on both
+    sides of ``δ = -β`` (within ``2^-20 mβ``), towards the pole and away from it are scanned."""
     from scipy.optimize import brentq
 
-    o, c, P = system.open, system.closed, system.transfer
+    w = system.open.omega[mode]
+    half, d = np.pi / w, system.gap
+    m = min(contact_share(system, mode), 1.0)
+    if not m > 0:
+        return None
 
-    def det(alpha: float, beta: float) -> float:  # the mid-open amplitudes' matrix (closing_residual's L)
-        co, so = np.cos(o.omega * alpha), np.sin(o.omega * alpha)
-        cc, sc = np.cos(c.omega * beta), np.sin(c.omega * beta)
-        L = -(sc * c.omega)[:, None] * (P * co) - cc[:, None] * (P * (o.omega * so))
-        sign, logdet = np.linalg.slogdet(L)
-        return float(sign)
+    def r(u: float) -> float:  # α = π/ω - β + u m β: the root at u ≈ 0, the pole at u ≈ -κ/m <= -1
+        value = closing_residual(system, half - beta + u * m * beta, beta)[1]
+        return value if np.isfinite(value) else np.nan
 
-    half = np.pi / w
-    for beta in np.array([1e-6, 1e-5, 1e-4, 1e-3]) / w:
-        lo, hi = 0.9 * half, 1.1 * half  # the pole: where L is singular, beside half the linear period
-        grid = np.linspace(lo, hi, 401)
-        s = np.array([det(x, beta) for x in grid])
-        flips = np.flatnonzero(s[:-1] != s[1:])
-        if not flips.size:
+    brackets = [(-0.5, 1.0)]
+    ends = {u: r(u) for u in brackets[0]}
+    if not ends[-0.5] > 0 > ends[1.0]:  # beyond leading order (the pole moved more than the root): scan both
+        near = 0.5 ** np.arange(1, 21)  # sides of the root's place u = 0, and towards the pole and away from it
+        grid = np.concatenate([-(1 - near[:6]), -near, [0.0], near[::-1], 4.0 ** np.arange(5)])
+        ends.update({u: r(u) for u in grid if u not in ends})
+        u = np.array(sorted(ends))
+        v = np.array([ends[x] for x in u])
+        brackets = [(u[i], u[i + 1]) for i in np.flatnonzero(np.isfinite(v[:-1]) & np.isfinite(v[1:])
+                                                            & (np.sign(v[:-1]) != np.sign(v[1:])))]
+    for lo, hi in brackets:
+        try:
+            u = brentq(r, lo, hi, xtol=1e-14, rtol=4 * np.finfo(float).eps)
+        except ValueError:
             continue
-        k = flips[np.argmin(np.abs(grid[flips] - half))]
-        a0, a1 = grid[k], grid[k + 1]
-        for _ in range(200):  # bisection on the determinant's sign to the last bit
-            m = 0.5 * (a0 + a1)
-            if m in (a0, a1):
-                break
-            a0, a1 = (m, a1) if det(m, beta) == s[k] else (a0, m)
-        pole = 0.5 * (a0 + a1)
-        eps = pole * np.logspace(-2, -15, 261)
-        for side in (-1.0, 1.0):
-            a = pole + side * eps
-            r = np.array([closing_residual(system, x, beta)[1] for x in a])
-            for k in np.flatnonzero(np.isfinite(r[:-1]) & np.isfinite(r[1:]) & (np.sign(r[:-1]) != np.sign(r[1:]))):
-                root = brentq(lambda x, b=beta: closing_residual(system, x, b)[1], min(a[k], a[k + 1]),
-                              max(a[k], a[k + 1]), xtol=1e-15 * pole, rtol=4 * np.finfo(float).eps)
-                if abs(closing_residual(system, root, beta)[1]) <= 1e-8 * system.gap:
-                    return np.array([root, beta])
-    raise ValueError("no grazing orbit found from the linear mode: the closing residual has no root beside its "
-                     "pole at half the linear period (the contact does not see this mode?)")
+        alpha = half - beta + u * m * beta
+        if abs(closing_residual(system, alpha, beta)[1]) <= 1e-8 * d:
+            return np.array([alpha, beta])
+    return None
+
+
+def _is_grazing_root(system: MasslessSystem, mode: int, z: np.ndarray) -> bool:
+    """Whether the root ``z = (α, β)`` is the one grown from grazing of ``mode``: nearer ``δ = -β`` than half way
+    to the pole (a root beside another pole of ``r`` — another mode's — is not)."""
+    w = system.open.omega[mode]
+    m = min(contact_share(system, mode), 1.0)
+    return bool(m > 0 and 0 < z[1] and abs(z[0] + z[1] - np.pi / w) <= 0.5 * m * z[1])
+
+
+def _grazing_start(system: MasslessSystem, mode: int) -> np.ndarray:
+    """The first point ``(α, β)`` of the branch grown from grazing of ``mode``, bracketed beside its pole.
+
+    The root lies ``κβ`` from the pole (:func:`contact_share`): a soft casing puts it within ``1e-7`` of ``π/ω`` at
+    ``βω = 1e-6`` (``1e7`` N/m on a stiff plate), beyond double precision for ``κβω`` below
+    :data:`GRAZING_RESOLUTION`. The contact half-time ``βω`` starts at ``1e-6`` (as Newton does), or at the
+    shortest that resolves the root, and grows tenfold up to :data:`GRAZING_BETA_MAX`; ``ValueError`` saying why
+    (computed from the system) if none does."""
+    w = system.open.omega[mode]
+    kappa = contact_share(system, mode)
+    shortest = max(1e-6, GRAZING_RESOLUTION / kappa) if kappa > 0 else np.inf
+    tried = [shortest * 10.0 ** i for i in range(6) if shortest * 10.0 ** i <= GRAZING_BETA_MAX * (1 + 1e-12)]
+    if tried and tried[-1] < GRAZING_BETA_MAX / 2:
+        tried.append(GRAZING_BETA_MAX)
+    for bw in tried:
+        z = _grazing_root(system, mode, bw / w)
+        if z is not None:
+            if bw > 1e-6:
+                log.info("massless branch of open mode %d: the contact stiffens it by κ = %.3g of its stiffness; its "
+                         "orbits are resolved from a contact phase of %.2g %% of the period on (closer to grazing the "
+                         "closing residual's root is within rounding of its pole)", mode + 1, kappa, 100 * bw / np.pi)
+            return z
+    raise ValueError(_no_grazing_reason(system, mode, tried))
+
+
+def _no_grazing_reason(system: MasslessSystem, mode: int, tried: list[float]) -> str:
+    """Why no orbit grows from grazing of ``mode``, in the system's numbers."""
+    o = system.open
+    w, b = o.omega[mode], float(o.b[mode])
+    f = w / (2 * np.pi)
+    kappa = contact_share(system, mode)
+    shares = system.kc * o.b**2 / o.omega**2
+    best = int(np.argmax(shares))
+    head = f"no grazing orbit found from open-phase mode {mode + 1} ({f:.6g} Hz): "
+    seen = (f"the contact sees mode {best + 1} ({o.omega[best] / (2 * np.pi):.6g} Hz) most, b = {o.b[best]:.3g}, "
+            f"κ = {shares[best]:.3g}")
+    if not tried:
+        energy = 0.5 * w**2 * (system.gap / b) ** 2 if b else np.inf
+        return (head + f"the contact hardly sees it — its contact participation b = {b:.3g} is "
+                f"{abs(b) / np.abs(o.b).max():.1e} of the largest, so the contact's spring ({system.kc:.4g}) adds "
+                f"only κ = k b²/ω² = {kappa:.2e} to the mode's stiffness (its frequency by {50 * kappa:.1e} %) and "
+                f"grazing takes the energy {energy:.3g}. Its one-phase orbits are the linear mode to within κ: the "
+                f"closing residual's root lies κβ from its pole, below double precision for any contact shorter than "
+                f"{100 * GRAZING_BETA_MAX / np.pi:.0f} % of the period (resolving it needs κ >= "
+                f"{GRAZING_RESOLUTION / GRAZING_BETA_MAX:.0e}). Put the contact where this mode moves it, or search "
+                f"near a mode the contact sees ({seen})")
+    ratio = o.omega / w
+    near = [i for i in range(system.n) if i != mode and ratio[i] > 1.5 and abs(ratio[i] - np.rint(ratio[i])) <= 0.02]
+    resonance = "".join(f"; open-phase mode {i + 1} ({o.omega[i] / (2 * np.pi):.6g} Hz) is "
+                        f"{ratio[i]:.4f} × its frequency (an internal resonance at grazing)" for i in near)
+    return (head + f"the closing residual has no root beside its pole at contact half-times βω = "
+            f"{tried[0]:.2g} … {tried[-1]:.2g} (κ = k b²/ω² = {kappa:.3g}, b = {b:.3g}{resonance}); {seen}")
 
 
 def follow_from_grazing(system: MasslessSystem, T_min: float, mode: int = 0, ds: float = 1e-3,
@@ -330,8 +427,10 @@ def follow_from_grazing(system: MasslessSystem, T_min: float, mode: int = 0, ds:
             lam /= 2
         z[0] -= lam * step
     r = closing_residual(system, *z)[1]
-    if not (abs(r) <= 1e-8 * system.gap and 0.5 * np.pi / w < z[0] < 1.5 * np.pi / w):
-        z = _grazing_start(system, w)  # Newton missed the root beside the pole (a soft casing): bracket it
+    narrow = False
+    if not (abs(r) <= 1e-8 * system.gap and _is_grazing_root(system, mode, z)):
+        z = _grazing_start(system, mode)  # Newton missed the root beside the pole (a soft casing): bracket it
+        narrow = z[1] * w > 1.5e-6  # resolved beyond Newton's contact half-time: the valley of r is narrow
     out: list[SymmetricOrbit] = []
     tangent, h, ds_max = None, ds * L, ds_max * L
     while len(out) < max_points:
@@ -341,7 +440,7 @@ def follow_from_grazing(system: MasslessSystem, T_min: float, mode: int = 0, ds:
         t = t if (t[1] > 0 if tangent is None else t @ tangent > 0) else -t
         tangent = t
         while True:
-            zp, ok, it = _correct(system, z + h * tangent, L)
+            zp, ok, it = _correct(system, z + h * tangent, L, narrow)
             if ok and np.hypot(*(zp - z)) < 2 * h and (zp - z) @ tangent > 0:
                 h = min(h * (1.5 if it <= 3 else 1.0), ds_max)
                 break
