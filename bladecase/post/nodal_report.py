@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["load_words", "nodal_report"]
+__all__ = ["backbone_rows", "end_words", "load_words", "nodal_report", "tongue_words"]
 
 
 def load_words(row: dict, face_mm2: float | None = None) -> str:
@@ -43,13 +43,88 @@ def load_words(row: dict, face_mm2: float | None = None) -> str:
             f"{row['total_force_n']:.3g} N, over {row['loaded_area_mm2']:.3g} mm²{face}{at}")
 
 
+def _ordinal(n: int) -> str:
+    return f"{n}{'th' if 10 <= n % 100 <= 20 else {1: 'st', 2: 'nd', 3: 'rd'}.get(n % 10, 'th')}"
+
+
+def backbone_rows(section: dict) -> list[dict]:
+    """The rows of the orbits on the backbone: a row's ``on_backbone`` if it has one, else every row outside the
+    section's ``tongues`` (``start``–``stop`` index ranges, :attr:`~bladecase.nsm.massless.NodalFamily.tongues`);
+    all rows when neither says (a summary from before the tongues were recorded)."""
+    rows = section.get("rows") or []
+    if rows and "on_backbone" in rows[0]:
+        return [r for r in rows if r["on_backbone"]] or rows
+    off = {i for t in section.get("tongues") or [] for i in range(t["start"], t["stop"] + 1)}
+    return [r for i, r in enumerate(rows) if i not in off] or rows
+
+
+def _trend_words(trend: dict | None) -> str:
+    if not trend:
+        return ""
+    return (f"; below it the backbone rises {trend['hz_per_doubling']:.2g} Hz per doubling of the energy "
+            f"(f ≈ {trend['frequency_hz']:.5g} Hz + {trend['df_dlnE_hz']:.3g} Hz × ln(E / {trend['energy_j']:.3g} J), "
+            f"from {trend['frequency_range_hz'][0]:.5g} Hz): extrapolate along it to read the backbone beyond")
+
+
+def end_words(section: dict) -> str:
+    """The report's line on how the family ends, from ``section["end"]``
+    (:attr:`~bladecase.nsm.massless.NodalFamily.end`), else from ``section["stop"]``.
+
+    >>> end = {"kind": "internal_resonance", "frequency_hz": 215.4987, "energy_j": 0.0263, "mode": 2,
+    ...        "mode_frequency_hz": 1722.36, "ratio": "8:1", "ratio_value": 7.9924, "share": 0.44, "other_share": 0.553,
+    ...        "crossing": "not crossed (through_resonances=False)", "mesh_dependent": True,
+    ...        "trend": {"frequency_hz": 213.9, "energy_j": 0.00925, "df_dlnE_hz": 5.1, "hz_per_doubling": 3.5,
+    ...                  "frequency_range_hz": [211.3, 213.9]}}
+    >>> print(end_words({"end": end, "stop": "internal resonance at …"}))
+    - The family ends in an internal resonance at 215.5 Hz: its motion turns into the 3rd mode of the blade with \
+the contacts open (1722 Hz, 8:1 — 7.99 × the orbit's frequency), which takes 55% of the modal energy. Where such a \
+resonance falls depends on the mesh (the high modes move with it), so this is where the mesh ends the backbone, not \
+the blade; below it the backbone rises 3.5 Hz per doubling of the energy (f ≈ 213.9 Hz + 5.1 Hz × \
+ln(E / 0.00925 J), from 211.3 Hz): extrapolate along it to read the backbone beyond.
+    """
+    end = section.get("end")
+    if not end or end.get("kind") != "internal_resonance":
+        return f"- The family ends: {section.get('stop', 'where the continuation stopped')}."
+    return (f"- The family ends in an internal resonance at {end['frequency_hz']:.5g} Hz: its motion turns into the "
+            f"{_ordinal(end['mode'] + 1)} mode of the blade with the contacts open ({end['mode_frequency_hz']:.4g} Hz, "
+            f"{end['ratio']} — {end['ratio_value']:.3g} × the orbit's frequency), which takes "
+            f"{end.get('other_share', 1 - end['share']):.0%} of the modal energy. Where such a resonance falls depends "
+            "on the mesh (the high modes move with it), so this is where the mesh ends the backbone, not the blade"
+            f"{_trend_words(end.get('trend'))}.")
+
+
+def tongue_words(section: dict) -> str | None:
+    """The report's line on the internal resonances the family passed (``section["tongues"]`` whose ``left`` is
+    ``"crossed"`` or ``"continued"``), or None.
+
+    >>> print(tongue_words({"tongues": [{"start": 11, "stop": 17, "mode": 2, "mode_frequency_hz": 1722.4,
+    ...     "ratio": "8:1", "frequency_hz": 215.499, "left": "crossed", "to_frequency_hz": 215.69}]}))
+    - On the way it passes 1 internal resonance: with the 3rd open-contact mode (1722 Hz) at 8:1 near 215.5 Hz, \
+crossed to the backbone at 215.69 Hz; the family's 7 orbits inside its tongue are not on the backbone (`on_backbone` \
+in `nodal_modes.csv`). Where a tongue sits depends on the mesh; the backbone on either side does not.
+    """
+    passed = [t for t in section.get("tongues") or [] if t.get("left") in ("crossed", "continued")]
+    if not passed:
+        return None
+    items = [f"with the {_ordinal(t['mode'] + 1)} open-contact mode ({t['mode_frequency_hz']:.4g} Hz) at {t['ratio']} "
+             f"near {t['frequency_hz']:.5g} Hz, " + (f"crossed to the backbone at {t['to_frequency_hz']:.5g} Hz"
+                                                      if t["left"] == "crossed" else "passed by the continuation")
+             for t in passed]
+    inside = sum(t["stop"] - t["start"] + 1 for t in passed)
+    many = len(passed) > 1
+    return (f"- On the way it passes {len(passed)} internal resonance{'s' if many else ''}: " + "; ".join(items)
+            + f"; the family's {inside} orbits inside {'their tongues' if many else 'its tongue'} are not on the "
+            "backbone (`on_backbone` in `nodal_modes.csv`). Where a tongue sits depends on the mesh; the backbone on "
+            "either side does not.")
+
+
 def nodal_report(section: dict | None) -> list[str]:
     """Markdown lines for ``summary["nodal_modes"]`` (:func:`bladecase.study.nodal.nodal_stage`)."""
     if not section or not section.get("rows"):
         return [] if not section else ["", "## Every face node a contact", "",
                                        f"- No orbit: {section.get('stop', 'the family could not be started')}."]
     rows = section["rows"]
-    top = max(rows, key=lambda r: r["energy_j"])
+    top = max(backbone_rows(section), key=lambda r: r["energy_j"])
     lo, hi = section["frequency_range_hz"]
     first = section.get("first_touch_nodes") or []
     stable = section.get("stable_fraction")
@@ -66,7 +141,10 @@ def nodal_report(section: dict | None) -> list[str]:
              f"{top['max_contact_fraction']:.0%} of the period and the casing yields up to "
              f"{top['max_penetration_mm'] * 1e3:.0f} µm"
              + ("" if stable is None else f"; {stable:.0%} of the orbits are linearly stable") + ".",
-             f"- The family ends: {section['stop']}."]
+             end_words(section)]
+    passed = tongue_words(section)
+    if passed:
+        lines.append(passed)
     ref = section.get("reference")
     if ref and ref.get("checked"):
         bad = ref["checked"] - ref["survived"]

@@ -34,7 +34,8 @@ __all__ = ["nodal_stage", "orbit_load"]
 
 COLUMNS = ("frequency_hz", "period_s", "energy_j", "nodes_touching", "touching_nodes", "max_pressure_mpa",
            "total_force_n", "loaded_area_mm2", "peak_loaded_area_mm2", "load_centre", "load_location",
-           "max_contact_fraction", "max_penetration_mm", "max_tip_mm", "stable", "residual", "reference_drift")
+           "max_contact_fraction", "max_penetration_mm", "max_tip_mm", "stable", "residual", "reference_drift",
+           "on_backbone")
 
 
 def orbit_load(nodal, orbit) -> dict:
@@ -97,6 +98,13 @@ def _reference_checks(study, nodal, orbits, reference) -> dict | None:
             "drifts": drifts}
 
 
+def _face_top_energy(families) -> float | None:
+    """The face mean's highest admissible energy: how far the every-node family is followed (``None``: no arc)."""
+    tops = [float(np.max(f.energy[a.start:a.stop + 1][f.admissible[a.start:a.stop + 1]])) for f in families
+            for a in f.arcs if f.admissible[a.start:a.stop + 1].any()]
+    return max(tops) if tops else None
+
+
 def _log_casing(nodal) -> None:
     """What casing each node gets: the face's stiffness shared by tributary area is a stiffness per unit area."""
     k = np.asarray(nodal.system.casing, dtype=float)
@@ -131,20 +139,23 @@ def nodal_stage(study, model, contact, families, reduced, *, factor=None, folder
     size = study["reduction"]["size"] or 8
     nodal = nodal_model(model, contact, size, factor=factor, residual=True)
     _log_casing(nodal)
-    fam = nodal_family(nodal.system, 0)
+    top = _face_top_energy(families)
+    cap = {"energy_max": top} if top is not None else {"freq_ratio": 1.0 / study["search"]["periods"][0]}
+    fam = nodal_family(nodal.system, 0, through_resonances=True, **cap)  # up to the face mean's energy
     orbits = fam.orbits
     reference = (nodal_extension(nodal, REFERENCE_FACTOR * nodal.n, factor) if study["output"]["reference"]
                  and orbits else None)
     checks = _reference_checks(study, nodal, orbits, reference)
-    rows = [dict(_row(nodal, o), reference_drift=(checks["drifts"].get(n) if checks else None))
-            for n, o in enumerate(orbits)]
+    rows = [dict(_row(nodal, o), reference_drift=(checks["drifts"].get(n) if checks else None), on_backbone=bool(on))
+            for n, (o, on) in enumerate(zip(orbits, fam.on_backbone))]
+    back = [r for r in rows if r["on_backbone"]] or rows
     stable = [r["stable"] for r in rows]
     section = {
         "size": size, "contact_nodes": nodal.system.m, "reduced_dofs": nodal.system.n,
         "face_area_mm2": float(nodal.areas.sum()) * 1e6,
-        "orbits": len(rows), "stop": fam.stop,
-        "frequency_range_hz": [rows[0]["frequency_hz"], max(r["frequency_hz"] for r in rows)] if rows else None,
-        "energy_range_j": [rows[0]["energy_j"], max(r["energy_j"] for r in rows)] if rows else None,
+        "orbits": len(rows), "stop": fam.stop, "end": fam.end, "tongues": [dict(t) for t in fam.tongues],
+        "frequency_range_hz": [back[0]["frequency_hz"], max(r["frequency_hz"] for r in back)] if rows else None,
+        "energy_range_j": [back[0]["energy_j"], max(r["energy_j"] for r in back)] if rows else None,
         "stable_fraction": float(np.mean(stable)) if stable else None,
         "first_touch_nodes": next((r["touching_nodes"].split() for r in rows if r["touching_nodes"]), []),
         "most_nodes_touching": max((r["nodes_touching"] for r in rows), default=0),

@@ -154,7 +154,7 @@ def converged_check(orbit, nodal, extend) -> dict:
 
 def _pick(family, target_energy: float | None):
     """The orbit to animate: nearest in energy to ``target_energy`` (log scale), else the middle in energy."""
-    orbits = [o for o in family.orbits if o.touching.any()]
+    orbits = [o for o, on in zip(family.orbits, family.on_backbone) if on and o.touching.any()]  # not in a tongue
     if not orbits:
         return None
     e = np.array([o.energy for o in orbits])
