@@ -136,9 +136,9 @@ def sweep(workers: int) -> None:
     finally:
         ex.close()
     rows = section["rows"]
-    peak = max(rows, key=lambda r: r["tip_displacement_mm"])
+    peak = max(rows, key=lambda r: r["tip_normal_displacement_mm"])
     print(f"   {dt:.1f} s ({'MET' if dt <= 120 else 'NOT MET'}: goal <= 120 s); {sum(r['switches'] for r in rows)} "
-          f"switches; hardest rub at {peak['speed']:.0f} rpm: {peak['tip_displacement_mm']:.3f} mm, "
+          f"switches; hardest rub at {peak['speed']:.0f} rpm: {peak['tip_normal_displacement_mm']:.3f} mm, "
           f"{peak['total_force_n']:.2f} N in total, {peak['max_pressure_mpa']:.3g} MPa, {peak['nodes_touching']} "
           f"nodes; not settled at "
           f"{len(section['unsettled_speeds'])} of 50 speeds")

@@ -7,7 +7,7 @@ run.log, modes.json and forced.csv.
   figures; Newton's (impacts, impulses) kept for Newton studies;
 * forced.csv: one unit per column, as the name's suffix (the convention of comparison.csv and summary.json);
 * a face contact is named as a face in the log and the report;
-* tip displacement (mm), contact force (N) or impulses (N·s), contact fraction and casing penetration per animated
+* tip amplitude |u| (mm), contact force (N) or impulses (N·s), contact fraction and casing penetration per animated
   orbit and per admissible arc, and the contact stiffnesses — each checked against an independent computation.
 """
 
@@ -307,7 +307,7 @@ def test_tip_and_contact_force_of_the_animated_orbit(demo):
     (momentum,) = entry["contact_momentum_ns"]
     assert 2 / np.pi * 0.9 * entry["contact_force_n"] * (c1 - c0) < momentum < entry["contact_force_n"] * (c1 - c0)
     report, log, _ = _texts(demo)
-    words = (f"tip displacement up to {entry['tip_amplitude_mm']:.4g} mm (node {entry['tip_amplitude_node_id']}, "
+    words = (f"tip amplitude |u| up to {entry['tip_amplitude_mm']:.4g} mm (node {entry['tip_amplitude_node_id']}, "
              f"t/T = {entry['tip_amplitude_t_over_T']:.3f}); contact force up to {entry['contact_force_n']:.4g} N, "
              f"in contact {100 * entry['contact_fraction']:.3g} % of the period; the casing yields up to "
              f"{entry['casing_penetration_m'] * 1e6:.4g} µm (λ/k)")
@@ -341,7 +341,7 @@ def test_engineering_ranges_of_the_admissible_arcs(demo):
                  f"{a['tip_amplitude_range_mm'][1]:.4g} | {a['contact_force_range_n'][0]:.4g} – "
                  f"{a['contact_force_range_n'][1]:.4g} |")
         assert cells in report
-    assert "| family | admissible arc f (Hz) | orbits used | tip displacement (mm) | peak contact force (N) | in " \
+    assert "| family | admissible arc f (Hz) | orbits used | tip amplitude |u| (mm) | peak contact force (N) | in " \
            "contact (% of the period) | casing penetration (µm) |" in report
     assert json.dumps(demo.summary, allow_nan=False)
 

@@ -67,7 +67,8 @@ def test_a_speed_that_settles_late_runs_on_from_where_it_stopped():
 def test_the_report_says_which_speeds_ran_on():
     r = rub_response(two_nodes(), 0.5, 3, 1.2, [0.0, 0.3], Damping(zeta=0.02), revolutions=6, window=3,
                      max_revolutions=60)
-    row = {"speed": 4.77, "speed_rad_s": 0.5, "speed_ratio": None, "tip_displacement_mm": 1e3 * r.tip_displacement,
+    row = {"speed": 4.77, "speed_rad_s": 0.5, "speed_ratio": None,
+           "tip_normal_displacement_mm": 1e3 * r.tip_displacement,
            "max_pressure_mpa": 1.0, "total_force_n": r.total_force, "loaded_area_mm2": 1.0,
            "peak_loaded_area_mm2": 1.0, "load_centre": 0.5, "load_location": "mid-chord",
            "max_node_force_n": float(r.peak_force.max()), "contact_fraction": float(r.contact_fraction.max()),
@@ -203,7 +204,7 @@ def test_the_crossing_speed_meets_the_lobes_excitation():
 
 
 def test_the_report_quotes_the_hardest_rub_against_the_crossing_speed():
-    row = {"speed": 8100.0, "speed_rad_s": 848.2, "speed_ratio": 1.0213, "tip_displacement_mm": 0.5,
+    row = {"speed": 8100.0, "speed_rad_s": 848.2, "speed_ratio": 1.0213, "tip_normal_displacement_mm": 0.5,
            "max_pressure_mpa": 2.0, "total_force_n": 30.0, "loaded_area_mm2": 20.0, "peak_loaded_area_mm2": 25.0,
            "load_centre": 0.8, "load_location": "trailing edge", "max_node_force_n": 3.0, "contact_fraction": 0.2,
            "penetration_mm": 0.01, "nodes_touching": 12, "switches": 900, "settled": True, "response": "periodic-9",

@@ -21,19 +21,19 @@ from .verdict import (  # noqa: F401 (re-exported)
 
 def engineering_words(a: dict, massless: bool) -> str:
     """What the blade and the casing see over an animated orbit (its ``summary.json`` entry), in a sentence:
-    tip displacement, contact force (Newton: impulses) and duration, the casing's give.
+    tip amplitude |u|, contact force (Newton: impulses) and duration, the casing's give.
 
     >>> text = engineering_words({"tip_amplitude_mm": 0.5, "tip_amplitude_node_id": 3, "tip_amplitude_t_over_T": 0.09,
     ...                           "contact_force_n": 27.3, "contact_fraction": 0.181,
     ...                           "casing_penetration_m": 2.73e-5}, True)
     >>> print(*text.split("; "), sep="\\n")
-    tip displacement up to 0.5 mm (node 3, t/T = 0.090)
+    tip amplitude |u| up to 0.5 mm (node 3, t/T = 0.090)
     contact force up to 27.3 N, in contact 18.1 % of the period
     the casing yields up to 27.3 µm (λ/k)
     """
     if "tip_amplitude_mm" not in a:
         return "no engineering quantities in this summary"
-    words = [f"tip displacement up to {a['tip_amplitude_mm']:.4g} mm (node {a['tip_amplitude_node_id']}, "
+    words = [f"tip amplitude |u| up to {a['tip_amplitude_mm']:.4g} mm (node {a['tip_amplitude_node_id']}, "
              f"t/T = {a['tip_amplitude_t_over_T']:.3f})"]
     if massless:
         words.append(f"contact force up to {a['contact_force_n']:.4g} N, in contact "
@@ -322,7 +322,7 @@ def _arc_engineering_table(with_arcs: list, massless: bool) -> list[str]:
     if not rows:
         return []
     casing = massless and any("casing_penetration_range_m" in a for _, a in rows)
-    head = ["family", "admissible arc f (Hz)", "orbits used", "tip displacement (mm)"]
+    head = ["family", "admissible arc f (Hz)", "orbits used", "tip amplitude |u| (mm)"]
     if massless:
         head += ["peak contact force (N)", "in contact (% of the period)"] + (["casing penetration (µm)"] * casing)
         what = ("the largest contact force λ, the share of the period in contact"
@@ -331,7 +331,7 @@ def _arc_engineering_table(with_arcs: list, massless: bool) -> list[str]:
         head += ["largest impulse (N·s)"]
         what = "the largest impulse"
     lines = ["", "Tip and casing over each admissible arc, lowest – highest over the orbits used (evenly spread over "
-             f"the arc, ends included), each expanded to the FE model: the largest tip displacement |u| over the "
+             f"the arc, ends included), each expanded to the FE model: the largest tip amplitude |u| over the "
              f"period, {what}.", "", "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
 
     def span(a: dict, key: str, scale: float = 1.0, fmt: str = ".4g") -> str:

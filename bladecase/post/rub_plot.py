@@ -1,16 +1,16 @@
-"""The interaction diagram of a rub sweep: peak tip displacement, peak total contact force and peak contact
+"""The interaction diagram of a rub sweep: peak tip normal displacement, peak total contact force and peak contact
 pressure against speed, with the speeds where the casing's lobes excite a linear mode (``n·Ω = ω_k``, dashed) and
 where they excite a nonsmooth mode's frequency band (shaded); on top, the ratio of the speed to the crossing speed
 of mode 1. Each point says what the response is: settled, periodic over another period (a sub-harmonic), or not
 settled.
 
 >>> section = {"speed_unit": "rpm", "lobes": 3, "rows": [
-...     {"speed": s, "tip_displacement_mm": d, "total_force_n": f, "max_pressure_mpa": f / 20, "settled": True}
+...     {"speed": s, "tip_normal_displacement_mm": d, "total_force_n": f, "max_pressure_mpa": f / 20, "settled": True}
 ...     for s, d, f in [(3000, 0.05, 1.0), (4000, 0.4, 9.0), (5000, 0.1, 2.0)]],
 ...     "resonances": [{"mode": 1, "speed": 4100.0}], "nonsmooth_bands_hz": [(210.0, 216.0)]}
 >>> fig = interaction_plot(section)
 >>> [ax.get_ylabel() for ax in fig.axes]
-['peak tip displacement (mm)', 'peak total contact force (N)', 'peak contact pressure (MPa)']
+['peak tip normal displacement (mm)', 'peak total contact force (N)', 'peak contact pressure (MPa)']
 >>> section["crossing"] = {"mode": 1, "speed": 4100.0}
 >>> section["rows"][1]["response"] = "periodic-6"
 >>> interaction_plot(section).axes[0].child_axes[0].get_xlabel()
@@ -40,8 +40,8 @@ def interaction_plot(section: dict, title: str | None = None) -> Figure:
     settled = np.array([r["settled"] for r in rows], dtype=bool)
     periodic = np.array([str(r.get("response", "")).startswith("periodic-") for r in rows], dtype=bool)
     campbell = bool(section.get("open_hz"))
-    series = [("tip_displacement_mm", "peak tip displacement (mm)"), ("total_force_n", "peak total contact force (N)"),
-              ("max_pressure_mpa", "peak contact pressure (MPa)")]
+    series = [("tip_normal_displacement_mm", "peak tip normal displacement (mm)"),
+              ("total_force_n", "peak total contact force (N)"), ("max_pressure_mpa", "peak contact pressure (MPa)")]
     fig = new_figure(figsize=(7.0, 9.6 if campbell else 7.4), layout="constrained")
     axes = fig.subplots(len(series) + int(campbell), 1, sharex=True)
     lobes = section["lobes"]

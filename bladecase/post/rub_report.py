@@ -2,7 +2,7 @@
 rubs, how hard, at which speed and at what ratio to the crossing speed of mode 1, and whether each figure can be
 trusted (a speed that ran on to settle, a sub-harmonic, a response that never settled and what it is).
 
->>> rows = [{"speed": s, "speed_rad_s": s * 0.10472, "tip_displacement_mm": d, "max_pressure_mpa": q,
+>>> rows = [{"speed": s, "speed_rad_s": s * 0.10472, "tip_normal_displacement_mm": d, "max_pressure_mpa": q,
 ...          "total_force_n": f, "loaded_area_mm2": a, "peak_loaded_area_mm2": a, "load_centre": x,
 ...          "load_location": where, "max_node_force_n": f / 4, "contact_fraction": c, "penetration_mm": p,
 ...          "nodes_touching": n, "switches": 100, "settled": ok}
@@ -66,14 +66,14 @@ def rub_report(section: dict | None) -> list[str]:
              f"{unit}, {section['revolutions']} revolutions each, the figures read on the last {section['window']} "
              "(the stiffness and the running clearances at each speed: centrifugal state about the casing's axis).",
              "- Files: `rub.csv` (per speed), `rub_nodes.csv` (per speed and node, with each node's contact pressure), "
-             "`rub.png` (peak tip displacement, total contact force and contact pressure against speed)."]
+             "`rub.png` (peak tip normal displacement, total contact force and contact pressure against speed)."]
     touching = w["touching_nodes"]
     if w["total_force_n"] > 0:
         face = (section.get("model") or {}).get("face_area_mm2")
         ratio = (f" ({w['speed_ratio']:.3g} × the crossing speed of mode 1)" if w.get("speed_ratio") is not None
                  else "")
         lines.append(f"- The hardest rub is at {w['speed']:.6g} {unit}{ratio}: the tip reaches "
-                     f"{w['tip_displacement_mm']:.4g} "
+                     f"{w['tip_normal_displacement_mm']:.4g} "
                      f"mm outwards, {w['nodes_touching']} nodes touch (nodes {', '.join(map(str, touching[:12]))}"
                      f"{', …' if len(touching) > 12 else ''}){_where(w.get('touching_along_tip'))}; "
                      f"{load_words(w, face)}; a node is in contact for up to {w['contact_fraction']:.0%} of a "

@@ -13,7 +13,7 @@ executor. Each speed is also given as its ratio to the **crossing speed** of mod
 ``lobes·Ω/2π`` meets mode 1's frequency at speed, :func:`crossing_speed`): at the same ratio the rub of two meshes
 compares without the meshes' error in ``f1``. Outputs:
 ``rub.csv`` (one row per speed), ``rub_nodes.csv`` (one row per speed and node), ``rub.png`` (the interaction
-diagram: peak tip displacement, peak total contact force and peak contact pressure against speed, with the speeds
+diagram: peak tip normal displacement, peak total contact force and peak contact pressure against speed, with the speeds
 where the casing's lobes excite a linear mode and, when the study found nonsmooth modes, where they excite the
 nonsmooth mode's band).
 
@@ -46,7 +46,7 @@ COLUMNS = {
     "speed": "the speed, in [rub] speed_unit",
     "speed_rad_s": "the speed (rad/s)",
     "speed_ratio": "the speed over the crossing speed of mode 1 with the lobes' excitation (empty: no crossing)",
-    "tip_displacement_mm": "the largest peak outward normal displacement over the contact nodes (mm)",
+    "tip_normal_displacement_mm": "the largest peak outward normal displacement over the contact nodes (mm)",
     "max_pressure_mpa": "the largest contact pressure over the nodes and the window (MPa): force over tributary area",
     "total_force_n": "the peak over the window of the total contact force, the sum over the nodes (N)",
     "loaded_area_mm2": "the area of the nodes in contact at the instant of that peak (mm²)",
@@ -281,7 +281,7 @@ def _write_vtu(path: Path, model, contact: Contact, section: dict, points: list[
     mesh = model.mesh
     n = len(mesh.points)
     idx = np.asarray(contact.nodes)
-    worst = points[int(np.argmax([r["tip_displacement_mm"] for r in section["rows"]]))]
+    worst = points[int(np.argmax([r["tip_normal_displacement_mm"] for r in section["rows"]]))]
     data = {}
     for key, scale, unit in (("peak_displacement", 1e3, "mm"), ("peak_force", 1.0, "n"),
                              ("contact_fraction", 1.0, ""), ("penetration", 1e3, "mm"), ("peak_pressure", 1.0, "")):
@@ -331,7 +331,7 @@ def _summary(study, speeds: np.ndarray, points: list[dict], families, contact: C
     if not rows:
         raise StudyError(f"[rub] speeds: the simulation was refused at every speed; at {failed[0]['speed']:.6g} "
                          f"{unit}: {failed[0]['reason']}")
-    worst = int(np.argmax([row["tip_displacement_mm"] for row in rows]))
+    worst = int(np.argmax([row["tip_normal_displacement_mm"] for row in rows]))
     p = good[worst]
     touching = [i for i, f in enumerate(p["contact_fraction"]) if f > 0]
     where = _along_tip(model, contact, touching)
@@ -366,7 +366,7 @@ def _row(speed: float, w: float, p: dict, crossing: dict | None, lobes: int) -> 
     load = p["load"]
     return {"speed": speed, "speed_rad_s": w,
             "speed_ratio": None if crossing is None else w / crossing["speed_rad_s"],
-            "tip_displacement_mm": 1e3 * max(p["peak_displacement"]),
+            "tip_normal_displacement_mm": 1e3 * max(p["peak_displacement"]),
             "max_pressure_mpa": 1e-6 * max(p["peak_pressure"]), "total_force_n": float(p["total_force"]),
             "loaded_area_mm2": 1e6 * load["loaded_area_m2"], "peak_loaded_area_mm2": 1e6 * p["loaded_area"],
             "load_centre": load["centre"], "load_location": load["location"],
