@@ -260,3 +260,18 @@ def test_mesh_and_assemble_need_no_contact(plate, tmp_path, capsys):
     capsys.readouterr()
     assert _run("reduce", study, "--model", tmp_path / "m.npz", "-o", tmp_path / "r.npz") == 2
     assert "[contact] clearance: required" in capsys.readouterr().err
+
+
+def test_a_run_without_png_removes_the_previous_runs_figure(plate, tmp_path):
+    """As docs/study.md promises: results of the previous run that this run does not produce are removed —
+    frequency_energy.png after dropping png from [output] formats — and nothing else of the folder is touched."""
+    study = plate / "png.toml"
+    study.write_text(PLATE.replace('formats = ["gif", "vtu"]', 'formats = ["png"]'))
+    out = tmp_path / "out"
+    assert _run("run", study, "--out", out) == 0 and (out / "frequency_energy.png").is_file()
+    (out / "notes.txt").write_text("mine")
+    study.write_text(PLATE.replace('formats = ["gif", "vtu"]', "formats = []"))
+    assert _run("run", study, "--out", out) == 0
+    assert not (out / "frequency_energy.png").exists() and (out / "notes.txt").read_text() == "mine"
+    text = (ROOT / "docs" / "study.md").read_text()
+    assert "`frequency_energy.png` after dropping `png` from `[output] formats`) are removed" in text
