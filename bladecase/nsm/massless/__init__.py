@@ -22,6 +22,8 @@ has contact phases of finite duration instead of impacts. One module per step:
 - :mod:`~bladecase.nsm.massless.nodal_modes` — the nonsmooth modes of a :class:`NodalSystem`: periodic orbits by
   shooting with exact sensitivities, a family followed from the first node's grazing through changes of the set of
   touching nodes (:func:`nodal_family`, :class:`NodalFamily`);
+- :mod:`~bladecase.nsm.massless.nodal_resonance` — that family followed step by step through the internal-resonance
+  tongues it meets, recorded and crossed (:func:`backbone_trend`, :func:`resonance_ratio`);
 - :mod:`~bladecase.nsm.massless.rub` — the rub response of a turning blade at one speed and over speeds
   (:func:`rub_response`, :func:`rub_sweep`);
 - :mod:`~bladecase.nsm.massless.forced` — forced and damped simulation (:func:`simulate_forced_massless`;
@@ -59,6 +61,7 @@ from .nodal_modes import (
     nodal_orbit,
     transfer_state,
 )
+from .nodal_resonance import BACKBONE_SHARE, RESONANCE_SHARE, TONGUE_POINTS, backbone_trend, resonance_ratio
 from .nodes import NodalFlight, NodalSystem, NodalTrajectory, Rub, lcp, simulate_nodes
 from .orbits import (
     ADMISSIBILITY_RTOL,
@@ -74,8 +77,9 @@ from .phases import PHASES, PhasedOrbit, solve_half, split_at, violation
 from .rub import RubResponse, rub_response, rub_sweep
 
 __all__ = [
-    # nodes, nodal_modes, rub
+    # nodes, nodal_modes, nodal_resonance, rub
     "NodalFamily", "NodalOrbit", "flow_map", "grazing_orbit", "nodal_family", "nodal_orbit", "transfer_state",
+    "BACKBONE_SHARE", "RESONANCE_SHARE", "TONGUE_POINTS", "backbone_trend", "resonance_ratio",
     "NodalFlight", "NodalSystem", "NodalTrajectory", "Rub", "lcp", "simulate_nodes", "RubResponse", "rub_response",
     "rub_sweep",
     # bar
