@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _studies import PLATE as _PLATE
 from _studies import ROOT
 
 import bladecase as bc
@@ -22,31 +23,14 @@ from bladecase.cli import main
 from bladecase.reduction import load_reduced
 from bladecase.study.choose import Choice, distinct_stems
 
-PLATE = """
-[study]
-name = "plate"
-[mesh]
-path = "plate.vtu"
-[fem]
-order = 1
-mass = "lumped"
-thickness = 0.002
-[contact]
-clearance = 1e-4
-[reduction]
-method = "modal"
-size = 6
-[search]
-ipp = [1]
-periods = [0.5, 0.9999]
-scan = 24
-[output]
+#: The plate study of tests/_studies.py beside its mesh (copied into each test's folder), 6 modes, a short scan.
+PLATE = _PLATE.replace("meshes/plate.vtu", "plate.vtu").replace("size = 10", "size = 6").replace(
+    "periods = [0.5, 0.9999]\n", "periods = [0.5, 0.9999]\nscan = 24\n") + """[output]
 formats = ["gif", "vtu"]
 frames = 4
 reference = false
 manifold = false
 """
-
 
 def _run(*args) -> int:
     return main([*map(str, args), "--quiet", "--no-progress"])

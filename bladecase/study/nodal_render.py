@@ -27,9 +27,9 @@ from pathlib import Path
 import numpy as np
 
 from .. import log
-from ..nsm.massless.nodes import simulate_nodes
 from ..post.grid import fe_grid, grid_index, nodal_field
 from ..post.outputs import FORMATS, OrbitScene
+from .reference import nodal_drift, open_start, phase_changes
 
 __all__ = ["animate_nodal", "nodal_frames", "return_error"]
 
@@ -43,21 +43,10 @@ def return_error(orbit) -> dict:
     """One period of the exact event-driven simulator of ``orbit``'s own system from the middle of its longest phase
     with every node open (else from ``t = 0``): ``{"return_error", "switches", "expected", "ok"}``, the error the
     relative distance of the end state from the start in the energy norm."""
-    s = orbit.system
-    open_ = np.flatnonzero(~orbit.active.any(axis=1))
-    t0 = (orbit.starts[open_[np.argmax(orbit.durations[open_])]] + 0.5 * orbit.durations[open_].max()
-          if open_.size else 0.0)
+    t0 = open_start(orbit) or 0.0
     x0, v0 = (z[:, 0] for z in orbit.state(np.array([t0])))
-    traj = simulate_nodes(s, x0, v0, orbit.T)
-    xT, vT = (z[:, 0] for z in traj.state(np.array([orbit.T])))
-
-    def norm2(x, v):
-        return float(x @ (s.S @ x) + v @ (s.M @ v))
-
-    error = float(np.sqrt(norm2(xT - x0, vT - v0) / norm2(x0, v0)))
-    A = orbit.active
-    expected = int(np.count_nonzero(np.any(A != np.roll(A, 1, axis=0), axis=1))) if len(A) > 1 else 0
-    return {"return_error": error, "switches": int(traj.starts.size - 1), "expected": expected,
+    error, switches = nodal_drift(orbit.system, x0, v0, orbit.T)
+    return {"return_error": error, "switches": switches, "expected": phase_changes(orbit),
             "ok": bool(error <= RETURN_RTOL), "from_t_over_T": float(t0 / orbit.T)}
 
 

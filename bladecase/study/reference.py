@@ -147,26 +147,42 @@ def check_nodal_in_reference(orbit, nodal, reference) -> dict:
     count of switches is no test of its own (nodes that switch together in the orbit may switch a round-off apart
     in the reference, a grazing node may touch there), so it is given, not judged.
     """
-    from ..nsm.massless.nodes import simulate_nodes
-
     name = f"{reference.method} ({reference.n} dofs)"
-    open_ = np.flatnonzero(~orbit.active.any(axis=1))
-    if not open_.size:
+    t0 = open_start(orbit)
+    if t0 is None:
         return {"reference": name, "drift": None, "switches": 0, "expected": int(len(orbit.starts)),
                 "survives": None, "reason": "no phase of the orbit has every node open"}
-    j = open_[np.argmax(orbit.durations[open_])]
-    t0 = orbit.starts[j] + 0.5 * orbit.durations[j]
     x_r, v_r = (z[:, 0] for z in orbit.state(np.array([t0])))
     q0, p0 = _project(reference, np.column_stack([nodal.basis @ x_r, nodal.basis @ v_r])).T  # open: no λ term
-    s = reference.system
-    traj = simulate_nodes(s, q0, p0, orbit.T)
-    xT, vT = (z[:, 0] for z in traj.state(np.array([orbit.T])))
+    drift, switches = nodal_drift(reference.system, q0, p0, orbit.T)
+    return {"reference": name, "drift": drift, "switches": switches, "expected": phase_changes(orbit),
+            "survives": bool(drift <= SURVIVAL_RTOL)}
+
+
+def open_start(orbit) -> float | None:
+    """The middle of the longest phase of a nodal orbit with every node open (``None``: it has none)."""
+    open_ = np.flatnonzero(~orbit.active.any(axis=1))
+    if not open_.size:
+        return None
+    j = open_[np.argmax(orbit.durations[open_])]
+    return float(orbit.starts[j] + 0.5 * orbit.durations[j])
+
+
+def nodal_drift(system, x0, v0, T: float) -> tuple[float, int]:
+    """One period ``T`` of the exact event-driven simulator of ``system`` (a ``NodalSystem``) from ``(x0, v0)``: the
+    relative distance of the end state from the start in the energy norm, and the switches met."""
+    from ..nsm.massless.nodes import simulate_nodes
+
+    traj = simulate_nodes(system, x0, v0, T)
+    xT, vT = (z[:, 0] for z in traj.state(np.array([T])))
 
     def norm2(x, v):
-        return float(x @ (s.S @ x) + v @ (s.M @ v))
+        return float(x @ (system.S @ x) + v @ (system.M @ v))
 
-    drift = float(np.sqrt(norm2(xT - q0, vT - p0) / norm2(q0, p0)))
+    return float(np.sqrt(norm2(xT - x0, vT - v0) / norm2(x0, v0))), int(traj.starts.size - 1)
+
+
+def phase_changes(orbit) -> int:
+    """The changes of the set of closed nodes per period of a nodal orbit."""
     A = orbit.active
-    expected = int(np.count_nonzero(np.any(A != np.roll(A, 1, axis=0), axis=1))) if len(A) > 1 else 0
-    return {"reference": name, "drift": drift, "switches": int(traj.starts.size - 1), "expected": expected,
-            "survives": bool(drift <= SURVIVAL_RTOL)}
+    return int(np.count_nonzero(np.any(A != np.roll(A, 1, axis=0), axis=1))) if len(A) > 1 else 0
