@@ -29,3 +29,18 @@ def test_a_band_is_visible_and_labelled_with_its_true_width(width, widened):
     label = band.get_label()
     assert f"up to +{100 * width:.2g} %" in label and ("(drawn wider)" in label) == widened
     assert (band.get_hatch() == "///") == widened
+
+
+def test_the_speed_axis_speaks_the_studys_unit_with_rpm_on_top():
+    speeds, f, c = _campbell()
+    fig = campbell_figure(c, speed_unit="rad/s")
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == "rotation speed (rad/s)" and ax.get_xlim()[1] == pytest.approx(1000.0)
+    (top,) = [child for child in ax.get_children() if type(child).__name__ == "SecondaryAxis"]
+    assert top.get_xlabel() == "(rpm)"
+    rpm = campbell_figure(c).axes[0]
+    assert rpm.get_xlabel() == "rotation speed (rpm)" and rpm.get_xlim()[1] == pytest.approx(1000 * 60 / (2 * np.pi))
+    eo = {t.get_text(): t.get_position() for t in ax.texts}  # EO labels on their lines f = n Ω / 2π
+    for n in c.engine_orders:
+        x, y = eo[f"EO {n}"]
+        assert y == pytest.approx(n * x / (2 * np.pi))

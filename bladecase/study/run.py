@@ -438,8 +438,8 @@ def _campbell(study: Study, model, contact, executor: Executor, progress: bool, 
             if band is not None:
                 lo, hi = bands.setdefault(band["mode"], (w, np.full(w.size, np.nan), np.full(w.size, np.nan)))[1:]
                 lo[s], hi[s] = band["low_hz"], band["high_hz"]
-        save_figure(campbell_figure(diagram, bands, title=f"{study.name}: Campbell diagram"), staging / "campbell.png",
-                    dpi=150)
+        save_figure(campbell_figure(diagram, bands, title=f"{study.name}: Campbell diagram",
+                                    speed_unit=study["rotation"]["speed_unit"]), staging / "campbell.png", dpi=150)
         files["campbell"] = "campbell.png"
     return section
 
