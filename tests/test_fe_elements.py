@@ -334,8 +334,9 @@ def test_hex27_cannot_be_written_for_abaqus(tmp_path):
 @pytest.mark.parametrize("btype, order, parts", [("hexahedron", 1, None), ("hexahedron20", 2, None),
                                                  ("wedge", 1, WEDGES), ("wedge", 2, WEDGES)])
 def test_hex_and_wedge_models_are_drawn_on_their_corner_nodes(tmp_path, btype, order, parts):
-    """fe_grid/nodal_field draw hexahedra and wedges on their vertices (the vertex dofs come first); a mode shape
-    written to VTK reads back with the cell type and the field of the model."""
+    """fe_grid/nodal_field draw first-order hexahedra and wedges on their vertices (the vertex dofs come first), a
+    mesh of hexahedron20 on all its nodes; a mode shape written to VTK reads back with the cell type and the field of
+    the model."""
     from bladecase.post.grid import fe_grid, nodal_field
 
     m = hex_beam(0.2, 0.02, (4, 1, 1), "hexahedron" if parts else btype)
@@ -344,10 +345,11 @@ def test_hex_and_wedge_models_are_drawn_on_their_corner_nodes(tmp_path, btype, o
     model = assemble(from_meshio(m, source="beam"), STEEL, order=order, clamp=ROOT)
     grid = fe_grid(model)
     family = KINDS[btype].family
-    assert grid.body_type == family and grid.points.shape == (20, 3)  # 5 × 2 × 2 vertices
+    n = len(model.mesh.points)  # 5 × 2 × 2 vertices, and the 36 midside nodes of the hexahedron20
+    assert grid.body_type == (btype if parts is None else family) and grid.points.shape == (n, 3) and n in (20, 56)
     f, phi = natural_frequencies(model, 1, return_modes=True)
     u = nodal_field(model, phi[:, 0])
-    assert u.shape == (20, 3)
+    assert u.shape == (n, 3)
     root = grid.points[:, 0] < 1e-12
     assert np.abs(u[root]).max() == 0 and np.abs(u[~root]).max() > 0  # clamped root, moving tip
     tip = grid.points[:, 0] > 0.2 - 1e-12
@@ -357,8 +359,8 @@ def test_hex_and_wedge_models_are_drawn_on_their_corner_nodes(tmp_path, btype, o
     pv = pytest.importorskip("pyvista")
     from bladecase.post.grid import VTK_CELL_TYPES
 
-    cells = grid.cells[family]
-    ug = pv.UnstructuredGrid({pv.CellType[VTK_CELL_TYPES[family]]: cells}, grid.points)
+    cells = grid.cells[grid.body_type]
+    ug = pv.UnstructuredGrid({pv.CellType[VTK_CELL_TYPES[grid.body_type]]: cells}, grid.points)
     ug.point_data["u"] = u
     assert ug.volume == pytest.approx(0.2 * 0.02 * 0.02, rel=1e-12)  # positive volume: VTK node order right
 

@@ -18,6 +18,12 @@ only the last ``*NODE`` block and reads no ``*BOUNDARY``; :func:`read_abaqus` re
   fixed, by one line or several) and ``boundary_<first>_<last>`` per dof range as written (``boundary_1_3``;
   ``ENCASTRE`` is ``boundary_1_6``, ``PINNED`` ``boundary_1_3``, ``XSYMM`` ``boundary_xsymm``); a prescribed
   non-zero displacement is not a fixed dof.
+* ``*MATERIAL`` with its ``*ELASTIC`` (isotropic ``E, nu``) and ``*DENSITY``, and the ``*SOLID SECTION, ELSET=…,
+  MATERIAL=…`` lines that give the elements their material: the material of the body's elements (the deck's only
+  one when no section names one) is the mesh's ``info["material"]`` (:attr:`bladecase.fe.mesh.Mesh.material`, in
+  the deck's units). Body elements of several materials, a table over temperatures, an anisotropic ``*ELASTIC`` or
+  a missing ``*DENSITY`` are recorded as the reason it cannot be used, raised only when a model needs it
+  (:func:`bladecase.fe.material.mesh_material`): a study's ``[material]`` replaces it.
 
 A set or a ``*BOUNDARY`` line must name nodes and elements the deck defines, or the study would run on a group
 that silently lost members:
@@ -248,7 +254,9 @@ class _Deck:
         self.elsets: dict[str, tuple[str, _Members]] = {}
         self.bcs: list[tuple[tuple[str, int], int | str, tuple[int, ...], str]] = []  # line, node/set, dofs, group
         self.files: set[str] = set()  # the files read (the deck and its includes)
-        self.materials: list[str] = []
+        self.materials: dict[str, dict] = {}  # upper-case name -> name, line, E, nu, rho (file units) or problem
+        self.material_now: str | None = None  # the *MATERIAL that *ELASTIC and *DENSITY lines belong to
+        self.sections: list[tuple[tuple[str, int], str, str]] = []  # line, ELSET, MATERIAL of each *SOLID SECTION
 
     # -------------------------------------------------------------- keywords
     def node(self, place, params, data) -> None:
@@ -322,6 +330,40 @@ class _Deck:
         have.extend(members)
         table[name.upper()] = (written, have)
 
+    def material(self, place, params) -> None:
+        name = params.get("NAME") or "?"
+        self.materials[name.upper()] = {"name": name, "place": place}
+        self.material_now = name.upper()
+
+    def material_option(self, place, keyword: str, params, data) -> None:
+        """``*ELASTIC`` (isotropic ``E, nu``) or ``*DENSITY`` of the ``*MATERIAL`` above. What bladecase cannot use
+        (another elastic type, a table over temperatures, a field that is no number) is recorded as the material's
+        problem, not raised: a study that gives ``[material]`` does not need the deck's."""
+        if self.material_now is None:
+            log.info("%s: *%s outside a *MATERIAL definition: left out", _where(place), keyword)
+            return
+        record = self.materials[self.material_now]
+        kind = (params.get("TYPE") or "ISOTROPIC").upper()
+        rows = [(where, [f.strip() for f in text.split(",") if f.strip()]) for where, text in data]
+        need = 2 if keyword == "ELASTIC" else 1
+        try:
+            values = [[float(f) for f in fields[:need]] for _, fields in rows]
+        except ValueError:
+            where, fields = next((w, f) for w, f in rows if not all(_number(x) for x in f[:need]))
+            record.setdefault("problem", f"{_where(where)}: *{keyword} line {', '.join(fields)!r} is not numbers")
+            return
+        if keyword == "ELASTIC" and kind not in ("ISO", "ISOTROPIC"):
+            record.setdefault("problem", f"*ELASTIC, TYPE={kind} ({_where(place)}): bladecase's materials are "
+                              "isotropic (E, nu)")
+        elif len(values) != 1 or len(values[0]) < need:
+            what = "E, nu" if keyword == "ELASTIC" else "the density"
+            got = f"{len(values)} lines (a table over temperatures)" if len(values) > 1 else f"no {what}"
+            record.setdefault("problem", f"*{keyword} ({_where(place)}) has {got}: bladecase takes one {what}")
+        elif keyword == "ELASTIC":
+            record["E"], record["nu"] = values[0]
+        else:
+            record["rho"] = values[0][0]
+
     def bc(self, place, params, data) -> None:
         if (params.get("TYPE") or "DISPLACEMENT").upper() != "DISPLACEMENT":
             return  # velocities, accelerations: not fixed dofs
@@ -381,6 +423,21 @@ class _Deck:
         return table[name.upper()]
 
 
+def _number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+#: Keywords that end a ``*MATERIAL`` definition (its options — ``*ELASTIC``, ``*DENSITY``, ``*EXPANSION``, … —
+#: follow it up to the next keyword that is not one).
+_NOT_MATERIAL_OPTIONS = {"NODE", "ELEMENT", "NSET", "ELSET", "BOUNDARY", "STEP", "SOLID SECTION", "SHELL SECTION",
+                         "BEAM SECTION", "MEMBRANE SECTION", "PART", "END PART", "ASSEMBLY", "INSTANCE", "SURFACE",
+                         "ORIENTATION", "EQUATION", "AMPLITUDE", "INITIAL CONDITIONS", "HEADING"}
+
+
 def read_abaqus(path: str | os.PathLike):
     """The mesh of an Abaqus/CalculiX deck as a ``meshio.Mesh`` (see the module docstring for what is read)."""
     import meshio
@@ -397,8 +454,14 @@ def read_abaqus(path: str | os.PathLike):
             deck.sets(place, params, data, keyword)
         elif keyword == "BOUNDARY":
             deck.bc(place, params, data)
-        elif keyword == "MATERIAL":
-            deck.materials.append(params.get("NAME") or "?")
+        if keyword in _NOT_MATERIAL_OPTIONS:
+            deck.material_now = None
+        if keyword == "MATERIAL":
+            deck.material(place, params)
+        elif keyword in ("ELASTIC", "DENSITY"):
+            deck.material_option(place, keyword, params, data)
+        elif keyword == "SOLID SECTION" and params.get("ELSET") and params.get("MATERIAL"):
+            deck.sections.append((place, params["ELSET"], params["MATERIAL"]))
     if not deck.ids:
         raise AbaqusError(f"Abaqus file {source!r} defines no node (*NODE): not a mesh (a deck whose mesh is in "
                           "another file needs *INCLUDE, INPUT=<mesh file>)")
@@ -451,11 +514,45 @@ def read_abaqus(path: str | os.PathLike):
         point_sets.update(fixed)
         point_sets["boundary_fixed"] = full
         _log_boundary(source, fixed, full, ids)
-    if deck.materials:
-        log.info("Abaqus file %s: material(s) %s of the deck not used (the study's [material] is, in SI units)",
-                 source, ", ".join(deck.materials))
+    material = _body_material(deck, numbers, source)
     return meshio.Mesh(np.asarray(deck.xyz, dtype=float), cells, point_sets=point_sets,
-                       point_data={NODE_ID_KEY: ids})
+                       point_data={NODE_ID_KEY: ids}, info={"material": material} if material else None)
+
+
+def _body_material(deck: _Deck, numbers: _Numbers, source: str) -> dict | None:
+    """The material of the body's elements (:func:`bladecase.fe.material.file_material`): the ``*MATERIAL`` that
+    the ``*SOLID SECTION`` lines give them, or the deck's only material when no section names one; logged."""
+    from .material import file_material
+
+    if not deck.materials:
+        return None
+    body = np.array(sorted(e for rows in deck.elements.values() for e, _ in rows), dtype=np.int64)
+    used: dict[str, int] = {}
+    covered = np.zeros(body.size, dtype=bool)
+    for place, elset, name in deck.sections:
+        if elset.upper() not in deck.elsets:
+            log.info("%s: *SOLID SECTION, ELSET=%s: no such *ELSET; left out", _where(place), elset)
+            continue
+        inside = np.isin(body, numbers.elements(deck.elsets[elset.upper()][1], f"*ELSET {elset!r}"))
+        if inside.any():
+            written = deck.materials.get(name.upper(), {"name": name})["name"]
+            used[written] = used.get(written, 0) + int(inside.sum())
+            covered |= inside
+    values = {r["name"]: {k: r[k] for k in ("E", "nu", "rho", "problem") if k in r} for r in deck.materials.values()}
+    record = file_material(repr(source), values, used, "", "*MATERIAL")
+    if "problem" in record:
+        log.info("Abaqus file %s: material(s) %s: %s (a study without [material] is refused)", source,
+                 ", ".join(values), record["problem"])
+        return record
+    place = deck.materials[record["name"].upper()]["place"]
+    how = "the *SOLID SECTION of the body's elements" if used else "the deck's only material"
+    record["where"] = f"*MATERIAL, NAME={record['name']} of {place[0]!r}, line {place[1]} ({how})"
+    if used and not covered.all():
+        log.info("Abaqus file %s: %d of the %d body elements are in no *SOLID SECTION", source,
+                 int((~covered).sum()), body.size)
+    log.info("Abaqus file %s: material %s for the body: E = %g, nu = %g, rho = %g in the deck's units (used when "
+             "the study gives no [material])", source, record["name"], record["E"], record["nu"], record["rho"])
+    return record
 
 
 class _Numbers:
@@ -513,6 +610,13 @@ class _Numbers:
             raise AbaqusError(f"{_where(where)}: {owner} names {kind}s {first}..{last}"
                               f"{f' step {step}' if step != 1 else ''}, {how} ({self.numbering(kind)})")
         return chosen
+
+    def elements(self, members: _Members, owner: str) -> np.ndarray:
+        """The element numbers (sorted, unique) an element set names."""
+        parts = [self.listed(*members.listed["element"], "element", owner)]
+        parts += [self._range(where, kind, first, last, step, owner)
+                  for where, kind, first, last, step in members.ranges if kind == "element"]
+        return np.unique(np.concatenate(parts))
 
     def _nodes_of(self, elements: np.ndarray) -> np.ndarray:
         """The node numbers of ``elements`` (numbers the deck has), with repeats."""

@@ -12,6 +12,12 @@ meshio 5.3 reads no ``.cdb``; :func:`read_cdb` reads the blocks a mesh needs and
   line and the rest on continuation lines, ended by ``-1``;
 * ``CMBLOCK``: node components (``NODE``) as they are and element components (``ELEM``) as the nodes of their
   elements, both as named node groups (``point_sets``); a negative entry closes a range (``1, -10`` is 1…10).
+* material records — ``MP,Lab,MAT,C0`` (commands), ``MPDATA,R5.0,LENGTH,Lab,MAT,STLOC,V1,…`` (as ``CDWRITE``
+  writes them, each after its ``MPTEMP``) and ``MPDATA,Lab,MAT,STLOC,C1,…`` — for ``EX``, ``PRXY`` (or ``NUXY``) and
+  ``DENS``: the material of the number the solid elements' EBLOCK records give (their first field) is the mesh's
+  ``info["material"]`` (:attr:`bladecase.fe.mesh.Mesh.material`, in the archive's units; several material numbers
+  among the solid elements, a temperature table, an anisotropic material or a missing density are recorded as the
+  reason it cannot be used, raised only when a model needs it).
 
 A component must name numbers the file has: a single number the NBLOCK (or the EBLOCK, for an element component)
 does not define, a range reaching below the file's smallest number or beyond its largest (``1, -1000000000`` over 412
@@ -29,8 +35,9 @@ node orders are VTK's (checked against a brick's corner and edge numbering). Pyr
 brick) are refused. Elements of other types — surface effect, contact, target, mesh-only, shells, beams — are left
 out with a log line counting them (their nodes stay, and their components become groups like any other).
 
-The positions are taken as they are (no unit conversion: ANSYS archives are in the model's units, SI for
-Workbench). Errors name the file, the line number and what was expected.
+The positions and material constants are taken as they are (no unit conversion here: ANSYS archives are in the
+model's units, SI for Workbench; ``[mesh] unit`` says which, :func:`bladecase.fe.material.mesh_material` converts
+the material with it). Errors name the file, the line number and what was expected.
 
 >>> import tempfile, os
 >>> text = '''ET,1,185
@@ -121,7 +128,9 @@ def read_cdb(path: str | os.PathLike):
     types: dict[int, int] = {}
     ids = np.zeros(0, dtype=np.int64)
     xyz = np.zeros((0, 3))
-    elements: list[tuple[int, int, list[int], int]] = []  # (type number, element number, nodes, line)
+    elements: list[tuple[int, int, list[int], int, int]] = []  # type number, element number, nodes, line, material
+    tables: dict[int, dict[str, dict[int, float]]] = {}  # material number -> property -> location -> value
+    broken: dict[int, str] = {}  # material number -> why its records cannot be used
     components: dict[str, tuple[str, list[tuple[int, int, int]]]] = {}  # name -> (kind, [(first, last, line)])
     i = 0
     while i < len(lines):
@@ -144,6 +153,8 @@ def read_cdb(path: str | os.PathLike):
             name, kind, ranges, i = _cmblock(lines, i, source)
             components[name] = (kind, ranges)
             continue
+        elif word in ("MP", "MPDATA"):
+            _mp(head, tables, broken, source, i)
         i += 1
     if ids.size == 0:
         raise CdbError(f"ANSYS archive {source!r} has no NBLOCK (node coordinates): not a mesh archive")
@@ -165,8 +176,82 @@ def read_cdb(path: str | os.PathLike):
                       for lo, hi, _ in ranges]
             nodes = [np.asarray(by_number[int(e)], dtype=np.int64) for part in chosen for e in part]
         point_sets[name] = np.unique(np.concatenate(nodes)) if nodes else np.zeros(0, dtype=np.int64)
+    material = _body_material(elements, types, tables, broken, source)
     return meshio.Mesh(xyz, [(t, np.asarray(c, dtype=np.int64)) for t, c in cells.items()], point_sets=point_sets,
-                       point_data={"node_id": np.asarray(ids, dtype=np.int64)}, field_data={"ansys:types": counts})
+                       point_data={"node_id": np.asarray(ids, dtype=np.int64)}, field_data={"ansys:types": counts},
+                       info={"material": material} if material else None)
+
+
+def _mp(head: str, tables: dict, broken: dict, source: str, i: int) -> None:
+    """One material property record into ``tables`` (material → property → location → value): ``MP,Lab,MAT,C0,C1,…``
+    (``C1…`` the temperature coefficients), ``MPDATA,Lab,MAT,STLOC,C1,…`` (a command) or CDWRITE's
+    ``MPDATA,R5.0,LENGTH,Lab,MAT,STLOC,V1,…``. A record that is not numbers marks its material ``broken``."""
+    f = [x.strip() for x in head.split(",")]
+    f += [""] * (8 - len(f))
+    try:
+        if f[0].upper() == "MP":
+            lab, mat, loc = f[1].upper(), int(f[2]), 1
+            values = [_real(x) for x in f[3:] if x]
+            if any(values[1:]):  # C1, C2, … : a polynomial in the temperature
+                broken.setdefault(mat, f"MP,{lab} (line {i + 1}) is a polynomial in the temperature")
+            values = values[:1]
+        elif f[1].upper().startswith("R"):  # MPDATA,R5.0,LENGTH,Lab,MAT,STLOC,V1,V2,…
+            length, lab, mat, loc = int(f[2]), f[3].upper(), int(f[4]), int(f[5] or 1)
+            values = [_real(x) for x in f[6:6 + length] if x]
+        else:  # MPDATA,Lab,MAT,STLOC,C1,…
+            lab, mat, loc = f[1].upper(), int(f[2]), int(f[3] or 1)
+            values = [_real(x) for x in f[4:] if x]
+    except ValueError:
+        log.info("ANSYS archive %s, line %d: material record %r is not numbers: left out", source, i + 1, head)
+        return
+    table = tables.setdefault(mat, {}).setdefault(lab, {})
+    table.update({loc + k: v for k, v in enumerate(values)})
+
+
+def _real(text: str) -> float:
+    return float(text.replace("D", "E").replace("d", "e"))
+
+
+#: ANSYS material properties that make a material anisotropic when they differ from the isotropic values.
+_ORTHOTROPIC = {"EY": "E", "EZ": "E", "PRXY": "nu", "NUXY": "nu", "PRYZ": "nu", "PRXZ": "nu", "NUYZ": "nu",
+                "NUXZ": "nu", "GXY": "G", "GYZ": "G", "GXZ": "G"}
+
+
+def _body_material(elements, types: dict[int, int], tables: dict, broken: dict, source: str) -> dict | None:
+    """The material of the solid elements (:func:`bladecase.fe.material.file_material`): the ``MP`` records of the
+    material number their EBLOCK records give; ``None`` when the archive has no material records. Logged."""
+    from .material import file_material
+
+    if not tables:
+        return None
+    used: dict[str, int] = {}
+    for itype, _, _, _, mat in elements:
+        if types.get(itype) in SOLIDS:
+            used[f"material {mat}"] = used.get(f"material {mat}", 0) + 1
+    values = {}
+    for mat, props in tables.items():
+        one = {lab: table[min(table)] for lab, table in props.items() if table}
+        many = [f"{lab} ({len(table)} values)" for lab, table in props.items() if len(table) > 1]
+        E, nu = one.get("EX"), one.get("PRXY", one.get("NUXY"))
+        rho = one.get("DENS")
+        iso = {"E": E, "nu": nu, "G": E / (2 * (1 + nu)) if E is not None and nu is not None else None}
+        odd = [lab for lab, key in _ORTHOTROPIC.items() if lab in one and iso[key] is not None
+               and abs(one[lab] - iso[key]) > 1e-6 * abs(iso[key])]
+        if mat in broken or many or odd:
+            why = broken.get(mat) or (f"temperature-dependent {', '.join(many)}" if many else
+                                      f"anisotropic ({', '.join(odd)} differ from the isotropic values)")
+            values[f"material {mat}"] = {"problem": why}
+        else:
+            values[f"material {mat}"] = {k: v for k, v in (("E", E), ("nu", nu), ("rho", rho)) if v is not None}
+    record = file_material(repr(source), values, used, "", "ANSYS")
+    if "problem" in record:
+        log.info("ANSYS archive %s: %s (a study without [material] is refused)", source, record["problem"])
+        return record
+    record["where"] = f"the MP records of {record['name']} in {source!r}"
+    log.info("ANSYS archive %s: material %s for the solid elements: E = %g, nu = %g, rho = %g in the archive's "
+             "units (used when the study gives no [material])", source, record["name"], record["E"], record["nu"],
+             record["rho"])
+    return record
 
 
 #: Largest node or element number read: ANSYS numbers them with 32-bit integers.
@@ -352,7 +437,7 @@ def _eblock(lines: list[str], i: int, source: str) -> tuple[list, int]:
                                f"lists {len(nodes)} of its {count} nodes, then an empty line")
             nodes += [_int(x, source, j, f"node {len(nodes) + k + 1} of element {number}")
                       for k, x in enumerate(more)]
-        out.append((v[1], number, nodes[:count], start))
+        out.append((v[1], number, nodes[:count], start, v[0]))
         j += 1
     raise CdbError(f"ANSYS archive {source!r}: the EBLOCK of line {i + 1} has no end (-1): the file is truncated")
 
@@ -434,7 +519,7 @@ def _cells(elements, types: dict[int, int], index: _NodeIndex, source: str):
     counts: dict[str, int] = {}
     by_number: dict[int, list[int]] = {}
     skipped: dict[int, int] = {}
-    for itype, number, nodes, line in elements:
+    for itype, number, nodes, line, _ in elements:
         ename = types.get(itype)
         if ename is None:
             raise CdbError(f"ANSYS archive {source!r}, line {line + 1}: element {number} has type {itype}, which no "

@@ -80,6 +80,13 @@ class Mesh:
     unit : str
         The length unit of the source's coordinates (:data:`~bladecase.fe.mesh_checks.LENGTH_UNITS`); ``points``
         are always in metres.
+    material : dict or None
+        The material the file gives the body's elements, in the file's own units (:attr:`unit` implies them):
+        ``{"name", "E", "nu", "rho", "source": "deck", "where"}`` — an Abaqus/CalculiX ``*MATERIAL`` (through the
+        ``*SOLID SECTION`` of the body's elements), an ANSYS archive's ``MP`` records (through the elements'
+        material number) —, or ``{"name", "problem", "source", "where"}`` when it cannot be used (several materials
+        for the body, no density, …); ``None`` when the file carries none.
+        :func:`bladecase.fe.material.mesh_material` converts it to SI.
 
     Examples
     --------
@@ -105,6 +112,7 @@ class Mesh:
     source: str = ""
     node_ids: np.ndarray | None = None
     unit: str = "m"
+    material: dict | None = None
 
     def __post_init__(self) -> None:
         n = len(self.points)
@@ -115,6 +123,9 @@ class Mesh:
         object.__setattr__(self, "node_ids", ids)
         if self.unit not in LENGTH_UNITS:
             raise ValueError(f"mesh unit must be one of {', '.join(LENGTH_UNITS)}, got {self.unit!r}")
+        if self.material is not None and not isinstance(self.material, dict):
+            raise ValueError(f"mesh {self.source or ''}: material must be a dict or None, got "
+                             f"{type(self.material).__name__}")
 
     @property
     def numbering(self) -> str:
@@ -331,7 +342,8 @@ def from_meshio(m, source: str = "", require: Sequence[str] = (), unit: str = "m
       ones no kept cell uses (e.g. geometry vertices); points are padded to
       three columns and scaled from ``unit`` to metres; the file's node numbers
       (point data ``node_id``, kept by the Abaqus reader) become
-      :attr:`Mesh.node_ids`.
+      :attr:`Mesh.node_ids`; the material the file gives its body (``info["material"]``, set by the Abaqus and
+      ANSYS archive readers) becomes :attr:`Mesh.material`.
     * **Groups** (node sets, unions when a name appears in several sources):
       gmsh physical groups (``cell_sets``, or ``field_data`` + ``cell_data
       ["gmsh:physical"]`` for MSH 2.2) → the nodes of their cells; Abaqus
@@ -399,7 +411,10 @@ def from_meshio(m, source: str = "", require: Sequence[str] = (), unit: str = "m
     if dropped:
         log.info("mesh %s: %s dropped (cell types a %d-D model does not use)", source,
                  ", ".join(f"{n} {t} cell(s)" for t, n in dropped.items()), dim)
-    mesh = Mesh(points=points, cells=cells, dim=dim, groups=groups, source=source, node_ids=ids, unit=unit)
+    info = getattr(m, "info", None)
+    material = info.get("material") if isinstance(info, dict) and isinstance(info.get("material"), dict) else None
+    mesh = Mesh(points=points, cells=cells, dim=dim, groups=groups, source=source, node_ids=ids, unit=unit,
+                material=material)
     for name in require:
         if len(mesh.group(name)) == 0:
             raise ValueError(f"mesh {source}: group {name!r} is empty")

@@ -19,8 +19,9 @@ import numpy as np
 
 from .. import log
 from ..fe import Mesh
+from ..fe.cells import KINDS
 from ..io import atomic_path
-from .grid import VTK_CELL_TYPES
+from .grid import vtk_cells
 
 _FIELD = "magnitude of u (m)"  # VTK's fonts draw no "|"
 
@@ -101,14 +102,15 @@ def animate(
     Parameters
     ----------
     mesh : Mesh
-        Body cells tetra/tetra10 (3-D) or triangle/triangle6 (2-D, ``z = 0``).
+        Body cells of any type of :data:`~bladecase.post.grid.VTK_CELL_TYPES`: tetrahedra, hexahedra, wedges
+        (3-D) or triangles, quadrilaterals (2-D, ``z = 0``), of first or second order (``tetra10``,
+        ``hexahedron20``/``27``, ``wedge15``/``18``, ``triangle6``, ``quad8``/``9``).
         Quadratic cells are drawn with all their nodes: their faces are
         subdivided (:data:`SUBDIVISION`) and ``u`` is interpolated by the
         quadratic shape functions, so a P2 field shows its bending within a
-        cell.  To draw everything a P2 model computed, pass
-        :func:`bladecase.post.grid.fe_grid` and
-        :func:`bladecase.post.grid.nodal_field` (a mesh's own ``tetra10``
-        midside nodes are not where the P2 edge dofs are).
+        cell and a curved cell its curved faces.  To draw everything a model
+        computed, pass :func:`bladecase.post.grid.fe_grid` and
+        :func:`bladecase.post.grid.nodal_field`.
     u : (n_nodes, dim, F) ndarray
         Displacement of every node at the ``F >= 2`` frames (m).
     times : (F,) ndarray
@@ -279,14 +281,12 @@ def _surface(pts: np.ndarray, mesh: Mesh, dim: int, u3: np.ndarray):
     import pyvista as pv
 
     body_type = mesh.body_type
-    if body_type not in VTK_CELL_TYPES:
-        raise ValueError(f"mesh body cells {body_type!r} cannot be drawn; valid: {', '.join(VTK_CELL_TYPES)}")
-    body = np.asarray(mesh.cells[body_type], dtype=np.int64)
-    grid = pv.UnstructuredGrid({pv.CellType[VTK_CELL_TYPES[body_type]]: body}, pts.copy())
+    name, body = vtk_cells(body_type, mesh.cells[body_type])
+    grid = pv.UnstructuredGrid({pv.CellType[name]: body}, pts.copy())
     nframes = u3.shape[2]
     grid.point_data["reference"] = pts
     grid.point_data["u"] = u3.reshape(len(pts), 3 * nframes)
-    level = SUBDIVISION if body.shape[1] > dim + 1 else None
+    level = SUBDIVISION if KINDS[body_type].order == 2 else None
     surf = grid.extract_surface(pass_pointid=False, pass_cellid=False, nonlinear_subdivision=level,
                                 algorithm="dataset_surface")
     ref = np.array(surf.point_data["reference"], dtype=float)

@@ -21,9 +21,10 @@ half-written result (frames go to a temporary folder renamed into place, the
 The frames are written by VTK's XML writer (``pyvista.UnstructuredGrid.save``,
 binary, zlib-compressed), which writes point data and field data alike; the
 manifold by meshio.  The ``.pvd`` is a short XML text written here.  To show
-the field of a P2 model at all its nodes, write it on
-:func:`bladecase.post.grid.fe_grid` (quadratic ``tetra10``/``triangle6`` cells)
-with :func:`bladecase.post.grid.nodal_field`.
+the field of a model at all its nodes, on its curved cells, write it on
+:func:`bladecase.post.grid.fe_grid` (quadratic cells whole: ``tetra10``,
+``hexahedron20``/``27``, ``wedge15``/``18``, ``triangle6``, ``quad8``/``9``, the
+points and cells of ``mesh.vtu``) with :func:`bladecase.post.grid.nodal_field`.
 """
 
 from __future__ import annotations
@@ -39,7 +40,7 @@ import numpy as np
 
 from ..fe.mesh import GROUP_PREFIX, Mesh
 from ..io import atomic_path, replace_dir
-from .grid import VTK_CELL_TYPES
+from .grid import vtk_cells
 
 #: Point-data names :func:`write_time_series` writes itself (plus ``group:<name>``).
 TIME_SERIES_ARRAYS = ("displacement", "velocity", "displacement_magnitude")
@@ -79,8 +80,9 @@ def write_time_series(
         Plain file name (no path separator): the collection is
         ``directory/stem.pvd``, the frames ``directory/stem/stem_0000.vtu`` …
     mesh : Mesh
-        The reference configuration; only its body cells (``mesh.body_type``:
-        ``tetra``, ``tetra10``, ``triangle`` or ``triangle6``) are written,
+        The reference configuration; only its body cells (``mesh.body_type``,
+        any type of :data:`~bladecase.post.grid.VTK_CELL_TYPES`: tetrahedra, hexahedra, wedges,
+        triangles, quadrilaterals, of first or second order) are written,
         quadratic cells with all their nodes (e.g. the grid of
         :func:`bladecase.post.grid.fe_grid`).
     times : (F,) array_like
@@ -106,7 +108,7 @@ def write_time_series(
     Notes
     -----
     Each frame holds the reference points ``(n_nodes, 3)``, the body cells
-    (quadratic cells as quadratic VTK cells, :data:`VTK_CELL_TYPES`), the point data
+    (quadratic cells as quadratic VTK cells, :func:`~bladecase.post.grid.vtk_cells`), the point data
     ``displacement`` and ``velocity`` (``(n_nodes, 3)``: planar fields get a
     zero ``z`` component, so ParaView's *Warp By Vector* works),
     ``displacement_magnitude``, the extra ``point_data``, each group as a
@@ -204,12 +206,12 @@ def write_time_series(
 
 
 def _vtk_grid(points: np.ndarray, body_type: str, body: np.ndarray):
-    """A ``pyvista.UnstructuredGrid`` of the body cells (meshio cell type -> VTK cell type, same node order)."""
+    """A ``pyvista.UnstructuredGrid`` of the body cells as ``mesh.vtu`` holds them (meshio cell type -> VTK cell
+    type and node order, :func:`~bladecase.post.grid.vtk_cells`)."""
     import pyvista as pv
 
-    if body_type not in VTK_CELL_TYPES:
-        raise ValueError(f"mesh body cells {body_type!r} cannot be written; valid: {', '.join(VTK_CELL_TYPES)}")
-    return pv.UnstructuredGrid({pv.CellType[VTK_CELL_TYPES[body_type]]: body}, points)
+    name, cells = vtk_cells(body_type, body)
+    return pv.UnstructuredGrid({pv.CellType[name]: cells}, points)
 
 
 def _save(grid, path: Path) -> None:

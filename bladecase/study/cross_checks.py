@@ -78,7 +78,7 @@ def cross_checks(c: dict, model: bool = True, contact: bool = True) -> None:
     if ct["weights"] is not None and ct["face"] is None and ct["nodes"] is None:
         raise StudyError(f"[contact] weights: only with [contact] face or nodes (the weights of its nodes), got "
                          f"{ct['weights']!r} without a face")
-    if not given:
+    if not given and m["preset"] is not None:  # not set: the mesh file's material, else the default preset
         try:
             Material.preset(m["preset"])
         except ValueError as exc:

@@ -125,8 +125,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
                       "any meshio format name); default: from the suffix and the content.", _mesh_format),
     },
     "material": {
-        "preset": Key(_STR, "Ti-6Al-4V", "Material preset (Ti-6Al-4V, steel, Inconel 718, Al 6061-T6); "
-                      "ignored when E, nu and rho are given."),
+        "preset": Key(_STR, None, "Material preset (Ti-6Al-4V, steel, Inconel 718, Al 6061-T6); ignored when E, "
+                      "nu and rho are given; not set: the mesh file's own material (a deck's *MATERIAL, an ANSYS "
+                      "archive's MP records, converted to SI with [mesh] unit) when it has one, else Ti-6Al-4V."),
         "E": Key(_NUM, None, "Young's modulus (Pa).", _in_range("E")),
         "nu": Key(_NUM, None, "Poisson's ratio.", lambda v: None if -1 < v < 0.5 else "must be in (-1, 0.5)"),
         "rho": Key(_NUM, None, "Density (kg/m³).", _density),

@@ -62,19 +62,41 @@ def build_mesh(study: Study, path: str | os.PathLike | None = None) -> Mesh:
     return mesh
 
 
-def material(study: Study) -> Material:
+def material(study: Study, mesh: Mesh | None = None) -> Material:
+    """The model's material (SI): ``[material] E, nu, rho``, else its ``preset``, else the material the mesh file
+    gives its body (a deck's ``*MATERIAL``, an ANSYS archive's ``MP`` records: converted from the file's units with
+    ``[mesh] unit``, :func:`bladecase.fe.material.mesh_material`), else the Ti-6Al-4V preset. Logged: the SI values
+    and where they came from (and that ``[material]`` overrides the file's)."""
+    from ..fe.material import DEFAULT_PRESET, material_words, mesh_material
+
     m = study["material"]
+    in_file = getattr(mesh, "material", None)
     if m["E"] is not None:
-        return Material(float(m["E"]), float(m["nu"]), float(m["rho"]), "custom")
-    try:
-        return Material.preset(m["preset"])
-    except ValueError as exc:
-        raise StudyError(f"[material] preset: {exc}") from None
+        chosen, where = Material(float(m["E"]), float(m["nu"]), float(m["rho"]), "custom"), "[material] E, nu, rho"
+    elif m["preset"] is not None:
+        try:
+            chosen, where = Material.preset(m["preset"]), f"[material] preset = {m['preset']!r}"
+        except ValueError as exc:
+            raise StudyError(f"[material] preset: {exc}") from None
+    elif in_file is not None:
+        try:
+            chosen = mesh_material(mesh)
+        except ValueError as exc:
+            raise StudyError(f"[material]: not given, and the mesh file's material cannot be used: {exc}") from None
+        where = f"the mesh file: {material_words(mesh)}"
+    else:
+        chosen, where = Material.preset(DEFAULT_PRESET), "the default preset: no [material], none in the mesh file"
+    if in_file is not None and where.startswith("[material]"):
+        log.info("material: %s overrides the mesh file's material %s", where, in_file.get("name"))
+    log.info("material %s: E = %.6g Pa, nu = %.6g, rho = %.6g kg/m³ (%s)", chosen.name, chosen.E, chosen.nu,
+             chosen.rho, where)
+    return chosen
 
 
 def build_model(study: Study, mesh: Mesh) -> FEModel:
-    """Assemble the FE model of ``[material]`` and ``[fem]`` on ``mesh``; log the nodes the clamp holds (midside
-    nodes included) and warn when the model's mass is not a blade's (:func:`check_plausibility`)."""
+    """Assemble the FE model of ``[material]`` (else the mesh file's material: :func:`material`) and ``[fem]`` on
+    ``mesh``; log the nodes the clamp holds (midside nodes included) and warn when the model's mass is not a
+    blade's (:func:`check_plausibility`)."""
     f = study["fem"]
     if mesh.dim == 2 and f["thickness"] is None:
         raise StudyError("[fem] thickness: required for a 2-D (plane) mesh, e.g. thickness = 0.002 (metres)")
@@ -84,7 +106,7 @@ def build_model(study: Study, mesh: Mesh) -> FEModel:
     if isinstance(clamp, dict):  # by coordinates or node numbers: the nodes, named in the messages
         clamp = selected_nodes(study, mesh, clamp, "[fem] clamp", allow_all=False)
     try:
-        model = assemble(mesh, material(study), order=f["order"], mass=f["mass"], clamp=clamp,
+        model = assemble(mesh, material(study, mesh), order=f["order"], mass=f["mass"], clamp=clamp,
                          thickness=f["thickness"], plane=f["plane"])
     except ValueError as exc:
         if isinstance(f["clamp"], dict) and str(exc).startswith("clamp"):
