@@ -11,7 +11,8 @@ Modules: :mod:`~bladecase.fe.naca` (sections), :mod:`~bladecase.fe.geometry` (pa
 :mod:`~bladecase.fe.material` (:class:`Material`, presets), :mod:`~bladecase.fe.model` (:class:`FEModel`,
 :class:`DofMap`), :mod:`~bladecase.fe.assembly` (:func:`assemble`), :mod:`~bladecase.fe.isoparametric` (the
 curved map of quadratic cells through their midside nodes), :mod:`~bladecase.fe.rotation`
-(:func:`~bladecase.fe.rotation.spin`), :mod:`~bladecase.fe.campbell` (frequencies against speed),
+(:func:`~bladecase.fe.rotation.spin`), :mod:`~bladecase.fe.nonlinear_static` (:func:`nonlinear_state`: the
+geometrically nonlinear static state, large rotations), :mod:`~bladecase.fe.campbell` (frequencies against speed),
 :mod:`~bladecase.fe.eigen` (:func:`natural_frequencies`, :func:`stiffness_factor`),
 :mod:`~bladecase.fe.storage` (stage files), :mod:`~bladecase.fe.calculix` (the model as a CalculiX deck, its
 frequencies back).
@@ -25,15 +26,17 @@ from .material import AL6061T6, INCONEL718, PRESETS, STEEL, TI6AL4V, Material
 from .mesh import Mesh, load_mesh, save_mesh
 from .model import DofMap, FEModel, node_operator
 from .naca import naca_parameters, naca_section
+from .nonlinear_static import NonlinearState, nonlinear_state
 from .select import select_nodes
 from .storage import load_model, model_from_arrays, model_to_arrays, save_model, sparse_from_arrays, sparse_to_arrays
 
 __all__ = [
     "AL6061T6", "INCONEL718", "PRESETS", "STEEL", "TI6AL4V",
-    "BladeGeometry", "DofMap", "FEModel", "MappingCurved", "Material", "Mesh", "PlateGeometry",
+    "BladeGeometry", "DofMap", "FEModel", "MappingCurved", "Material", "Mesh", "NonlinearState", "PlateGeometry",
     "assemble", "blade_mesh", "cad_volume", "curved_geometry", "load_mesh", "load_model", "model_from_arrays",
     "model_to_arrays",
-    "naca_parameters", "naca_section", "natural_frequencies", "node_operator", "save_mesh", "save_model",
+    "naca_parameters", "naca_section", "natural_frequencies", "node_operator", "nonlinear_state", "save_mesh",
+    "save_model",
     "select_nodes",
     "sparse_from_arrays", "sparse_to_arrays", "stiffness_factor",
 ]

@@ -13,9 +13,16 @@ projection on the plane of rotation.  Linearised about the static centrifugal st
   is ``K(Ω)``.  Coriolis coupling (``2Ω G``, skew) is left out of ``K(Ω)``: it is small for modes whose
   motion is mostly parallel to the axis or radial (a blade's flap and torsion); it is not a stiffness.
 
-This is the linear prestress of ANSYS (``PSTRES``, ``SPIN SOFTENING``) and CalculiX (``*STATIC``,
-``CENTRIF`` then ``*FREQUENCY`` with ``PERTURBATION``).  It reproduces the Southwell coefficients of a
-rotating cantilever (flapwise ``1.1933 + 1.5709 R/L`` for the first mode; chordwise 1 less).
+This is the linear prestress of ANSYS (``PSTRES``, ``SPIN SOFTENING``).  It reproduces the Southwell coefficients
+of a rotating cantilever (flapwise ``1.1933 + 1.5709 R/L`` for the first mode; chordwise 1 less).  CalculiX's
+linear ``*STATIC`` step with ``CENTRIF`` then ``*FREQUENCY`` with ``PERTURBATION`` differs in two terms (measured
+in ``benchmarks/bench_nlgeom.py``, docs/rotation.md): its static step has no load stiffness (``K u₀ = Ω² f₁``) and
+its perturbation stiffness holds the material stiffness with the static state's deformation gradient.
+
+``static="nonlinear"`` (:mod:`~bladecase.fe.nonlinear_static`) solves the geometrically nonlinear state instead
+(large rotations, the follower load ``Ω² (f₁ + M⊥ u)``) and vibrates about it with its full tangent
+``K_T(u₀) − Ω² M⊥``: CalculiX's ``NLGEOM`` static step and ``PERTURBATION`` frequencies, ANSYS's large-deflection
+prestressed modal analysis.
 """
 
 from __future__ import annotations
@@ -33,7 +40,7 @@ from .model import FEModel
 __all__ = ["RotationAxis", "SpinState", "coriolis_matrix", "second_order_state", "spin", "to_rad_s"]
 
 #: The static centrifugal states :func:`spin` solves for (see its ``static``).
-STATIC_STATES = ("linear", "second-order", "auto")
+STATIC_STATES = ("linear", "second-order", "nonlinear", "auto")
 
 #: Rotation-speed units and their factor to rad/s.
 SPEED_UNITS = {"rad/s": 1.0, "rpm": 2.0 * math.pi / 60.0, "hz": 2.0 * math.pi}
@@ -140,7 +147,8 @@ class SpinState:
         Rotation speed (rad/s).
     axis : RotationAxis
     model : FEModel
-        The model with ``K`` replaced by ``K(Ω) = K + K_σ − Ω² M⊥`` (``M`` unchanged).
+        The model with ``K`` replaced by ``K(Ω) = K + K_σ − Ω² M⊥`` (``K_T(u₀) − Ω² M⊥`` about a nonlinear state;
+        ``M`` unchanged).
     displacement : ndarray
         The static centrifugal displacement ``u₀`` on the free dofs (m).
     softening, stiffening : bool
@@ -155,12 +163,15 @@ class SpinState:
     stiffening: bool = True
     #: The factorisation of ``model.K`` (``K(Ω)``), made once here: pass it on as ``factor=``.
     factor: SPDFactor | None = None
-    #: The static state solved: ``"linear"`` or ``"second-order"`` (see :func:`spin`).
+    #: The static state solved: ``"linear"``, ``"second-order"`` or ``"nonlinear"`` (see :func:`spin`).
     static: str = "linear"
-    #: Iterations of the second-order state (0: linear).
+    #: Iterations of the second-order state, Newton iterations of the nonlinear one (0: linear).
     iterations: int = 0
-    #: With ``static`` "auto"/"second-order": how much one second-order step moved the linear state (relative).
+    #: With ``static`` "auto"/"second-order": how much one second-order step moved the linear state (relative, max
+    #: norm; what ``"auto"`` decides on).
     second_order_change: float | None = None
+    #: The nonlinear state's load steps (0 for the others).
+    load_steps: int = 0
 
     def nodal_displacement(self) -> np.ndarray:
         """``u₀`` at every mesh node ``(n_nodes, 3)`` (zero at clamped nodes)."""
@@ -263,19 +274,25 @@ def spin(model: FEModel, speed: float, axis: RotationAxis | None = None, *, soft
         Include spin softening ``−Ω² M⊥`` and the stress stiffness ``K_σ`` (both by default).
     factor : SPDFactor
         ``K``'s factorisation, reused when ``softening`` is off (the static solve is then with ``K``).
-    static : {"linear", "second-order", "auto"}
-        The static centrifugal state: ``"linear"``, ``(K − Ω² M⊥) u₀ = Ω² f₁`` (the linear prestress of ANSYS and
-        CalculiX without large deflections); ``"second-order"``, the fixed point of ``(K + K_σ(u) − Ω² M⊥) u =
+    static : {"linear", "second-order", "nonlinear", "auto"}
+        The static centrifugal state: ``"linear"``, ``(K − Ω² M⊥) u₀ = Ω² f₁`` (the linear prestress of ANSYS;
+        ``K(Ω) = K + K_σ(u₀) − Ω² M⊥``); ``"second-order"``, the fixed point of ``(K + K_σ(u) − Ω² M⊥) u =
         Ω² f₁`` — the tension the load creates also resists the bending it causes on a leaned, swept or twisted
-        blade (on the demo blade leaned 30 mm at 10 000 rpm it closes the clearance by 2.0 mm instead of 9.0 mm,
-        f1 +0.4 %); ``"auto"``, the linear state unless one second-order step moves it by more than 1 %.
+        blade; ``"nonlinear"``, the geometrically nonlinear state (large rotations, the follower centrifugal load:
+        :func:`~bladecase.fe.nonlinear_static.nonlinear_state`) with ``K(Ω) = K_T(u₀) − Ω² M⊥``, its full tangent
+        — CalculiX's ``NLGEOM`` static step and ``PERTURBATION`` frequencies (on the demo blade leaned 30 mm at
+        10 000 rpm: within 0.01 % of them for f1–f4, where the second-order state is 3.9 % off f3); ``"auto"``, the
+        linear state unless one second-order step moves it by more than 1 %, then the nonlinear state. Both
+        ``softening`` and ``stiffening`` are needed by ``"nonlinear"`` (``"second-order"`` and ``"auto"`` stay linear
+        without).
 
     Raises
     ------
     ValueError
         An axis a 2-D (plane) model cannot spin about (tilted, or in the plane but offset out of it: see
         :class:`RotationAxis`); a speed that is negative or not finite; a speed at which ``K − Ω² M⊥`` is no
-        longer positive definite (the blade diverges under spin softening: the message gives the speed).
+        longer positive definite (the blade diverges under spin softening: the message gives the speed); a
+        nonlinear state that does not converge (the message gives the speed reached and the residual).
 
     Examples
     --------
@@ -307,68 +324,90 @@ def spin(model: FEModel, speed: float, axis: RotationAxis | None = None, *, soft
         raise ValueError(f"axis must be a RotationAxis, got {type(axis).__name__}")
     if omega == 0.0:
         return SpinState(0.0, axis, model, np.zeros(model.n_dofs), softening, stiffening, factor)
+    if static == "nonlinear" and not (softening and stiffening):
+        raise ValueError("static = 'nonlinear' solves the large-deflection state with its follower centrifugal load: "
+                         "its tangent holds the stress stiffness and the spin softening, so softening and stiffening "
+                         "must both be on (or use static = 'linear')")
     ops = _operators(model, axis)
     w2 = omega * omega
     rpm = omega * 60 / (2 * math.pi)
-    if softening:
-        A = sp.csr_array(model.K - w2 * ops.M_perp)
-        try:  # definite below the first mode's speed; past it (slender blades) indefinite but regular
-            solver = spd_factor(A, "K - Ω² M⊥")
-        except ValueError:
-            try:
-                solver = symmetric_factor(A, "K - Ω² M⊥")
-            except ValueError:
-                raise ValueError(f"at {omega:.6g} rad/s ({rpm:.6g} rpm) K − Ω² M⊥ is singular: the speed is a "
-                                 "critical speed of the blade's spin softening; choose another speed") from None
-    else:
-        solver = factor if factor is not None else spd_factor(model.K, "K")
-    u0 = solver.solve(w2 * ops.f1)
-    iterations, change = 0, None
-    if static != "linear" and stiffening and softening:
-        u0, iterations, change = _second_order(model, ops, w2, u0, static, omega)
-    K = model.K
-    if stiffening:
-        K = K + ops.stress_stiffness(u0)
-    if softening:
-        K = K - w2 * ops.M_perp
-    K = sp.csr_array(0.5 * (K + K.T))
+    iterations, change, steps, used, K = 0, None, 0, "linear", None
+    if static != "nonlinear":
+        u0 = _linear_state(model, ops, w2, softening, factor, omega)
+    if static in ("second-order", "auto") and stiffening and softening:
+        change, step = _second_order_step(model, ops, w2, u0)
+        # "auto": when the state moves with its own stress stiffness, its rotations matter too
+        used = static if static == "second-order" else AUTO_STATE if change > AUTO_RTOL else "linear"
+        if used == "second-order":
+            u0, iterations = _second_order(model, ops, w2, step, omega, change)
+    if used == "nonlinear" or static == "nonlinear":
+        from .nonlinear_static import nonlinear_state
+
+        state = nonlinear_state(model, omega, axis)
+        u0, K, iterations, steps, used = state.displacement, state.tangent, state.iterations, state.steps, "nonlinear"
+    if K is None:
+        K = model.K
+        if stiffening:
+            K = K + ops.stress_stiffness(u0)
+        if softening:
+            K = K - w2 * ops.M_perp
+        K = sp.csr_array(0.5 * (K + K.T))
     try:
         tangent = spd_factor(K, "K(Ω)")
     except ValueError:
         raise ValueError(f"at {omega:.6g} rad/s ({rpm:.6g} rpm) the blade is unstable: its stiffness about the "
                          "centrifugal state, K + K_σ − Ω² M⊥, is not positive definite (spin softening beats the "
                          "stiffening); check the speed, the rotation axis and the mesh's length unit") from None
-    used = "linear" if iterations == 0 else "second-order"
-    return SpinState(omega, axis, replace(model, K=K), u0, softening, stiffening, tangent, used, iterations, change)
+    return SpinState(omega, axis, replace(model, K=K), u0, softening, stiffening, tangent, used, iterations, change,
+                     steps)
+
+
+def _linear_state(model: FEModel, ops: _Operators, w2: float, softening: bool, factor, omega: float) -> np.ndarray:
+    """``(K − Ω² M⊥) u₀ = Ω² f₁`` (``K u₀ = Ω² f₁`` without ``softening``)."""
+    if not softening:
+        return (factor if factor is not None else spd_factor(model.K, "K")).solve(w2 * ops.f1)
+    A = sp.csr_array(model.K - w2 * ops.M_perp)
+    try:  # definite below the first mode's speed; past it (slender blades) indefinite but regular
+        solver = spd_factor(A, "K - Ω² M⊥")
+    except ValueError:
+        try:
+            solver = symmetric_factor(A, "K - Ω² M⊥")
+        except ValueError:
+            rpm = omega * 60 / (2 * math.pi)
+            raise ValueError(f"at {omega:.6g} rad/s ({rpm:.6g} rpm) K − Ω² M⊥ is singular: the speed is a "
+                             "critical speed of the blade's spin softening; choose another speed") from None
+    return solver.solve(w2 * ops.f1)
 
 
 #: ``static = "auto"``: the linear state is kept when one step of the second-order iteration moves it by less than
-#: this (relative, max norm); else the iteration runs to convergence.
+#: this (relative, max norm); else :data:`AUTO_STATE` is solved.
 AUTO_RTOL = 1e-2
+#: The state ``static = "auto"`` solves past :data:`AUTO_RTOL`: the geometrically nonlinear one (CalculiX's NLGEOM
+#: to 1e-4 on the demo blade where the second-order state is 1 to 4 % off f2–f4; docs/rotation.md).
+AUTO_STATE = "nonlinear"
 
 
-def _second_order(model: FEModel, ops: _Operators, w2: float, u: np.ndarray, static: str, omega: float,
-                  rtol: float = 1e-6, max_iter: int = 30) -> tuple[np.ndarray, int, float]:
-    """The fixed point of ``(K + K_σ(u) − Ω² M⊥) u = Ω² f₁`` from the linear state ``u``: ``(u, iterations,
-    first step's relative change)``; with ``static = "auto"`` the linear state when the first step is small."""
-    first = None
+def _second_order_step(model: FEModel, ops: _Operators, w2: float, u: np.ndarray) -> tuple[float, np.ndarray]:
+    """One step of the second-order iteration from ``u``: ``(relative change (max norm), new state)``."""
+    A = sp.csr_array(model.K + ops.stress_stiffness(u) - w2 * ops.M_perp)
+    try:
+        solver = spd_factor(A, "K + K_σ − Ω² M⊥")
+    except ValueError:
+        solver = symmetric_factor(A, "K + K_σ − Ω² M⊥")
+    new = solver.solve(w2 * ops.f1)
+    return float(np.abs(new - u).max()) / max(float(np.abs(new).max()), 1e-300), new
+
+
+def _second_order(model: FEModel, ops: _Operators, w2: float, u: np.ndarray, omega: float, change: float,
+                  rtol: float = 1e-6, max_iter: int = 30) -> tuple[np.ndarray, int]:
+    """The fixed point of ``(K + K_σ(u) − Ω² M⊥) u = Ω² f₁`` from its first step ``u`` (which moved the linear state
+    by ``change``): ``(u, iterations)``."""
     for k in range(1, max_iter + 1):
-        A = sp.csr_array(model.K + ops.stress_stiffness(u) - w2 * ops.M_perp)
-        try:
-            solver = spd_factor(A, "K + K_σ − Ω² M⊥")
-        except ValueError:
-            solver = symmetric_factor(A, "K + K_σ − Ω² M⊥")
-        new = solver.solve(w2 * ops.f1)
-        change = float(np.abs(new - u).max()) / max(float(np.abs(new).max()), 1e-300)
-        if first is None:
-            first = change
-            if static == "auto" and change <= AUTO_RTOL:
-                return u, 0, first
-        u = new
         if change <= rtol:
-            return u, k, first
+            return u, k
+        change, u = _second_order_step(model, ops, w2, u)
     raise ValueError(f"the second-order centrifugal state did not converge in {max_iter} iterations at {omega:.6g} "
-                     f"rad/s (last relative change {change:.2e}): use static = 'linear'")
+                     f"rad/s (last relative change {change:.2e}): use static = 'linear' or 'nonlinear'")
 
 
 def coriolis_matrix(model: FEModel, axis: RotationAxis, speed: float) -> sp.csr_array:

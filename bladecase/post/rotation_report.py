@@ -25,8 +25,7 @@ def rotation_report(rotation: dict | None, campbell: dict | None) -> list[str]:
                   f"- Operating speed {rotation['speed_rpm']:.6g} rpm ({rotation['speed_rad_s']:.6g} rad/s) about the "
                   f"axis {_vec(rotation['axis']['direction'])} through {_vec(rotation['axis']['origin'])} m: every "
                   "result below is about the centrifugal state there (stress stiffening, spin softening; "
-                  + ("a second-order static state, " + f"{rotation['static_iterations']} iterations"
-                     if rotation.get("static_state") == "second-order" else "the linear static state") + ").",
+                  + _static_words(rotation) + ").",
                   f"- Running clearance {rotation['clearance_running_m'] * 1e3:.4g} mm: cold clearance "
                   f"{rotation['clearance_cold_m'] * 1e3:.4g} mm, closed by {rotation['closure_m'] * 1e3:.4g} mm of "
                   "centrifugal growth along the casing normal."]
@@ -75,3 +74,13 @@ def _campbell_lines(c: dict) -> list[str]:
         lines += ["", "No engine order enters a nonsmooth-mode band at the speeds computed (bands between speeds "
                   "interpolated linearly)."]
     return lines
+
+
+def _static_words(rotation: dict) -> str:
+    """Which centrifugal static state the results are about."""
+    state, n = rotation.get("static_state"), rotation.get("static_iterations")
+    if state == "nonlinear":
+        return f"the geometrically nonlinear static state, {n} Newton iterations"
+    if state == "second-order":
+        return f"a second-order static state, {n} iterations"
+    return "the linear static state"

@@ -251,8 +251,10 @@ ROTATION_KEYS: dict[str, Key] = {
                          "crossings with the modes and with the nonsmooth-mode bands are reported.", _orders),
     "static": Key(_STR, "auto", "The static centrifugal state: 'linear' (the linear prestress), 'second-order' (its "
                   "own stress stiffness in the static solve: the tension resists the bending the load causes on a "
-                  "leaned or swept blade) or 'auto' (linear unless one second-order step moves it by more than 1 %).",
-                  _one_of("linear", "second-order", "auto")),
+                  "leaned or swept blade), 'nonlinear' (geometrically nonlinear: large rotations, the load following "
+                  "the deformation, the vibration about it with its full tangent, as CalculiX's NLGEOM) or 'auto' "
+                  "(linear unless one second-order step moves it by more than 1 %, then nonlinear).",
+                  _one_of("linear", "second-order", "nonlinear", "auto")),
     "modes": Key(_INT, 6, "Modes followed (by shape) on the Campbell diagram.", _int_between(1, 50)),
     "bands": Key(_BOOL, True, "At each speed of 'speeds', also reduce and search the nonsmooth modes: the band "
                  "of frequencies of the admissible orbits (costs a reduction and a search per speed)."),
