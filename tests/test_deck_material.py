@@ -8,13 +8,11 @@ SI, the conversion factors from the definitions of the units (lbf = 0.45359237 k
 ft = 0.3048 m), and a model assembled with the material typed by hand.
 
 The study's side — a study without ``[material]`` takes the file's material, a ``[material]`` overrides it, both
-logged — goes through ``stages.material(study, mesh)`` as the reply to the lead proposes it; until that change is
-applied, the same function is defined here (``_proposed_material``) and the preset default ``None`` is emulated.
+logged — goes through ``stages.material(study, mesh)``.
 """
 
 from __future__ import annotations
 
-import inspect
 from pathlib import Path
 
 import numpy as np
@@ -25,7 +23,7 @@ from bladecase import log
 from bladecase.fe import Material, assemble, load_mesh, natural_frequencies
 from bladecase.fe.material import DEFAULT_PRESET, UNIT_SYSTEMS, material_words, mesh_material
 from bladecase.study import stages
-from bladecase.study.schema import SCHEMA, StudyError, loads
+from bladecase.study.schema import StudyError, loads
 
 #: The NASA Rotor 37 CalculiX deck's material (N, mm, t, s) and the same in SI, typed by hand.
 ROTOR37_MM = {"E": 210000.0, "nu": 0.3, "rho": 9e-9}
@@ -80,48 +78,15 @@ nearest = [0.04, 0.01, 0.01]
 """
 
 
-# ----------------------------------------------------------------------------- the proposed stage
-
-
-def _proposed_material(study, mesh=None) -> Material:
-    """``stages.material`` as proposed to the lead (the reply's diff), for as long as it is not applied."""
-    m = study["material"]
-    in_file = getattr(mesh, "material", None)
-    if m["E"] is not None:
-        chosen, where = Material(float(m["E"]), float(m["nu"]), float(m["rho"]), "custom"), "[material] E, nu, rho"
-    elif m["preset"] is not None:
-        chosen, where = Material.preset(m["preset"]), f"[material] preset = {m['preset']!r}"
-    elif in_file is not None:
-        try:
-            chosen = mesh_material(mesh)
-        except ValueError as exc:
-            raise StudyError(f"[material]: not given, and the mesh file's material cannot be used: {exc}") from None
-        where = f"the mesh file: {material_words(mesh)}"
-    else:
-        chosen, where = Material.preset(DEFAULT_PRESET), "the default preset: no [material], none in the mesh file"
-    if in_file is not None and where.startswith("[material]"):
-        log.info("material: %s overrides the mesh file's material %s", where, in_file.get("name"))
-    log.info("material %s: E = %.6g Pa, nu = %.6g, rho = %.6g kg/m³ (%s)", chosen.name, chosen.E, chosen.nu,
-             chosen.rho, where)
-    return chosen
-
-
-APPLIED = "mesh" in inspect.signature(stages.material).parameters and SCHEMA["material"]["preset"].default is None
+# ----------------------------------------------------------------------------- the stage
 
 
 def model_of_study(folder: Path, text: str):
-    """``(material, model, log lines)`` of a study: ``stages.build_model`` once the proposed change is applied,
-    else the proposed material function on the stage's mesh (a study without a preset: ``preset = None``)."""
+    """``(material, model, log lines)`` of a study, through ``stages.build_mesh`` and ``stages.build_model``."""
     st = loads(text, base=folder)
     with log.transcript() as lines:
-        mesh = stages.build_mesh(st)
-        if APPLIED:
-            model = stages.build_model(st, mesh)
-            return model.material, model, lines
-        if "preset" not in text:
-            st["material"]["preset"] = None  # the proposed schema default: "not given"
-        mat = _proposed_material(st, mesh)
-    return mat, assemble(mesh, mat, order=2, clamp="boundary"), lines
+        model = stages.build_model(st, stages.build_mesh(st))
+    return model.material, model, lines
 
 
 # ----------------------------------------------------------------------------- Abaqus / CalculiX decks
