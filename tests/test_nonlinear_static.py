@@ -178,13 +178,10 @@ def test_cantilever_under_a_large_tip_load_follows_the_elastica():
 
 
 def _flap_chord(model, speed: float, static: str = "nonlinear") -> tuple[float, float]:
-    state = spin(model, speed, Z_AXIS, static=static)
-    lam, phi = lowest_modes(state.model.K, state.model.M, 3, factor=state.factor)
-    d = model.dofs.direction
-    share = np.array([[np.sum(phi[d == c, j] ** 2) / np.sum(phi[:, j] ** 2) for j in range(3)] for c in (1, 2)])
-    chord, flap = int(np.argmax(share[0])), int(np.argmax(share[1]))
-    assert share[1, flap] > 0.9 and share[0, chord] > 0.9 and flap != chord
-    return float(np.sqrt(lam[flap])), float(np.sqrt(lam[chord]))
+    """The first flapwise and chordwise angular frequencies about the ``static`` state (test_rotation's)."""
+    from test_rotation import _flap_chord as flap_chord
+
+    return flap_chord(model, speed, Z_AXIS, static=static)
 
 
 @pytest.mark.parametrize("hub", [0.0, 0.5])

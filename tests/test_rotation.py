@@ -38,9 +38,10 @@ def _scale(model) -> float:
     return np.sqrt(rho * C * H * L**4 / (E * C * H**3 / 12))
 
 
-def _flap_chord(model, speed: float, axis=Z_AXIS) -> tuple[float, float]:
-    """The first flapwise (z) and chordwise (y) angular frequencies at ``speed``."""
-    state = spin(model, speed, axis)
+def _flap_chord(model, speed: float, axis=Z_AXIS, **spin_options) -> tuple[float, float]:
+    """The first flapwise (z) and chordwise (y) angular frequencies at ``speed`` (``spin_options``, e.g. ``static``,
+    passed to :func:`spin`)."""
+    state = spin(model, speed, axis, **spin_options)
     lam, phi = lowest_modes(state.model.K, state.model.M, 3, factor=state.factor)
     d = model.dofs.direction
     share = np.array([[np.sum(phi[d == c, j] ** 2) / np.sum(phi[:, j] ** 2) for j in range(3)] for c in (1, 2)])
