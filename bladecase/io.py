@@ -35,8 +35,9 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["WriteError", "atomic_path", "check_output_dir", "check_output_file", "npz_array", "npz_scalar", "os_reason",
-           "read_npz", "replace_dir", "save_figure", "strict_json", "write_json", "write_text", "written_together"]
+__all__ = ["WriteError", "atomic_path", "check_output_dir", "check_output_file", "csv_cell", "npz_array", "npz_scalar",
+           "os_reason", "read_npz", "replace_dir", "save_figure", "strict_json", "write_json", "write_text",
+           "written_together"]
 
 
 class WriteError(OSError, ValueError):
@@ -197,6 +198,19 @@ def strict_json(data: Any) -> tuple[Any, list[str]]:
         return x
 
     return clean(data, ""), where
+
+
+def csv_cell(value) -> str:
+    """A CSV cell: floats to 9 significant digits, booleans lower-case, ``None`` (no value) empty.
+
+    >>> [csv_cell(x) for x in (0.1 + 0.2, True, None, 3, "trailing edge")]
+    ['0.3', 'true', '', '3', 'trailing edge']
+    """
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return str(value).lower()
+    return f"{value:.9g}" if isinstance(value, float) else str(value)
 
 
 def write_json(path: str | os.PathLike, data: Any) -> None:

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import log
-from ..io import save_figure, write_text
+from ..io import csv_cell, save_figure, write_text
 from ..nsm.massless.nodal_modes import nodal_family
 from ..reduction.nodes import contact_pressure, nodal_extension, nodal_model
 from .reference import REFERENCE_FACTOR, check_nodal_in_reference
@@ -179,22 +179,13 @@ def nodal_stage(study, model, contact, families, reduced, *, factor=None, folder
         section["animations"] = animate_nodal(study, nodal, fam, folder, target_energy, reference,
                                               lambda o: _row(nodal, o),
                                               extend=lambda count: nodal_extension(nodal, count, factor))
-        lines = [",".join(COLUMNS)] + [",".join(_cell(r[c]) for c in COLUMNS) for r in rows]
+        lines = [",".join(COLUMNS)] + [",".join(csv_cell(r[c]) for c in COLUMNS) for r in rows]
         write_text(folder / "nodal_modes.csv", "\n".join(lines) + "\n")
         section["files"] = {"csv": "nodal_modes.csv"}
         if figures and rows:
             save_figure(_figure(section, title), folder / "nodal_modes.png")
             section["files"]["figure"] = "nodal_modes.png"
     return section
-
-
-def _cell(value) -> str:
-    """A CSV cell: floats to 9 digits, booleans lower-case, ``None`` (not checked; no load) empty."""
-    if value is None:
-        return ""
-    if isinstance(value, bool):
-        return str(value).lower()
-    return f"{value:.9g}" if isinstance(value, float) else str(value)
 
 
 def _figure(section: dict, title: str | None):

@@ -32,7 +32,7 @@ import numpy as np
 
 from .. import log
 from ..fe.rotation import SPEED_UNITS, RotationAxis, spin, to_rad_s
-from ..io import save_figure, write_text
+from ..io import csv_cell, save_figure, write_text
 from ..nsm.damping import Damping
 from ..nsm.massless.rub import RUN_ON_FACTOR, rub_response
 from ..reduction.contact import Contact, tributary_areas
@@ -399,20 +399,11 @@ def _along_tip(model, contact: Contact, touching: list[int]) -> list[float] | No
     return [float(np.round(s[i], 3)) for i in touching]
 
 
-def _csv_cell(value) -> str:
-    """A CSV cell: floats to 9 digits, booleans lower-case, ``None`` (no load) empty."""
-    if value is None:
-        return ""
-    if isinstance(value, bool):
-        return str(value).lower()
-    return f"{value:.9g}" if isinstance(value, float) else str(value)
-
-
 def _write(folder: Path, section: dict, points: list[dict], figures: bool, title: str | None) -> dict:
     rows = section["rows"]
     lines = [",".join(COLUMNS)]
     for row in rows:
-        lines.append(",".join(_csv_cell(row[c]) for c in COLUMNS))
+        lines.append(",".join(csv_cell(row[c]) for c in COLUMNS))
     write_text(folder / "rub.csv", "\n".join(lines) + "\n")
     node_lines = ["speed,speed_rad_s,node,peak_displacement_mm,peak_force_n,contact_pressure_mpa,contact_fraction,"
                   "penetration_mm,clearance_mm"]
