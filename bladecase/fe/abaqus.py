@@ -85,7 +85,11 @@ import re
 import numpy as np
 
 from .. import log
+from .abaqus_sets import AbaqusError, Numbers, body_material, boundary_groups, log_boundary
+from .abaqus_sets import at_line as _where
+from .abaqus_write import ABAQUS_TYPES, abaqus_text, node_numbers  # noqa: F401  (public names of this module)
 from .groups import NODE_ID_KEY  # the point-data key of the file's node numbers (Mesh.node_ids)
+from .mesh_checks import SNIFFERS, check_input_file
 
 #: Corner/quadratic node count of the solid and plane elements → meshio type (Abaqus and VTK share node orders).
 _SOLID = {4: "tetra", 10: "tetra10", 6: "wedge", 15: "wedge15", 8: "hexahedron", 20: "hexahedron20"}
@@ -103,10 +107,6 @@ MAX_INCLUDE_DEPTH = 32
 
 #: Bytes of a file's beginning searched by :func:`looks_like_abaqus`.
 SNIFF_BYTES = 65536
-
-
-class AbaqusError(ValueError):
-    """An Abaqus file that cannot be read: the message names the file and the line."""
 
 
 def element_type(name: str) -> tuple[str, int] | None:
@@ -130,10 +130,6 @@ def looks_like_abaqus(path: str | os.PathLike) -> bool:
     return re.search(r"^[ \t]*\*[ \t]*(NODE|ELEMENT|INCLUDE)[ \t]*(,|\r?$)", head, re.I | re.M) is not None
 
 
-def _where(place: tuple[str, int]) -> str:
-    return f"Abaqus file {place[0]!r}, line {place[1]}"
-
-
 def _params(text: str) -> tuple[str, dict[str, str | None]]:
     """``(KEYWORD, {PARAMETER: value or None})`` of a keyword line; keywords and parameter names upper case."""
     fields = [f.strip() for f in text.strip().lstrip("*").split(",")]
@@ -147,8 +143,6 @@ def _params(text: str) -> tuple[str, dict[str, str | None]]:
 
 def _read_text(path: str, place: tuple[str, int] | None = None, target: str = "") -> list[str]:
     """The lines of ``path``; ``AbaqusError`` naming the including file and line (``place``) when it is missing."""
-    from .mesh_checks import check_input_file
-
     by = f"{_where(place)}: *INCLUDE, INPUT={target}: " if place else ""
     if place and not os.path.exists(path):
         raise AbaqusError(f"{by}no such file {path!r} (an include is found relative to the folder of the file that "
@@ -499,7 +493,7 @@ def read_abaqus(path: str | os.PathLike):
         found = ", ".join(f"{n} × {t}" for t, n in deck.left_out.items()) or "none"
         raise AbaqusError(f"Abaqus file {source!r} has no solid or plane element bladecase reads (found: {found}; "
                           "read: C3D4, C3D6, C3D8, C3D10, C3D15, C3D20 and variants, CPS/CPE 3, 4, 6, 8)")
-    numbers = _Numbers(ranked, deck.element_nodes, source, deck.files | {p[0] for p in deck.node_place})
+    numbers = Numbers(ranked, deck.element_nodes, source, deck.files | {p[0] for p in deck.node_place})
     # element sets first: a number is named under the set whose line lists it
     elset_nodes = {key: numbers.nodes(m, f"*ELSET {w!r}") for key, (w, m) in deck.elsets.items()}
     nset_nodes = {key: numbers.nodes(m, f"*NSET {w!r}") for key, (w, m) in deck.nsets.items()}
@@ -510,188 +504,13 @@ def read_abaqus(path: str | os.PathLike):
         extra = point_sets.get(written, np.zeros(0, dtype=np.int64))
         point_sets[written] = np.union1d(extra, index(elset_nodes[key], f"*ELSET {written!r}", source))
     if deck.bcs:
-        fixed, full = _boundary_groups(deck.bcs, numbers, nset_nodes, lambda n: index(n, "*BOUNDARY", source))
+        fixed, full = boundary_groups(deck.bcs, numbers, nset_nodes, lambda n: index(n, "*BOUNDARY", source))
         point_sets.update(fixed)
         point_sets["boundary_fixed"] = full
-        _log_boundary(source, fixed, full, ids)
-    material = _body_material(deck, numbers, source)
+        log_boundary(source, fixed, full, ids)
+    material = body_material(deck, numbers, source)
     return meshio.Mesh(np.asarray(deck.xyz, dtype=float), cells, point_sets=point_sets,
                        point_data={NODE_ID_KEY: ids}, info={"material": material} if material else None)
-
-
-def _body_material(deck: _Deck, numbers: _Numbers, source: str) -> dict | None:
-    """The material of the body's elements (:func:`bladecase.fe.material.file_material`): the ``*MATERIAL`` that
-    the ``*SOLID SECTION`` lines give them, or the deck's only material when no section names one; logged."""
-    from .material import file_material
-
-    if not deck.materials:
-        return None
-    body = np.array(sorted(e for rows in deck.elements.values() for e, _ in rows), dtype=np.int64)
-    used: dict[str, int] = {}
-    covered = np.zeros(body.size, dtype=bool)
-    for place, elset, name in deck.sections:
-        if elset.upper() not in deck.elsets:
-            log.info("%s: *SOLID SECTION, ELSET=%s: no such *ELSET; left out", _where(place), elset)
-            continue
-        inside = np.isin(body, numbers.elements(deck.elsets[elset.upper()][1], f"*ELSET {elset!r}"))
-        if inside.any():
-            written = deck.materials.get(name.upper(), {"name": name})["name"]
-            used[written] = used.get(written, 0) + int(inside.sum())
-            covered |= inside
-    values = {r["name"]: {k: r[k] for k in ("E", "nu", "rho", "problem") if k in r} for r in deck.materials.values()}
-    record = file_material(repr(source), values, used, "", "*MATERIAL")
-    if "problem" in record:
-        log.info("Abaqus file %s: material(s) %s: %s (a study without [material] is refused)", source,
-                 ", ".join(values), record["problem"])
-        return record
-    place = deck.materials[record["name"].upper()]["place"]
-    how = "the *SOLID SECTION of the body's elements" if used else "the deck's only material"
-    record["where"] = f"*MATERIAL, NAME={record['name']} of {place[0]!r}, line {place[1]} ({how})"
-    if used and not covered.all():
-        log.info("Abaqus file %s: %d of the %d body elements are in no *SOLID SECTION", source,
-                 int((~covered).sum()), body.size)
-    log.info("Abaqus file %s: material %s for the body: E = %g, nu = %g, rho = %g in the deck's units (used when "
-             "the study gives no [material])", source, record["name"], record["E"], record["nu"], record["rho"])
-    return record
-
-
-class _Numbers:
-    """The deck's node and element numbers, against which what a set or a ``*BOUNDARY`` line names is checked
-    (module docstring): binary searches, so a range is checked before it is expanded, and expanded only to the
-    numbers the deck has."""
-
-    def __init__(self, nodes: np.ndarray, element_nodes: dict[int, list[int]], source: str, files: set[str]):
-        elements = np.array(sorted(element_nodes), dtype=np.int64)
-        self.have = {"node": nodes, "element": elements}
-        sizes = np.fromiter((len(element_nodes[e]) for e in elements.tolist()), dtype=np.int64, count=elements.size)
-        self.start = np.concatenate([[0], np.cumsum(sizes)])  # element k's nodes: flat[start[k]:start[k + 1]]
-        self.flat = np.fromiter((n for e in elements.tolist() for n in element_nodes[e]), dtype=np.int64,
-                                count=int(self.start[-1]))
-        self.deck = "the file" if files <= {os.path.abspath(source)} else "the deck"
-        self.source = source
-
-    def numbering(self, kind: str) -> str:
-        """E.g. "the file has 412 nodes, numbered 1 to 412"."""
-        have = self.have[kind]
-        whole = self.deck if self.deck == "the file" else f"the deck ({self.source!r} and the files it includes)"
-        if not have.size:
-            return f"{whole} has no {kind}"
-        return f"{whole} has {have.size} {kind}{'s' if have.size > 1 else ''}, numbered {have[0]} to {have[-1]}"
-
-    def nodes(self, members: _Members, owner: str) -> np.ndarray:
-        """The node numbers (sorted, unique) a set names; ``owner`` (e.g. ``*NSET 'ROOT'``) for the messages."""
-        nodes = [self.listed(*members.listed["node"], "node", owner)]
-        elements = [self.listed(*members.listed["element"], "element", owner)]
-        for where, kind, first, last, step in members.ranges:
-            (nodes if kind == "node" else elements).append(self._range(where, kind, first, last, step, owner))
-        nodes.append(self._nodes_of(np.concatenate(elements)))
-        return np.unique(np.concatenate(nodes))
-
-    def listed(self, numbers, places, kind: str, owner: str) -> np.ndarray:
-        """``numbers`` (the line of each in ``places``), when the deck has every one of them."""
-        numbers, have = np.asarray(numbers, dtype=np.int64), self.have[kind]
-        k = np.minimum(np.searchsorted(have, numbers), max(have.size - 1, 0))
-        missing = np.flatnonzero(have[k] != numbers) if have.size else np.arange(numbers.size)
-        if missing.size:
-            i = missing[0]
-            more = f"; {missing.size - 1} more numbers it names are missing too" if missing.size > 1 else ""
-            raise AbaqusError(f"{_where(places[i])}: {owner} names {kind} {numbers[i]}, which {self.deck} does not "
-                              f"have ({self.numbering(kind)}){more}")
-        return numbers
-
-    def _range(self, where, kind: str, first: int, last: int, step: int, owner: str) -> np.ndarray:
-        """The numbers the deck has among ``first, first + step, …, last`` (its gaps skipped)."""
-        have = self.have[kind]
-        beyond = not have.size or first < have[0] or last > have[-1]
-        chosen = have[np.searchsorted(have, first):np.searchsorted(have, last, "right")]
-        chosen = chosen[(chosen - first) % step == 0]
-        if beyond or not chosen.size:
-            how = f"beyond {self.deck}'s {kind}s" if beyond else f"none of which {self.deck} has"
-            raise AbaqusError(f"{_where(where)}: {owner} names {kind}s {first}..{last}"
-                              f"{f' step {step}' if step != 1 else ''}, {how} ({self.numbering(kind)})")
-        return chosen
-
-    def elements(self, members: _Members, owner: str) -> np.ndarray:
-        """The element numbers (sorted, unique) an element set names."""
-        parts = [self.listed(*members.listed["element"], "element", owner)]
-        parts += [self._range(where, kind, first, last, step, owner)
-                  for where, kind, first, last, step in members.ranges if kind == "element"]
-        return np.unique(np.concatenate(parts))
-
-    def _nodes_of(self, elements: np.ndarray) -> np.ndarray:
-        """The node numbers of ``elements`` (numbers the deck has), with repeats."""
-        k = np.searchsorted(self.have["element"], elements)
-        first, sizes = self.start[k], self.start[k + 1] - self.start[k]
-        offsets = np.repeat(first - (np.cumsum(sizes) - sizes), sizes)
-        return self.flat[offsets + np.arange(int(sizes.sum()))]
-
-
-def _boundary_groups(bcs, numbers: _Numbers, nset_nodes: dict[str, np.ndarray], index):
-    """The ``*BOUNDARY`` groups (node positions, see the module docstring) and the positions of the nodes whose
-    three translations are fixed; ``index`` maps node numbers to positions."""
-    singles = [bc for bc in bcs if isinstance(bc[1], int)]  # one node a line (as cgx writes them): checked at once
-    single_pos = index(numbers.listed([bc[1] for bc in singles], [bc[0] for bc in singles], "node", "*BOUNDARY"))
-    groups: dict[str, list[np.ndarray]] = {"boundary": [single_pos]}
-    bits = np.array([sum(1 << (d - 1) for d in set(bc[2]) if d <= 3) for bc in singles], dtype=np.uint8)
-    held = np.zeros(len(numbers.have["node"]), dtype=np.uint8)  # bit d - 1: translation d fixed
-    np.bitwise_or.at(held, single_pos, bits)
-    labels = np.array([bc[3] for bc in singles], dtype=object)
-    for group in dict.fromkeys(labels.tolist()):
-        groups.setdefault(group, []).append(single_pos[labels == group])
-    for _, target, dofs, group in (bc for bc in bcs if isinstance(bc[1], str)):
-        pos = index(nset_nodes[target])
-        groups["boundary"].append(pos)
-        groups.setdefault(group, []).append(pos)
-        held[pos] |= sum(1 << (d - 1) for d in set(dofs) if d <= 3)
-    return {g: np.unique(np.concatenate(p)) for g, p in groups.items()}, np.flatnonzero(held == 7)
-
-
-def _log_boundary(source: str, fixed: dict[str, np.ndarray], full: np.ndarray, ids: np.ndarray) -> None:
-    groups = ", ".join(f"{g} ({len(m)})" for g, m in sorted(fixed.items()) if g != "boundary")
-    log.info("Abaqus file %s: *BOUNDARY fixes %d nodes: group boundary; all three translations fixed: "
-             "boundary_fixed (%d); per dof range: %s", source, len(fixed["boundary"]), len(full), groups)
-    partial = np.setdiff1d(fixed["boundary"], full)
-    if partial.size:
-        log.info("Abaqus file %s: %d of the *BOUNDARY nodes have only some translations fixed (symmetry or "
-                 "sliding conditions; first: node %d): a clamp fixes all three — clamp = \"boundary_fixed\" takes "
-                 "only the nodes fixed in x, y and z", source, partial.size, int(ids[partial].min()))
-
-
-#: meshio body type → the Abaqus element :func:`abaqus_text` writes (one that :func:`read_abaqus` reads back).
-ABAQUS_TYPES = {"tetra": "C3D4", "tetra10": "C3D10", "triangle": "CPS3", "triangle6": "CPS6",
-                "hexahedron": "C3D8", "hexahedron20": "C3D20", "wedge": "C3D6", "wedge15": "C3D15",
-                "quad": "CPS4", "quad8": "CPS8"}
-
-
-def node_numbers(mesh) -> np.ndarray:
-    """The numbers :func:`abaqus_text` gives the nodes of ``mesh``: the file's own when they are >= 1, else
-    1-based indices."""
-    return mesh.node_ids if mesh.numbering == "file" and mesh.node_ids.min() >= 1 else \
-        np.arange(1, len(mesh.points) + 1)
-
-
-def abaqus_text(mesh, groups: dict | None = None, scale: float = 1.0, digits: int | None = None) -> str:
-    """An Abaqus input file of ``mesh`` (a :class:`bladecase.fe.mesh.Mesh`): its nodes with their numbers (the
-    file's own, else 1-based; :func:`node_numbers`), coordinates times ``scale`` (all their digits, or
-    ``digits`` significant ones: CalculiX reads at most 20 characters a field), the body elements and one
-    ``*NSET`` per group of ``groups`` (default: the mesh's)."""
-    btype = mesh.body_type
-    numbers = node_numbers(mesh)
-    groups = mesh.groups if groups is None else groups
-    origin = os.path.basename(mesh.source) or "memory"
-    lines = ["*HEADING", f"bladecase mesh from {origin}".encode("ascii", "replace").decode(), "*NODE"]
-    num = repr if digits is None else f"{{:.{int(digits)}g}}".format
-    lines += [f"{k}, {num(x)}, {num(y)}, {num(z)}" for k, (x, y, z) in zip(numbers.tolist(),
-                                                                          (mesh.points * scale).tolist())]
-    lines.append(f"*ELEMENT, TYPE={ABAQUS_TYPES[btype]}")
-    for e, row in enumerate(mesh.cells[btype].tolist()):
-        items = [str(e + 1)] + [str(numbers[v]) for v in row]
-        lines += [", ".join(items[i : i + 16]) + ("," if i + 16 < len(items) else "") for i in range(0, len(items), 16)]
-    for name, nodes in groups.items():
-        lines.append(f"*NSET, NSET={name}")
-        ids = [str(v) for v in numbers[np.asarray(nodes, dtype=np.int64)].tolist()]
-        lines += [", ".join(ids[i : i + 16]) for i in range(0, len(ids), 16)]
-    return "\n".join(lines) + "\n"
 
 
 def register() -> None:
@@ -700,5 +519,6 @@ def register() -> None:
     import meshio
     from meshio import _helpers
 
+    SNIFFERS["abaqus-deck"] = looks_like_abaqus
     if "abaqus-deck" not in _helpers.reader_map:
         meshio.register_format("abaqus-deck", [], read_abaqus, {})

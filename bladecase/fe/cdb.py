@@ -76,6 +76,7 @@ import re
 import numpy as np
 
 from .. import log
+from .mesh_checks import DeckError, check_input_file
 
 #: ANSYS element number → (family, nodes in the EBLOCK record).
 SOLIDS = {
@@ -102,8 +103,10 @@ def element_name(number: int) -> str:
     return f"SOLID{number}" if number in SOLIDS else f"type {number}"
 
 
-class CdbError(ValueError):
+class CdbError(DeckError):
     """A ``.cdb`` file that cannot be read (the message names the file and line)."""
+
+    final_when_named = False  # with the format named, its reason is told with the other formats'
 
 
 def read_cdb(path: str | os.PathLike):
@@ -113,8 +116,6 @@ def read_cdb(path: str | os.PathLike):
     count of elements of each ANSYS type that was read or left out.
     """
     import meshio
-
-    from .mesh import check_input_file
 
     try:
         source = check_input_file(path, "ANSYS archive")  # a pipe or a device would never end

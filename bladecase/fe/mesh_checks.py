@@ -281,6 +281,25 @@ def thin_plate(thickness: float, size: float) -> str | None:
 _UNIT_WORDS = {"m": "metres already", "mm": "millimetres", "cm": "centimetres", "in": "inches", "ft": "feet"}
 
 
+class DeckError(ValueError):
+    """A file that one of bladecase's own readers (Abaqus/CalculiX decks, ANSYS archives) cannot read; the message
+    names the file and the line. The readers' errors derive from it, so that reading a mesh needs no import of the
+    formats it tries."""
+
+    #: raised as it is even when the study names the format (False: its message becomes that format's reason, told
+    #: with the others')
+    final_when_named = True
+
+
+#: A format's sniffer (meshio format name → ``path -> bool``: the file's beginning is in that format), registered by
+#: the format's reader module (``register()``) where it teaches meshio the format.
+SNIFFERS: dict = {}
+
+
+def _sniff(name: str, source: str) -> bool:
+    return bool(SNIFFERS[name](source)) if name in SNIFFERS else False
+
+
 #: ``file_format`` names that are not meshio's: the Abaqus/CalculiX deck reader (:mod:`bladecase.fe.abaqus`).
 FORMAT_ALIASES = {"abaqus": "abaqus-deck", "calculix": "abaqus-deck", "inp": "abaqus-deck", "cdb": "ansys-cdb"}
 
@@ -291,8 +310,6 @@ def reader_formats(source: str, head: bytes, file_format: str | None) -> tuple[l
     reader; ``.msh`` → gmsh with a gmsh header, the Abaqus reader with Abaqus keyword lines (CalculiX), else gmsh
     then ANSYS; a suffix meshio does not know with Abaqus keyword lines → the Abaqus reader."""
     from meshio import _helpers
-
-    from .abaqus import looks_like_abaqus
 
     if file_format is not None:
         name = FORMAT_ALIASES.get(file_format.lower(), file_format.lower())
@@ -306,11 +323,11 @@ def reader_formats(source: str, head: bytes, file_format: str | None) -> tuple[l
     if suffix == ".msh":
         if head.startswith(b"$MeshFormat"):
             return ["gmsh"], "a gmsh header"
-        if looks_like_abaqus(source):
+        if _sniff("abaqus-deck", source):
             return ["abaqus-deck"], "Abaqus keyword lines (*NODE, *ELEMENT) in a .msh file, as CalculiX writes"
         # ".msh" is also an ANSYS suffix: gmsh first, then ANSYS (not for a gmsh file).
         return ["gmsh", "ansys"], "the suffix .msh; no gmsh header, no Abaqus *NODE/*ELEMENT line"
-    if suffix not in _helpers.extension_to_filetypes and looks_like_abaqus(source):
+    if suffix not in _helpers.extension_to_filetypes and _sniff("abaqus-deck", source):
         return ["abaqus-deck"], f"Abaqus keyword lines in a {suffix or 'suffix-less'} file"
     return [None], f"the suffix {suffix or '(none)'}"
 
@@ -370,13 +387,9 @@ def _read_quietly(meshio, path, file_format):
             return meshio.read(path, file_format=file_format), None
     except (Exception, SystemExit) as exc:  # meshio raises ReadError, KeyError, …, or exits
         said = " ".join(out.getvalue().split())
-        from .abaqus import AbaqusError
-        from .cdb import CdbError
-
-        if isinstance(exc, AbaqusError) or (isinstance(exc, CdbError) and file_format is None):
+        if isinstance(exc, DeckError) and (exc.final_when_named or file_format is None):
             raise type(exc)(str(exc)) from None  # names the file, the line and the field already
-
-        text = ("" if isinstance(exc, SystemExit) else str(exc) if isinstance(exc, CdbError)  # names file and line
+        text = ("" if isinstance(exc, SystemExit) else str(exc) if isinstance(exc, DeckError)  # names file and line
                 else _nastran_reason(exc) if _is_nastran(path, file_format) and isinstance(exc, KeyError)
                 else f"{type(exc).__name__}: {exc}".rstrip(": "))
         return None, " ".join(filter(None, [text, said])) or type(exc).__name__
