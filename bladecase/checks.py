@@ -16,18 +16,14 @@ Traceback (most recent call last):
     ...
 ValueError: count must be an integer with 1 <= count < 10 (the number of free dofs), got 10
 
-Matrices (dense or scipy sparse, never made dense): :func:`numbers` (a numeric dtype), :func:`symmetric`
-(to :data:`SYMMETRY_RTOL`) and :func:`positive_definite` (a factorisation, singular to working precision
-below :data:`SINGULAR_RTOL`).
+Matrices (dense or scipy sparse, never made dense): :func:`numbers` (a numeric dtype) and :func:`symmetric`
+(to :data:`SYMMETRY_RTOL`); positive definiteness is proved by a factorisation,
+:func:`bladecase.linalg.positive_definite` (singular to working precision below :data:`SINGULAR_RTOL`).
 
 >>> symmetric("K", np.array([[2.0, 1.0], [0.0, 2.0]]))
 Traceback (most recent call last):
     ...
 ValueError: K is not symmetric: max|K - Kᵀ| = 1 exceeds 1e-10 * max|K| = 2e-10
->>> positive_definite("K", np.array([[1.0, 2.0], [2.0, 1.0]]), hint="clamp it")
-Traceback (most recent call last):
-    ...
-ValueError: K is not positive definite: smallest eigenvalue -1 (largest 3; it must be > 0): clamp it
 """
 
 from __future__ import annotations
@@ -38,22 +34,18 @@ from collections.abc import Sequence
 import numpy as np
 
 __all__ = ["SINGULAR_RTOL", "SYMMETRY_RTOL", "finite", "integer", "is_integer", "numbers", "one_of", "point",
-           "positive", "positive_definite", "symmetric"]
+           "positive", "symmetric"]
 
 #: Relative tolerance of :func:`symmetric`: ``max|A - Aᵀ| <= SYMMETRY_RTOL * max|A|`` (assembled FE matrices and
 #: ``VᵀKV`` products are symmetric to ~1e-15 of ``max|A|``).
 SYMMETRY_RTOL = 1e-10
 
-#: :func:`positive_definite` refuses a matrix whose smallest factorisation pivot is ``<= SINGULAR_RTOL`` times its
-#: largest diagonal entry: its smallest eigenvalue is at most that pivot, so it is singular to working precision
-#: (a free–free chain factorises with a last pivot of ~1e-16 to 1e-15 of the diagonal instead of 0, by round-off),
-#: and the lowest eigenvalue would have no correct digit.  Physical models stay far above: a clamped chain of
-#: ``n`` unit springs has ``1/n``, a clamped FE model ~1e-8 or more.
+#: :func:`bladecase.linalg.positive_definite` refuses a matrix whose smallest factorisation pivot is
+#: ``<= SINGULAR_RTOL`` times its largest diagonal entry: its smallest eigenvalue is at most that pivot, so it is
+#: singular to working precision (a free–free chain factorises with a last pivot of ~1e-16 to 1e-15 of the diagonal
+#: instead of 0, by round-off), and the lowest eigenvalue would have no correct digit.  Physical models stay far
+#: above: a clamped chain of ``n`` unit springs has ``1/n``, a clamped FE model ~1e-8 or more.
 SINGULAR_RTOL = 1e-12
-
-#: Largest dense matrix :func:`positive_definite` factorises by Cholesky (a sparse one goes to
-#: :func:`bladecase.linalg.spd_factor`).
-_DENSE_CHOLESKY = 6000
 
 
 def positive(name: str, value, what: str = "> 0", noun: str = "number", allow_none: bool = False) -> float | None:
@@ -154,45 +146,3 @@ def symmetric(name: str, a, rtol: float = SYMMETRY_RTOL) -> None:
     if asym > rtol * scale:
         raise ValueError(f"{name} is not symmetric: max|{name} - {name}ᵀ| = {asym:.3g} exceeds "
                          f"{rtol:g} * max|{name}| = {rtol * scale:.3g}")
-
-
-def positive_definite(name: str, a, hint: str = "", rtol: float = SINGULAR_RTOL):
-    """``ValueError`` unless the finite symmetric matrix ``a`` is positive definite, and not singular to working
-    precision: smallest eigenvalue ``<= rtol * max diag`` (:data:`SINGULAR_RTOL`); ``hint`` ends the message.
-
-    Dense (at most 6000 rows): Cholesky (on failure the extreme eigenvalues go into the message); its smallest
-    pivot bounds the smallest eigenvalue from above.  Sparse: the project's factorisation,
-    :func:`bladecase.linalg.spd_factor` (never dense, pivots checked > 0), then two steps of inverse iteration
-    whose Rayleigh quotient bounds the smallest eigenvalue from above (a singular matrix gives round-off there).
-    Returns the factor of a sparse ``a`` (``None`` for a dense one).
-    """
-    import scipy.linalg as sla
-
-    from .linalg import is_sparse, spd_factor
-
-    tail = f": {hint}" if hint else ""
-    n = a.shape[0]
-    diag = np.asarray(a.diagonal(), dtype=float)
-    scale = float(np.abs(diag).max()) if n else 0.0
-    if n and not np.any(a.data if is_sparse(a) else a):
-        raise ValueError(f"{name} is zero (all {n}² entries), not positive definite{tail}")
-    if is_sparse(a) or n > _DENSE_CHOLESKY:
-        factor = spd_factor(a, name, hint=hint)
-        x = np.random.default_rng(0).standard_normal(n)
-        for _ in range(2):
-            x = factor.solve(x)
-            x /= np.linalg.norm(x)
-        low = float(x @ (a @ x))
-    else:
-        factor = None
-        try:
-            low = float(np.diag(np.linalg.cholesky(a)).min() ** 2)
-        except np.linalg.LinAlgError:
-            lam = sla.eigvalsh(a)[[0, -1]] if n <= 2 else np.r_[
-                sla.eigvalsh(a, subset_by_index=[0, 0]), sla.eigvalsh(a, subset_by_index=[n - 1, n - 1])]
-            raise ValueError(f"{name} is not positive definite: smallest eigenvalue {lam[0]:.6g} (largest "
-                             f"{lam[1]:.6g}; it must be > 0){tail}") from None
-    if not low > rtol * scale:
-        raise ValueError(f"{name} is singular to working precision, not positive definite: its smallest eigenvalue is "
-                         f"at most {low:.3g} <= {rtol:g} * max diag {name} = {rtol * scale:.3g}{tail}")
-    return factor

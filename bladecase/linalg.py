@@ -51,14 +51,14 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .checks import integer
+from .checks import SINGULAR_RTOL, integer
 from .linalg_backends import NotPositiveDefinite, cvxopt_cholesky, import_cvxopt
 from .linalg_block import BLOCK_SIZE, block_lanczos
 
 __all__ = [
     "BACKEND_ENV", "BLOCK_MIN_DOFS", "DENSE_LIMIT", "EIGEN_METHODS", "Factor", "SPDFactor", "available_backends",
-    "check_factor", "diagonal", "factor_backend", "is_sparse", "lowest_modes", "sign_convention", "spd_factor",
-    "symmetric_factor",
+    "check_factor", "diagonal", "factor_backend", "is_sparse", "lowest_modes", "positive_definite", "sign_convention",
+    "spd_factor", "symmetric_factor",
 ]
 
 #: Largest matrix :func:`lowest_modes` turns dense on its own (when more than half of the modes are asked
@@ -564,3 +564,50 @@ def lowest_modes(
     if not np.all(np.isfinite(lam)) or lam[0] <= 0:
         raise _fail(name, f"is not positive definite: eigenvalue {lam[0]:.3g} (a mechanism? degenerate cells?)", hint)
     return lam, sign_convention(phi)
+
+
+#: Largest dense matrix :func:`positive_definite` factorises by Cholesky (a sparse one goes to :func:`spd_factor`).
+_DENSE_CHOLESKY = 6000
+
+
+def positive_definite(name: str, a, hint: str = "", rtol: float = SINGULAR_RTOL):
+    """``ValueError`` unless the finite symmetric matrix ``a`` is positive definite, and not singular to working
+    precision: smallest eigenvalue ``<= rtol * max diag`` (:data:`SINGULAR_RTOL`); ``hint`` ends the message.
+
+    Dense (at most 6000 rows): Cholesky (on failure the extreme eigenvalues go into the message); its smallest
+    pivot bounds the smallest eigenvalue from above.  Sparse: the project's factorisation,
+    :func:`bladecase.linalg.spd_factor` (never dense, pivots checked > 0), then two steps of inverse iteration
+    whose Rayleigh quotient bounds the smallest eigenvalue from above (a singular matrix gives round-off there).
+    Returns the factor of a sparse ``a`` (``None`` for a dense one).
+
+    >>> positive_definite("K", np.array([[1.0, 2.0], [2.0, 1.0]]), hint="clamp it")
+    Traceback (most recent call last):
+        ...
+    ValueError: K is not positive definite: smallest eigenvalue -1 (largest 3; it must be > 0): clamp it
+    """
+    tail = f": {hint}" if hint else ""
+    n = a.shape[0]
+    diag = np.asarray(a.diagonal(), dtype=float)
+    scale = float(np.abs(diag).max()) if n else 0.0
+    if n and not np.any(a.data if is_sparse(a) else a):
+        raise ValueError(f"{name} is zero (all {n}² entries), not positive definite{tail}")
+    if is_sparse(a) or n > _DENSE_CHOLESKY:
+        factor = spd_factor(a, name, hint=hint)
+        x = np.random.default_rng(0).standard_normal(n)
+        for _ in range(2):
+            x = factor.solve(x)
+            x /= np.linalg.norm(x)
+        low = float(x @ (a @ x))
+    else:
+        factor = None
+        try:
+            low = float(np.diag(np.linalg.cholesky(a)).min() ** 2)
+        except np.linalg.LinAlgError:
+            lam = sla.eigvalsh(a)[[0, -1]] if n <= 2 else np.r_[
+                sla.eigvalsh(a, subset_by_index=[0, 0]), sla.eigvalsh(a, subset_by_index=[n - 1, n - 1])]
+            raise ValueError(f"{name} is not positive definite: smallest eigenvalue {lam[0]:.6g} (largest "
+                             f"{lam[1]:.6g}; it must be > 0){tail}") from None
+    if not low > rtol * scale:
+        raise ValueError(f"{name} is singular to working precision, not positive definite: its smallest eigenvalue is "
+                         f"at most {low:.3g} <= {rtol:g} * max diag {name} = {rtol * scale:.3g}{tail}")
+    return factor

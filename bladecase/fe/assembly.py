@@ -58,7 +58,7 @@ from .cells import KINDS, SKFEM_MESHES, element_name
 from .eigen import natural_frequencies
 from .material import AL6061T6, ALUMINIUM, INCONEL718, PLANE_KINDS, PRESETS, STEEL, TI6AL4V, Material
 from .mesh import Mesh, check_extent
-from .model import DofMap, FEModel
+from .model import MASS_KINDS, ORDERS, DofMap, FEModel
 from .quality import corner_jacobians
 from .select import select_nodes
 from .storage import (
@@ -78,11 +78,6 @@ __all__ = [
     "DofMap", "FEModel", "Material", "load_model", "model_from_arrays", "model_to_arrays", "natural_frequencies",
     "save_model", "sparse_from_arrays", "sparse_to_arrays",
 ]
-
-#: Accepted values of ``mass``.
-MASS_KINDS = ("consistent", "lumped")
-#: Accepted values of ``order``.
-ORDERS = (1, 2)
 
 #: Cells per batch of the element integration (bounds the temporaries).
 CHUNK_CELLS = 4096

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .geometry import BladeGeometry, PlateGeometry
+    from .shapes import BladeGeometry, PlateGeometry
 
 
 @contextmanager

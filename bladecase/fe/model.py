@@ -22,6 +22,11 @@ from .cells import KINDS
 from .material import Material
 from .mesh import Mesh
 
+#: Accepted values of ``mass`` (:func:`bladecase.fe.assemble`).
+MASS_KINDS = ("consistent", "lumped")
+#: Accepted values of ``order``.
+ORDERS = (1, 2)
+
 _DIRECTIONS = {"x": 0, "y": 1, "z": 2}
 
 

@@ -74,7 +74,7 @@ def model_to_arrays(model: FEModel, prefix: str = "") -> dict[str, np.ndarray]:
 
 
 #: Largest FE model whose ``K`` and ``M`` are factorised when read, proving them positive definite
-#: (:func:`bladecase.checks.positive_definite`).  The factorisations cost what the reduction's own does (3-D P2
+#: (:func:`bladecase.linalg.positive_definite`).  The factorisations cost what the reduction's own does (3-D P2
 #: boxes, SuperLU, one core: 4.3k dofs 0.11 s against 0.2-0.3 s for a 20-mode reduction, 13k 1.0 s against 2-3.6 s,
 #: 29k 4.2 s against 6-11 s; reading the file without them: 0.02-0.1 s): below this limit that is a fraction of a
 #: second.  A larger model gets the O(nnz) checks only (symmetry, positive diagonal, ...): the stage that uses it
@@ -127,9 +127,10 @@ def model_from_arrays(data, prefix: str = "", source: str = "", definite: bool =
     symmetric (:data:`bladecase.checks.SYMMETRY_RTOL`) with a positive diagonal — and, if ``definite`` and the
     model has at most :data:`DEFINITE_CHECK_LIMIT` dofs, positive definite (``K`` unless ``rigid_modes > 0``,
     which the reduction refuses with its own message)."""
-    from ..checks import positive_definite, symmetric
-    from .assembly import MASS_KINDS, ORDERS
+    from ..checks import symmetric
+    from ..linalg import positive_definite
     from .material import PLANE_KINDS
+    from .model import MASS_KINDS, ORDERS
 
     key = f"{prefix}format"
     source = source or "data"

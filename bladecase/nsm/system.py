@@ -22,7 +22,8 @@ import scipy.sparse as sp
 
 from ..checks import SINGULAR_RTOL as SINGULAR_RTOL  # re-exported: the tolerances of the checks below
 from ..checks import SYMMETRY_RTOL as SYMMETRY_RTOL
-from ..checks import numbers, positive_definite, symmetric
+from ..checks import numbers, symmetric
+from ..linalg import positive_definite
 
 ArrayLike = np.ndarray | sp.spmatrix | sp.sparray
 
@@ -109,7 +110,7 @@ def _check_scale(name: str, value: float) -> None:
 
 def _check_positive_definite(name: str, a) -> None:
     """``ValueError`` unless the symmetric ``a`` is positive definite and not singular to working precision
-    (:func:`bladecase.checks.positive_definite`: dense Cholesky; sparse LDLᵀ of
+    (:func:`bladecase.linalg.positive_definite`: dense Cholesky; sparse LDLᵀ of
     :func:`bladecase.linalg.spd_factor`), with the hint of :data:`_HINTS`."""
     positive_definite(name, a, hint=_HINTS.get(name, ""))
 

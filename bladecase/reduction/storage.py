@@ -72,7 +72,8 @@ def _reduced_from_arrays(data: dict, source: str) -> ReducedModel:
     checks; for the massless contact model the same checks on ``Mr``, ``Sr``, ``w``, ``kc``), ``gap`` the
     contact's, and ``basis`` (and ``closed_shape``, ``masses``) of one row per free dof of the model and one
     column per reduced dof."""
-    from ..checks import numbers, positive_definite, symmetric
+    from ..checks import numbers, symmetric
+    from ..linalg import positive_definite
     from .registry import METHODS
 
     def matrix(name):
