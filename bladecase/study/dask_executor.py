@@ -12,7 +12,7 @@ from collections.abc import Callable, Iterable
 from typing import Any
 
 from ..progress import progress_counter
-from .executor import WORKER_ENV, A, R, _check_workers, _environ_kept, _label, _Logged, _named, _relay
+from .tasks import WORKER_ENV, A, Logged, R, check_workers, environ_kept, label, named, relay
 
 __all__ = ["HOST_PORT_SCHEMES", "DaskExecutor"]
 
@@ -44,7 +44,7 @@ class DaskExecutor:
 
     def __init__(self, scheduler: Any = None, workers: int | None = None, *, timeout: float = 30.0,
                  **cluster_options: Any):
-        self.workers = _check_workers(workers, "DaskExecutor")
+        self.workers = check_workers(workers, "DaskExecutor")
         if scheduler is not None:
             if workers is not None or cluster_options:
                 raise ValueError(f"DaskExecutor: workers and cluster options apply to a local cluster only, not to "
@@ -88,7 +88,7 @@ class DaskExecutor:
         options = dict(dashboard_address=None, env=dict(WORKER_ENV)) | self.cluster_options
         what = f"a local Dask cluster of {self.workers or 'one per core'} worker(s)"
         try:
-            with _environ_kept():  # Dask's nannies write their pre-spawn variables into os.environ
+            with environ_kept():  # Dask's nannies write their pre-spawn variables into os.environ
                 self._cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True, **options)
         except (TypeError, OSError, TimeoutError, RuntimeError) as exc:  # a port in use, workers that do not start
             option = _unexpected_keyword(exc)
@@ -141,7 +141,7 @@ class DaskExecutor:
         try:
             try:
                 kwargs = {k: client.scatter([v], broadcast=True, hash=False)[0] for k, v in (shared or {}).items()}
-                task, tag = _Logged(fn), uuid.uuid4().hex[:8]
+                task, tag = Logged(fn), uuid.uuid4().hex[:8]
                 futures = [client.submit(task, x, kwargs, key=f"bladecase-{tag}-{i}", pure=False)
                            for i, x in enumerate(items)]
                 workers = len(client.nthreads())
@@ -155,11 +155,11 @@ class DaskExecutor:
                     try:
                         results[i], lines = fut.result()
                     except (KilledWorker, FutureCancelledError) as exc:  # not the task's own error: Dask's
-                        raise RuntimeError(f"{desc or 'task'} {i} (item {_label(items[i])}) did not run on the Dask "
+                        raise RuntimeError(f"{desc or 'task'} {i} (item {label(items[i])}) did not run on the Dask "
                                            f"cluster {_where(self.scheduler)}: {_dask_failure(exc)}") from None
                     except Exception as exc:
-                        raise _named(exc, desc, i, items[i]) from None
-                    _relay(lines)
+                        raise named(exc, desc, i, items[i]) from None
+                    relay(lines)
                     bar.update()
         finally:
             try:

@@ -32,23 +32,22 @@ import os
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Any, Protocol, TypeVar
+from typing import Any, Protocol
 
-from .. import log
 from ..progress import progress_bar, progress_counter
+from .tasks import WORKER_ENV, A, R  # noqa: F401  (WORKER_ENV: public name of this module)
+from .tasks import Logged as _Logged
+from .tasks import check_workers as _check_workers
+from .tasks import environ_kept as _environ_kept  # noqa: F401  (the former home of these names)
+from .tasks import label as _label  # noqa: F401
+from .tasks import named as _named
+from .tasks import relay as _relay
 
 __all__ = ["EXECUTOR_KINDS", "Executor", "KeywordTask", "ProcessExecutor", "SerialExecutor",
            "keyword_task", "make_executor"]
 
-A = TypeVar("A")
-R = TypeVar("R")
-
 #: The kinds :func:`make_executor` accepts.
 EXECUTOR_KINDS = ("serial", "processes", "dask")
-
-#: The environment of every worker: one BLAS/OpenMP thread each (the tasks are the parallelism).
-WORKER_ENV = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
-
 
 class Executor(Protocol):
     """Maps a function over items and returns the results in the items' order."""
@@ -88,50 +87,6 @@ def keyword_task(fn: Callable[..., R], name: str) -> KeywordTask:
     if not isinstance(name, str) or not name.isidentifier():
         raise ValueError(f"keyword_task: name must be a parameter name (an identifier), got {name!r}")
     return KeywordTask(fn, name)
-
-
-def _label(item: Any, width: int = 60) -> str:
-    text = repr(item)
-    return text if len(text) <= width else text[: width - 3] + "..."
-
-
-def _named(exc: BaseException, desc: str, index: int, item: Any) -> BaseException:
-    """``exc`` (same object, same type) with the failing item in its message and as a note."""
-    where = f"{desc or 'task'} {index} (item {_label(item)})"
-    if exc.args and isinstance(exc.args[0], str) and not exc.args[0].startswith(where):
-        exc.args = (f"{where}: {exc.args[0]}", *exc.args[1:])
-    exc.add_note(f"raised by {where}")
-    return exc
-
-
-class _Logged:
-    """A task run in a worker: ``(fn(item, **shared), the bladecase log lines it wrote)``.
-
-    ``shared`` is one positional dict (never keywords of Dask's ``submit``, whatever its names)."""
-
-    def __init__(self, fn: Callable[..., Any]):
-        self.fn = fn
-
-    def __call__(self, item: Any, shared: dict[str, Any]) -> tuple[Any, list[str]]:
-        with log.transcript() as lines:
-            out = self.fn(item, **shared)
-        return out, lines
-
-
-def _relay(lines: list[str]) -> None:
-    """Re-log a worker's transcript lines (``date time LEVEL message``) in this process."""
-    for line in lines:
-        parts = line.split(" ", 3)
-        level, msg = (parts[2], parts[3]) if len(parts) == 4 else ("INFO", line)
-        (log.warning if level in ("WARNING", "ERROR", "CRITICAL") else log.info)("%s", msg)
-
-
-def _check_workers(workers: int | None, what: str) -> int | None:
-    if workers is None:
-        return None
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise ValueError(f"{what}: workers must be a positive integer (or None for one per core), got {workers!r}")
-    return workers
 
 
 class SerialExecutor:
@@ -174,18 +129,6 @@ def _worker_env() -> Iterator[None]:
     finally:
         for k in added:
             os.environ.pop(k, None)
-
-
-@contextmanager
-def _environ_kept() -> Iterator[None]:
-    """``os.environ`` as it was before the block, whatever the block set."""
-    saved = dict(os.environ)
-    try:
-        yield
-    finally:
-        for k in set(os.environ) - set(saved):
-            del os.environ[k]
-        os.environ.update(saved)
 
 
 _SHARED: dict[str, Any] = {}
