@@ -28,14 +28,6 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str):
-    # ``orbits_kipp`` lived here before the k-ipp search moved to :mod:`bladecase.nsm.newton.kipp` (which imports
-    # this module): still importable from here, resolved on first use.
-    if name in ("orbits_kipp", "canonical_rotation"):
-        from . import kipp
-
-        return getattr(kipp, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def check_newton_system(system, what: str) -> LinearSystem:
