@@ -192,7 +192,6 @@ def krylov_extension(reduced: ReducedModel, count: int, factor: SPDFactor | None
     ValueError
         A sparse (exact) basis — the model is whole already —, ``count`` below ``reduced.n``, a wrong ``factor``.
     """
-    from .massless import MasslessReducedModel, extend_massless
     from .methods.common import constraint, projected_system
 
     if sp.issparse(reduced.basis):
@@ -202,8 +201,8 @@ def krylov_extension(reduced: ReducedModel, count: int, factor: SPDFactor | None
     model = reduced.model
     factor = check_factor(factor, model.K, "this model's K", "bladecase.fe.stiffness_factor(model)")
     fac = factor if factor is not None else spd_factor(model.K, "K", hint="is the model clamped?")
-    if isinstance(reduced, MasslessReducedModel):
-        return extend_massless(reduced, count, fac)
+    if hasattr(reduced, "krylov_extended"):  # a model of its own kind (massless: the interior's sequence)
+        return reduced.krylov_extended(count, fac)
     M = model.M
     w = constraint(model, reduced.contact)
     V = extend_basis(np.asarray(reduced.basis), fac.solve(w), lambda X: fac.solve(M @ X), lambda X: M @ X,

@@ -92,6 +92,11 @@ class MasslessReducedModel(ReducedModel):
     masses: np.ndarray = field(default=None, repr=False)  # type: ignore[assignment]
     spare: np.ndarray | None = field(default=None, repr=False)
 
+    def krylov_extended(self, count: int, fac: SPDFactor) -> MasslessReducedModel:
+        """This model extended by the block Krylov sequence of its own factorisation (:func:`extend_massless`; what
+        :func:`bladecase.reduction.extension.krylov_extension` does for a massless model)."""
+        return extend_massless(self, count, fac)
+
     @property
     def mass_matrix(self) -> sp.dia_array:
         """The massless model's (lumped, redistributed) mass matrix on the free dofs."""
