@@ -24,8 +24,9 @@ import _paper as paper  # noqa: E402  (the examples' shared command line)
 import bladecase as bc  # noqa: E402
 from bladecase.io import save_figure  # noqa: E402
 from bladecase.post.compare import ModelResult, fe_reference  # noqa: E402
+from bladecase.post.compare_diagnose import diagnose  # noqa: E402
 from bladecase.post.compare_plots import convergence_plot, overlay_plot, spectral_plot  # noqa: E402
-from bladecase.post.compare_table import comparison_rows, diagnose, write_comparison_csv  # noqa: E402
+from bladecase.post.compare_table import comparison_rows, write_comparison_csv  # noqa: E402
 
 PLATE = pathlib.Path(__file__).resolve().parent.parent / "meshes" / "plate.vtu"
 

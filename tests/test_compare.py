@@ -39,11 +39,11 @@ from bladecase.post.compare import (
     match_modes,
     model_matches,
 )
+from bladecase.post.compare_diagnose import diagnose
 from bladecase.post.compare_plots import MARKERS, convergence_plot, observed_order, overlay_plot, spectral_plot
 from bladecase.post.compare_table import (
     comparison_rows,
     convergence_verdict,
-    diagnose,
     energy_column,
     read_comparison_csv,
     write_comparison_csv,

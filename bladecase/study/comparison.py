@@ -12,13 +12,13 @@ from pathlib import Path
 from .. import log
 from ..io import save_figure
 from ..post.compare import FEReference, ModelResult, choose_periods, largest_model
+from ..post.compare_diagnose import diagnose
 from ..post.compare_plots import convergence_plot, convergence_series, overlay_plot, spectral_plot
 from ..post.compare_table import (
     ENERGY_RTOL,
     FREQUENCY_RTOL,
     comparison_rows,
     comparison_verdict,
-    diagnose,
     write_comparison_csv,
 )
 
