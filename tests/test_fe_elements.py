@@ -370,7 +370,7 @@ def test_area_weights_of_a_hexahedron_or_wedge_face(parts):
     """Contact.face(weights='area') integrates over the real facets: on a 2 × 2 quad face each corner of a quad
     gets a quarter of it (corner 1/16, edge 2/16, centre 4/16); wedges have the same quads on their x-faces."""
     from bladecase.fe import Mesh
-    from bladecase.reduction.contact import _area_weights
+    from bladecase.reduction.tributary import area_weights
 
     m = hex_beam(0.2, 0.02, (4, 2, 2), "hexahedron")
     if parts:
@@ -378,7 +378,7 @@ def test_area_weights_of_a_hexahedron_or_wedge_face(parts):
     tip = np.flatnonzero(np.isclose(m.points[:, 0], 0.2))
     mesh = Mesh(m.points, {k: v for k, v in m.cells_dict.items()}, dim=3, groups={"tip": tip}, source="beam")
     model = assemble(mesh, STEEL, order=1, clamp=ROOT)
-    w = _area_weights(model, "tip", tip)
+    w = area_weights(model, "tip", tip)
     y, z = m.points[tip, 1], m.points[tip, 2]
     interior = lambda c: (c > 1e-9) & (c < 0.02 - 1e-9)  # noqa: E731
     expected = (1 + interior(y)) * (1 + interior(z)) / 16
