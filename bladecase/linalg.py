@@ -52,7 +52,16 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .checks import SINGULAR_RTOL, integer
-from .linalg_backends import NotPositiveDefinite, cvxopt_cholesky, import_cvxopt
+from .linalg_backends import (  # noqa: F401  (INDEFINITE_PIVOT_THRESHOLD: a public name of this module)
+    INDEFINITE_PIVOT_THRESHOLD,
+    NotPositiveDefinite,
+    cholmod_factor,
+    cvxopt_cholesky,
+    fail,
+    import_cholmod,
+    import_cvxopt,
+    superlu_factor,
+)
 from .linalg_block import BLOCK_SIZE, block_lanczos
 
 __all__ = [
@@ -77,11 +86,6 @@ BLOCK_MIN_DOFS = 20_000
 #: Accepted ``method`` of :func:`lowest_modes`.
 EIGEN_METHODS = ("auto", "arpack", "block")
 
-#: Diagonal pivot threshold of the indefinite factorisation (:func:`symmetric_factor`): SuperLU keeps the
-#: diagonal pivot unless it is below this fraction of the largest entry of its column.
-INDEFINITE_PIVOT_THRESHOLD = 0.1
-
-
 def is_sparse(a) -> bool:
     """True for scipy sparse matrices and arrays."""
     return sp.issparse(a)
@@ -105,14 +109,8 @@ def _dense(a) -> np.ndarray:
     return a.toarray() if is_sparse(a) else np.asarray(a, dtype=float)
 
 
-def _import_cholmod():
-    from sksparse import cholmod  # optional: scikit-sparse, needs SuiteSparse's CHOLMOD
-
-    return cholmod
-
-
 #: Import probes of the optional backends: ``name -> () -> module`` (raises ``ImportError`` if missing).
-_PROBES: dict[str, Callable] = {"cholmod": _import_cholmod, "cvxopt": import_cvxopt}
+_PROBES: dict[str, Callable] = {"cholmod": import_cholmod, "cvxopt": import_cvxopt}
 
 #: How to install each optional backend (in the error of a forced backend that is missing).
 _INSTALL = {"cholmod": "install scikit-sparse<0.5 with SuiteSparse (apt install libsuitesparse-dev)",
@@ -257,66 +255,9 @@ class SPDFactor(Factor):
         return self._parts
 
 
-def _fail(name: str, why: str, hint: str) -> ValueError:
-    return ValueError(f"{name} {why}" + (f": {hint}" if hint else ""))
-
-
-def _superlu(A: sp.csc_array, name: str, hint: str, definite: bool):
-    """SuperLU in symmetric mode: ``(solve, ldlt, fill)``; the LDLᵀ checks if ``definite``."""
-    try:
-        lu = spla.splu(
-            A,
-            permc_spec="MMD_AT_PLUS_A",
-            diag_pivot_thresh=0.0 if definite else INDEFINITE_PIVOT_THRESHOLD,
-            options={"SymmetricMode": True},
-        )
-    except RuntimeError as exc:
-        what = "is singular, hence not positive definite" if definite else "is singular"
-        raise _fail(name, f"{what} ({exc})", hint) from None
-    if definite:
-        pivots = lu.U.diagonal()
-        if not np.array_equal(lu.perm_r, lu.perm_c):
-            raise _fail(name, "is not positive definite: its LDLᵀ factorisation needed off-diagonal pivoting", hint)
-        if np.any(~(pivots > 0)):
-            raise _fail(name, f"is not positive definite: its LDLᵀ factorisation has a pivot {pivots.min():.6g} <= 0",
-                        hint)
-
-    def ldlt():
-        L = sp.csc_array(lu.L)
-        L.sum_duplicates()
-        L.sort_indices()
-        return L, lu.U.diagonal(), np.asarray(lu.perm_c)
-
-    return lu.solve, ldlt, lu.L.nnz + lu.U.nnz
-
-
-def _cholmod(A: sp.csc_array, name: str, hint: str, definite: bool):
-    """CHOLMOD's supernodal Cholesky ``Pᵀ A P = L Lᵀ``: ``(solve, ldlt, fill)``; SPD matrices only.
-
-    A matrix that is not positive definite raises :class:`NotPositiveDefinite` (:func:`spd_factor` diagnoses).
-    :meth:`SPDFactor.ldlt` turns the factor into CHOLMOD's simplicial LDLᵀ in place (solves stay right).
-    """
-    if not definite:
-        raise ValueError("the CHOLMOD backend factors positive definite matrices only (no pivoting)")
-    cholmod = _import_cholmod()
-    try:
-        f = cholmod.cholesky(A, mode="supernodal")  # LLᵀ: simplicial would be an LDLᵀ, not checking definiteness
-    except cholmod.CholmodNotPositiveDefiniteError:
-        raise NotPositiveDefinite("CHOLMOD's Cholesky factorisation met a pivot <= 0") from None
-
-    def ldlt():
-        L, D = f.L_D()  # A[p][:, p] = L D Lᵀ
-        L = sp.csc_array(L)
-        L.sum_duplicates()
-        L.sort_indices()
-        return L, np.asarray(D.diagonal()), np.argsort(f.P())
-
-    return f.solve_A, ldlt, lambda: f.copy().L().nnz
-
-
 #: Sparse backends by name: ``factor(A_csc, name, hint, definite) -> (solve, ldlt, fill)`` (``fill`` an int
 #: or a function that counts it when asked).
-_SPARSE_BACKENDS = {"superlu": _superlu, "cvxopt": cvxopt_cholesky, "cholmod": _cholmod}
+_SPARSE_BACKENDS = {"superlu": superlu_factor, "cvxopt": cvxopt_cholesky, "cholmod": cholmod_factor}
 
 
 def _square(A, name: str) -> int:
@@ -371,19 +312,19 @@ def spd_factor(A, name: str = "A", *, hint: str = "") -> SPDFactor:
             L = np.linalg.cholesky(a)
         except np.linalg.LinAlgError:
             lam_min = sla.eigvalsh(a, subset_by_index=[0, 0])[0]
-            raise _fail(name, f"is not positive definite: smallest eigenvalue {lam_min:.6g} (must be > 0)",
+            raise fail(name, f"is not positive definite: smallest eigenvalue {lam_min:.6g} (must be > 0)",
                         hint) from None
         return SPDFactor(name, n, "dense", "cholesky", lambda b: sla.cho_solve((L, True), b), A, L)
     diag = A.diagonal()
     if np.any(~(diag > 0)):
         i = int(np.flatnonzero(~(diag > 0))[0])
-        raise _fail(name, f"is not positive definite: diagonal entry {name}[{i},{i}] = {diag[i]:.6g} <= 0", hint)
+        raise fail(name, f"is not positive definite: diagonal entry {name}[{i},{i}] = {diag[i]:.6g} <= 0", hint)
     backend, A_csc = factor_backend(), sp.csc_array(A, dtype=float)
     try:
         solve, ldlt, fill = _SPARSE_BACKENDS[backend](A_csc, name, hint, True)
     except NotPositiveDefinite as exc:  # a Cholesky-only backend: SuperLU says why (pivot, singular, pivoting)
-        _superlu(A_csc, name, hint, True)
-        raise _fail(name, f"is not positive definite: {exc}", hint) from None
+        superlu_factor(A_csc, name, hint, True)
+        raise fail(name, f"is not positive definite: {exc}", hint) from None
     return SPDFactor(name, n, "sparse", backend, solve, A, ldlt, fill)
 
 
@@ -416,7 +357,7 @@ def symmetric_factor(A, name: str = "A", *, hint: str = "") -> Factor:
             warnings.simplefilter("ignore", sla.LinAlgWarning)
             lu, piv = sla.lu_factor(np.asarray(A, dtype=float), check_finite=False)
         if np.any(np.diag(lu) == 0):
-            raise _fail(name, "is singular", hint)
+            raise fail(name, "is singular", hint)
         return Factor(name, n, "dense", "lu", lambda b: sla.lu_solve((lu, piv), b, check_finite=False), A)
     backend = factor_backend()
     backend = backend if backend in _PIVOTING else "superlu"
@@ -562,7 +503,7 @@ def lowest_modes(
                              "not positive semidefinite or has no mass on that mode's dofs")
         phi = phi / np.sqrt(norms)[None, :]
     if not np.all(np.isfinite(lam)) or lam[0] <= 0:
-        raise _fail(name, f"is not positive definite: eigenvalue {lam[0]:.3g} (a mechanism? degenerate cells?)", hint)
+        raise fail(name, f"is not positive definite: eigenvalue {lam[0]:.3g} (a mechanism? degenerate cells?)", hint)
     return lam, sign_convention(phi)
 
 

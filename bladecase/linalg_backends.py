@@ -1,4 +1,5 @@
-"""Optional sparse Cholesky backend of :mod:`bladecase.linalg`: CHOLMOD as shipped in cvxopt's wheels.
+"""The sparse factorisation backends of :mod:`bladecase.linalg`: SuperLU (always there; symmetric mode, LDLᵀ
+pivots checked), scikit-sparse's CHOLMOD where installed, and CHOLMOD as shipped in cvxopt's wheels (below).
 
 ``cvxopt`` (PyPI wheels for Linux, macOS and Windows) bundles SuiteSparse's CHOLMOD with an optimised BLAS,
 so ``pip`` installs it with no compiler and no system headers (``make`` installs it).  Its factorisation is
@@ -23,8 +24,10 @@ from contextlib import contextmanager
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
-__all__ = ["NotPositiveDefinite", "SPSOLVE_MIN_COLUMNS", "cvxopt_cholesky", "import_cvxopt"]
+__all__ = ["INDEFINITE_PIVOT_THRESHOLD", "NotPositiveDefinite", "SPSOLVE_MIN_COLUMNS", "cholmod_factor",
+           "cvxopt_cholesky", "fail", "import_cholmod", "import_cvxopt", "superlu_factor"]
 
 #: Blocks of at least this many right-hand sides are solved through cvxopt's ``cholmod.spsolve`` (CHOLMOD's
 #: supernodal solve of 4 columns at a time, the block given and returned as sparse matrices — dense here);
@@ -118,3 +121,71 @@ def cvxopt_cholesky(A: sp.csc_array, name: str, hint: str, definite: bool):
         return L, root**2, np.argsort(np.array(p).ravel().astype(np.int64))
 
     return solve, ldlt, lambda: ldlt()[0].nnz
+
+
+#: Diagonal pivot threshold of the indefinite factorisation (:func:`symmetric_factor`): SuperLU keeps the
+#: diagonal pivot unless it is below this fraction of the largest entry of its column.
+INDEFINITE_PIVOT_THRESHOLD = 0.1
+
+
+def fail(name: str, why: str, hint: str) -> ValueError:
+    return ValueError(f"{name} {why}" + (f": {hint}" if hint else ""))
+
+
+def import_cholmod():
+    from sksparse import cholmod  # optional: scikit-sparse, needs SuiteSparse's CHOLMOD
+
+    return cholmod
+
+
+def superlu_factor(A: sp.csc_array, name: str, hint: str, definite: bool):
+    """SuperLU in symmetric mode: ``(solve, ldlt, fill)``; the LDLᵀ checks if ``definite``."""
+    try:
+        lu = spla.splu(
+            A,
+            permc_spec="MMD_AT_PLUS_A",
+            diag_pivot_thresh=0.0 if definite else INDEFINITE_PIVOT_THRESHOLD,
+            options={"SymmetricMode": True},
+        )
+    except RuntimeError as exc:
+        what = "is singular, hence not positive definite" if definite else "is singular"
+        raise fail(name, f"{what} ({exc})", hint) from None
+    if definite:
+        pivots = lu.U.diagonal()
+        if not np.array_equal(lu.perm_r, lu.perm_c):
+            raise fail(name, "is not positive definite: its LDLᵀ factorisation needed off-diagonal pivoting", hint)
+        if np.any(~(pivots > 0)):
+            raise fail(name, f"is not positive definite: its LDLᵀ factorisation has a pivot {pivots.min():.6g} <= 0",
+                        hint)
+
+    def ldlt():
+        L = sp.csc_array(lu.L)
+        L.sum_duplicates()
+        L.sort_indices()
+        return L, lu.U.diagonal(), np.asarray(lu.perm_c)
+
+    return lu.solve, ldlt, lu.L.nnz + lu.U.nnz
+
+
+def cholmod_factor(A: sp.csc_array, name: str, hint: str, definite: bool):
+    """CHOLMOD's supernodal Cholesky ``Pᵀ A P = L Lᵀ``: ``(solve, ldlt, fill)``; SPD matrices only.
+
+    A matrix that is not positive definite raises :class:`NotPositiveDefinite` (:func:`spd_factor` diagnoses).
+    :meth:`SPDFactor.ldlt` turns the factor into CHOLMOD's simplicial LDLᵀ in place (solves stay right).
+    """
+    if not definite:
+        raise ValueError("the CHOLMOD backend factors positive definite matrices only (no pivoting)")
+    cholmod = import_cholmod()
+    try:
+        f = cholmod.cholesky(A, mode="supernodal")  # LLᵀ: simplicial would be an LDLᵀ, not checking definiteness
+    except cholmod.CholmodNotPositiveDefiniteError:
+        raise NotPositiveDefinite("CHOLMOD's Cholesky factorisation met a pivot <= 0") from None
+
+    def ldlt():
+        L, D = f.L_D()  # A[p][:, p] = L D Lᵀ
+        L = sp.csc_array(L)
+        L.sum_duplicates()
+        L.sort_indices()
+        return L, np.asarray(D.diagonal()), np.argsort(f.P())
+
+    return f.solve_A, ldlt, lambda: f.copy().L().nnz
