@@ -6,6 +6,7 @@ import numpy as np
 
 from .casing import casing_report
 from .convergence_report import convergence_report
+from .modes_report import modes_report
 from .nodal_report import nodal_report
 from .rotation_report import rotation_report
 from .rub_report import rub_report
@@ -54,7 +55,10 @@ def verdict_lines(summary: dict) -> list[str]:
 
 
 def report(summary: dict) -> str:
-    """A human-readable Markdown report of a run's :data:`summary`."""
+    """A human-readable Markdown report of a run's :data:`summary` (a run without a contact: the linear modes and
+    the Campbell diagram, :func:`~bladecase.post.modes_report.modes_report`)."""
+    if summary.get("contact") is None and summary.get("reduction") is None:
+        return modes_report(summary)
     m, c, r = summary["model"], summary["contact"], summary["reduction"]
     massless = massless_summary(summary)
     lines = [f"# bladecase study `{summary['study']}`", "", *verdict_lines(summary), "",
