@@ -92,7 +92,8 @@ def _campbell_lines(c: dict) -> list[str]:
     for s, x in enumerate(w):
         band = bands[s]
         words = (f"mode {band['mode'] + 1}: {band['low_hz']:.2f} – {band['high_hz']:.2f}"
-                 + (" (or more: the band reaches the edge of [search] periods)" if band.get("truncated") else "")
+                 + (" (cut at the small-displacement limit)" if band.get("cut") else
+                    " (or more: the band reaches the edge of [search] periods)" if band.get("truncated") else "")
                  if band else notes[s] or "—")
         lines.append(f"| {to_unit(x, unit):.6g} | {to_unit(x, other):.6g} | "
                      + (f"{clear[s] * 1e3:.4g} | " if clear is not None else "")
@@ -107,6 +108,7 @@ def _campbell_lines(c: dict) -> list[str]:
         lines += ["", f"**Doubtful tracking:** mode {j + 1} changes shape between {speed_words(w[s - 1], unit)} and "
                   f"{speed_words(w[s], unit)} (MAC {c['link_mac'][j][s]:.2f} < 0.8): the modes may have swapped "
                   "there; add speeds in between."]
+    lines += _cut_lines(c, unit)
     risks = c.get("risks") or []
     if risks:
         lines += ["", "**Contact-induced interaction risk:** " + "; ".join(
@@ -117,6 +119,19 @@ def _campbell_lines(c: dict) -> list[str]:
         lines += ["", "No engine order enters a nonsmooth-mode band at the speeds computed (bands between speeds "
                   "interpolated linearly)."]
     return lines
+
+
+def _cut_lines(c: dict, unit: str) -> list[str]:
+    """Where and why the bands were cut at the small-displacement limit, speed by speed."""
+    cuts = [(x, cut) for x, cut in zip(c["speeds_rad_s"], c.get("band_cuts") or []) if cut]
+    if not cuts:
+        return []
+    words = [f"at {speed_words(x, unit)}, "
+             + (f"the band stops at {cut['high_hz']:.2f} Hz" if cut.get("high_hz") is not None else "no band is left")
+             + f": {cut['reason']}" for x, cut in cuts]
+    return ["", "**Bands cut at the small-displacement limit:** " + "; ".join(words) + ". Beyond, the orbits move the "
+            "tip further than a linear-elastic, small-displacement model of the blade can follow: the band's edge "
+            "there is not a figure to quote."]
 
 
 def _risk_speed(r: dict, end: str, unit: str) -> str:

@@ -19,6 +19,7 @@ clearance, and the Campbell diagram with the nonsmooth-mode band at each speed.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 
 import numpy as np
@@ -138,7 +139,7 @@ def _speed_point(omega: float, *, study: Study, model, contact, axis: RotationAx
     state, phi, f = modes_at_speed(model, float(omega), axis, n, static=study["rotation"].get("static", "auto"))
     point = {"shapes": phi if sample is None else np.ascontiguousarray(phi[sample]), "frequencies_hz": f,
              "clearance": None if contact is None else running_clearance(study, model, contact, state, cold=True),
-             "band_hz": None, "note": None}
+             "band_hz": None, "note": None, "cut": None}
     if not bands or contact is None:
         return point
     d = point["clearance"]["clearance_running_m"]
@@ -148,6 +149,7 @@ def _speed_point(omega: float, *, study: Study, model, contact, axis: RotationAx
     hot = contact.closed_by(model, state.displacement)  # the contact's clearance is the cold one here
     reduced = build_reduced(study, state.model, hot, factor=state.factor)
     families = search(study, reduced.system, label=speed_words(omega, study["rotation"]["speed_unit"]))
+    families, point["cut"] = _cut_band(study, model, reduced, families)
     arcs = [a for f in families for a in f.arcs]
     if arcs:
         point["band_hz"] = (min(1.0 / a.T_hi for a in arcs), max(1.0 / a.T_lo for a in arcs))
@@ -155,9 +157,31 @@ def _speed_point(omega: float, *, study: Study, model, contact, axis: RotationAx
         edge = 1.0 / (study["search"]["periods"][0] * unit)  # the highest frequency the search looks at
         if point["band_hz"][1] >= edge * (1 - 1e-6):
             point["note"] = "the band reaches the edge of [search] periods: it may extend beyond"
+    elif point["cut"] is not None:
+        point["note"] = (f"every admissible orbit moves the tip more than the small-displacement limit "
+                         f"{point['cut']['limit_m'] * 1e3:.4g} mm")
     else:
         point["note"] = "no admissible orbit in [search] periods"
     return point
+
+
+def _cut_band(study: Study, model, reduced, families: list) -> tuple[list, dict | None]:
+    """The families with their arcs cut at the small-displacement limit (``[search] amplitude_limit`` × the span,
+    :mod:`~bladecase.study.validity`), and where and why the band was cut (``None``: not cut): the limit, each
+    cut's last orbit within it and first beyond, as frequencies and tip amplitudes."""
+    from .render import tip_amplitude
+    from .validity import blade_span, cut_arcs
+
+    span = blade_span(model)
+    fraction = study["search"]["amplitude_limit"]
+    cut, cuts = cut_arcs(families, [functools.partial(tip_amplitude, reduced)] * len(families), fraction * span)
+    if not cuts:
+        return families, None
+    rows = [{"family": c["family"], "f_beyond_hz": 1.0 / c["T_beyond"],
+             "tip_amplitude_beyond_m": c["tip_amplitude_beyond"],
+             "f_cut_hz": None if c["T_cut"] is None else 1.0 / c["T_cut"],
+             "tip_amplitude_cut_m": c["tip_amplitude_cut"]} for c in cuts]
+    return cut, {"limit_m": fraction * span, "span_m": span, "amplitude_limit": fraction, "cuts": rows}
 
 
 def campbell_stage(study: Study, model, contact, executor, progress: bool = False) -> tuple[Campbell, dict]:
@@ -178,6 +202,7 @@ def campbell_stage(study: Study, model, contact, executor, progress: bool = Fals
     c = from_modes(w, [p["shapes"] for p in points], [p["frequencies_hz"] for p in points], M, count,
                    r.get("engine_orders", []))
     bands = [p["band_hz"] for p in points]
+    unit = r["speed_unit"]
     section = c.to_dict()
     section["axis"] = {"origin": axis.origin.tolist(), "direction": axis.direction.tolist()}
     section["speed_unit"] = unit_name(r["speed_unit"])
@@ -186,11 +211,12 @@ def campbell_stage(study: Study, model, contact, executor, progress: bool = Fals
     section["running_clearance_m"] = [x.get("clearance_running_m") for x in clear] if contact is not None else None
     section["closure_m"] = [x.get("closure_m") for x in clear] if contact is not None else None
     section["bands"] = [None if b is None else {"mode": _rank0(c, s), "low_hz": b[0], "high_hz": b[1],
-                                                "truncated": bool(points[s]["note"])}
+                                                "truncated": bool(points[s]["note"]),
+                                                "cut": points[s]["cut"] is not None}
                         for s, b in enumerate(bands)]
     section["band_notes"] = [p["note"] for p in points]
+    section["band_cuts"] = [_cut_words(p["cut"], b, unit, x) for p, b, x in zip(points, bands, w)]
     section["risks"] = band_risks(w, bands, section["engine_orders"])
-    unit = r["speed_unit"]
     if c.uncertain_links:
         s, j = c.uncertain_links[0]
         log.warning("Campbell: mode %d is followed from %s to %s with a MAC of %.2f only: add speeds between them",
@@ -200,6 +226,26 @@ def campbell_stage(study: Study, model, contact, executor, progress: bool = Fals
                     "interaction risk", risk["engine_order"], speed_words(risk["from_rad_s"], unit),
                     speed_words(risk["to_rad_s"], unit))
     return c, section
+
+
+def _cut_words(cut: dict | None, band: tuple | None, unit: str, omega: float) -> dict | None:
+    """One speed's entry of ``summary["campbell"]["band_cuts"]``: the band's cut at the small-displacement limit
+    (where: the band's new upper edge, the first frequency beyond; why: the tip amplitude there against the limit),
+    logged; ``None`` where the band was not cut."""
+    if cut is None:
+        return None
+    beyond = min(cut["cuts"], key=lambda c: c["f_beyond_hz"])  # the lowest frequency beyond the limit
+    out = dict(cut, high_hz=None if band is None else band[1], f_beyond_hz=beyond["f_beyond_hz"],
+               tip_amplitude_beyond_m=beyond["tip_amplitude_beyond_m"],
+               reason=f"the tip amplitude reaches {beyond['tip_amplitude_beyond_m'] * 1e3:.4g} mm at "
+                      f"{beyond['f_beyond_hz']:.2f} Hz, beyond the small-displacement limit "
+                      f"{cut['limit_m'] * 1e3:.4g} mm ({100 * cut['amplitude_limit']:g} % of the "
+                      f"{cut['span_m'] * 1e3:.4g} mm span, [search] amplitude_limit)")
+    where = (f"its upper edge stops at {band[1]:.2f} Hz" if band is not None
+             else "no admissible orbit is within the limit: no band")
+    log.warning("Campbell at %s: the nonsmooth-mode band is cut at the small-displacement limit: %s; %s",
+                speed_words(omega, unit), where, out["reason"])
+    return out
 
 
 def _rank0(c: Campbell, s: int) -> int:
