@@ -216,6 +216,9 @@ def campbell_stage(study: Study, model, contact, executor, progress: bool = Fals
                         for s, b in enumerate(bands)]
     section["band_notes"] = [p["note"] for p in points]
     section["band_cuts"] = [_cut_words(p["cut"], b, unit, x) for p, b, x in zip(points, bands, w)]
+    for s, cut in enumerate(section["band_cuts"]):
+        if cut is not None:
+            cut["mode"] = _rank0(c, s)  # the band's mode (0-based), as in "bands"
     section["risks"] = band_risks(w, bands, section["engine_orders"])
     if c.uncertain_links:
         s, j = c.uncertain_links[0]
