@@ -226,6 +226,8 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
                  contact.gap * 1e3)
         log.info("reduced model: %s", reduced)
         log.info("contact stiffness: %s", _stiffness_words(reduced, fe))
+        if (soft := _soft_casing(reduced, fe)) is not None:
+            log.warning("%s", soft)
         t0 = time.perf_counter()
         reference = (reference_model(model, contact, reduced, factor, study_basis(study)) if o["reference"]
                      else None)
@@ -427,6 +429,17 @@ def _stiffness_words(reduced, fe) -> str:
     if np.isinf(s.casing):
         return f"{own}, rigid casing; {blade}"
     return f"{own}; casing {s.casing:.4g} N/m in series: k_s = {s.kc:.4g} N/m; {blade}"
+
+
+def _soft_casing(reduced, fe) -> str | None:
+    """The sentence of a compliant casing far softer than the blade's static stiffness at the contact
+    (:func:`~bladecase.post.casing_words.weak_casing_words`), else ``None``."""
+    from ..post.casing_words import weak_casing_words
+
+    s = reduced.system
+    if getattr(s, "contact_model", "newton") != "massless" or np.isinf(s.casing) or not fe.static_compliance > 0:
+        return None
+    return weak_casing_words(float(s.kc), 1.0 / float(fe.static_compliance), casing=float(s.casing))
 
 
 def _animate_forced(study: Study, reduced, section: dict, orbits: list, folder: Path) -> list[dict]:
