@@ -90,7 +90,7 @@ def test_a_clearance_closed_at_the_operating_speed_stops_the_run(tmp_path, capsy
     code = main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet", "--no-progress"])
     err = capsys.readouterr().err
     assert code == 2
-    assert "at 12000 rpm the blade's centrifugal growth along the contact normal" in err
+    assert "at 12000 rpm (1256.64 rad/s) the blade's centrifugal growth along the contact normal" in err
     touch = float(err.split("from about ")[1].split(" rpm")[0])
     assert 11000 < touch < 12000  # the growth goes as Ω²: sqrt(gap / growth) × 12000
     assert not (tmp_path / "out" / "summary.json").exists()

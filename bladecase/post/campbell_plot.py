@@ -1,6 +1,6 @@
-"""The Campbell diagram as a figure: tracked natural frequencies against speed (rpm), engine-order lines, their
-crossings, and the nonsmooth-mode bands — from grazing to the end of each mode's admissible arc — where the
-blade touches its casing.
+"""The Campbell diagram as a figure: tracked natural frequencies against speed (in the study's unit, the other
+common one on the top axis), engine-order lines, their crossings, and the nonsmooth-mode bands — from grazing to
+the end of each mode's admissible arc — where the blade touches its casing.
 
 >>> import numpy as np
 >>> from bladecase.fe.campbell import Campbell, crossings
@@ -47,7 +47,7 @@ def _band(ax, band, j: int, color: str, top: float, per: float) -> None:
 def campbell_figure(campbell, bands: dict | None = None, title: str | None = None, ax=None,
                     speed_unit: str = "rpm") -> Figure:
     """Frequencies (Hz) of the tracked modes against speed (in ``speed_unit``: the study's, ``"rpm"``, ``"rad/s"``
-    or ``"Hz"``; with rad/s or Hz, rpm on the top axis), engine orders (dashed, labelled ``EO n``), their crossings
+    or ``"Hz"``; on the top axis rad/s for rpm, else rpm), engine orders (dashed, labelled ``EO n``), their crossings
     (circles), and ``bands`` (mode → ``(speeds rad/s, low Hz, high Hz)``) shaded: the frequencies a nonsmooth mode
     of that linear mode spans at each speed.  An engine order entering a band is the contact-induced interaction
     risk."""
@@ -79,9 +79,9 @@ def campbell_figure(campbell, bands: dict | None = None, title: str | None = Non
     ax.set_ylim(0.0, top)
     unit = {"hz": "Hz"}.get(speed_unit.lower(), speed_unit.lower())
     ax.set_xlabel(f"rotation speed ({unit})")
-    if unit != "rpm":  # the other unit in brackets: rpm on top
-        to_rpm = per * 60 / (2 * math.pi)
-        ax.secondary_xaxis("top", functions=(lambda x: x * to_rpm, lambda r: r / to_rpm)).set_xlabel("(rpm)")
+    other = "rad/s" if unit == "rpm" else "rpm"  # the other unit in brackets, on top
+    scale = per / SPEED_UNITS[other]
+    ax.secondary_xaxis("top", functions=(lambda x: x * scale, lambda r: r / scale)).set_xlabel(f"({other})")
     ax.set_ylabel("frequency (Hz)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="upper left")

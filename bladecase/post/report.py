@@ -5,7 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from .casing import casing_report
+from .casing_words import weak_casing_words
 from .convergence_report import convergence_report
+from .modes_report import modes_report
 from .nodal_report import nodal_report
 from .rotation_report import rotation_report
 from .rub_report import rub_report
@@ -54,7 +56,10 @@ def verdict_lines(summary: dict) -> list[str]:
 
 
 def report(summary: dict) -> str:
-    """A human-readable Markdown report of a run's :data:`summary`."""
+    """A human-readable Markdown report of a run's :data:`summary` (a run without a contact: the linear modes and
+    the Campbell diagram, :func:`~bladecase.post.modes_report.modes_report`)."""
+    if summary.get("contact") is None and summary.get("reduction") is None:
+        return modes_report(summary)
     m, c, r = summary["model"], summary["contact"], summary["reduction"]
     massless = massless_summary(summary)
     lines = [f"# bladecase study `{summary['study']}`", "", *verdict_lines(summary), "",
@@ -311,8 +316,9 @@ def _static_words(c: dict) -> list[str]:
         return []
     k = c.get("casing_stiffness_n_per_m")
     versus = "" if k is None else f"; the casing's stiffness is {k / ks:.3g} × that"
+    soft = None if k is None else weak_casing_words(c.get("series_stiffness_n_per_m", k), ks, casing=k)
     return [f"- The blade's static stiffness at the contact: 1/(wᵀK⁻¹w) = {ks:.4g} N/m (the whole FE model, "
-            f"clamped at its root){versus}."]
+            f"clamped at its root){versus}.", *([f"- **Soft casing:** {soft}."] if soft else [])]
 
 
 def _arc_engineering_table(with_arcs: list, massless: bool) -> list[str]:

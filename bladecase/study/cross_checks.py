@@ -20,7 +20,7 @@ from .sections import (
 )
 from .values import LIMITS
 
-__all__ = ["MASSLESS_METHODS", "cross_checks"]
+__all__ = ["MASSLESS_METHODS", "campbell_only", "cross_checks", "modes_only_checks"]
 
 
 def _cell_checks(c: dict) -> None:
@@ -184,3 +184,32 @@ def _contact_model_checks(c: dict) -> None:
         m = next(m for m in methods if m in MASSLESS_METHODS)
         raise StudyError(f"[reduction] method: {m!r} is a reduction of the massless contact model: set "
                          "[contact] model = 'massless'")
+
+
+def campbell_only(raw: dict) -> bool:
+    """True for a study (as parsed, before its defaults) of the linear modes and the Campbell diagram alone:
+    ``[rotation] speeds`` given, no ``[contact]`` section and no casing of revolution.
+
+    >>> campbell_only({"rotation": {"speeds": [0, 1000]}}), campbell_only({"rotation": {"speeds": [0]}, "contact": {}})
+    (True, False)
+    """
+    rotation, casing = raw.get("rotation"), raw.get("casing")
+    speeds = rotation.get("speeds") if isinstance(rotation, dict) else None
+    ring = isinstance(casing, dict) and (casing.get("radius") is not None or casing.get("radii") is not None)
+    return "contact" not in raw and not ring and isinstance(speeds, list) and len(speeds) > 0
+
+
+#: The sections (and the key that turns each on) that need a contact: refused in a study without one.
+_CONTACT_STAGES = (("forcing", "amplitude", "the forced response follows the nonsmooth modes"),
+                   ("convergence", "meshes", "the mesh convergence is that of the nonsmooth modes' figures"),
+                   ("rub", "speeds", "the rub response is the blade's contact with its casing"))
+
+
+def modes_only_checks(c: dict) -> None:
+    """A study without a contact (:func:`campbell_only`) computes the linear modes and the Campbell diagram; a
+    stage that needs a contact is refused, naming the section to add."""
+    for section, key, why in _CONTACT_STAGES:
+        value = (c.get(section) or {}).get(key)
+        if value:
+            raise StudyError(f"[{section}] {key}: {why}, which needs a contact: add a [contact] section (its "
+                             f"clearance, e.g. clearance = 1e-4, and where it is) or remove {key} = {value!r}")

@@ -22,6 +22,7 @@ from .. import log
 from ..fe import save_mesh, stiffness_factor
 from ..io import write_json, write_text
 from ..post.compare import ModelResult, fe_reference
+from ..post.modes_report import modes_verdict
 from ..post.outputs import FORMATS, PlotScene
 from ..post.report import report
 from ..post.verdict import verdict
@@ -30,10 +31,11 @@ from .comparison import FE_MODES, compare_models, summary_section
 from .documents import contact_summary, families_document, family_summary, model_summary, reduced_summary
 from .executor import Executor, make_executor
 from .forcing import forced_response, forced_scene
+from .modes_run import campbell_with_figure, compute_modes
 from .publish import RUN_RESULTS, check_inputs, output_folder, publish, release, staged_names, staging_dir
 from .reference import reference_model, study_basis
 from .render import orbit_engineering, render_all
-from .rotation import campbell_stage, operating_point
+from .rotation import operating_point
 from .schema import Study, load_study
 from .stages import (
     build_contact,
@@ -149,7 +151,7 @@ def run(study: Study | str | os.PathLike, out: str | os.PathLike | None = None, 
     if study.source and Path(study.source).is_file():
         check_inputs(out, [study.source])
     staging = staging_dir(out)
-    stages = _Stages(progress, total=6 + (study["forcing"]["amplitude"] is not None)
+    stages = _Stages(progress, total=3 if not study.has_contact else 6 + (study["forcing"]["amplitude"] is not None)
                      + bool(study.config.get("rotation") and study["rotation"]["speeds"])
                      + bool((study.config.get("rub") or {}).get("speeds")) + bool(casing_sweep_values(study))
                      + (study["contact"].get("points") == "nodes") + bool(study["convergence"]["meshes"]))
@@ -158,12 +160,14 @@ def run(study: Study | str | os.PathLike, out: str | os.PathLike | None = None, 
     try:
         with log.transcript() as lines:
             log.info("study %s (%s) → %s", study.name, study.source, out)
-            summary, families, models = _compute(study, staging, stages, progress, executor or own)
+            compute = _compute if study.has_contact else compute_modes  # no contact: the modes and Campbell alone
+            summary, families, models = compute(study, staging, stages, progress, executor or own)
             summary["timings_s"] = dict(stages.timings, total=round(time.perf_counter() - t_start, 3))
             log.info("results in %s (%.1f s)", out, summary["timings_s"]["total"])
         write_text(staging / "run.log", "\n".join(lines) + "\n")
         summary["outputs"] = sorted(set(staged_names(staging)) | {"summary.json", "report.md"})
-        summary["verdict"] = verdict(summary, staging / "modes.json")
+        summary["verdict"] = (verdict(summary, staging / "modes.json") if study.has_contact
+                              else modes_verdict(summary))
         write_json(staging / "summary.json", summary)
         write_text(staging / "report.md", report(summary))
         publish(staging, out, RUN_RESULTS, whole=True)
@@ -222,6 +226,8 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
                  contact.gap * 1e3)
         log.info("reduced model: %s", reduced)
         log.info("contact stiffness: %s", _stiffness_words(reduced, fe))
+        if (soft := _soft_casing(reduced, fe)) is not None:
+            log.warning("%s", soft)
         t0 = time.perf_counter()
         reference = (reference_model(model, contact, reduced, factor, study_basis(study)) if o["reference"]
                      else None)
@@ -267,7 +273,7 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
     campbell = None
     if study.config.get("rotation") and study["rotation"]["speeds"]:
         with stage("campbell"):
-            campbell = _campbell(study, rest_model, cold_contact, executor, progress, staging, files)
+            campbell = campbell_with_figure(study, rest_model, cold_contact, executor, progress, staging, files)
     with stage("render"):
         rejected: list = []
         files["animations"] = render_all(study, reduced, families, staging, progress, reference, rejected)
@@ -425,23 +431,15 @@ def _stiffness_words(reduced, fe) -> str:
     return f"{own}; casing {s.casing:.4g} N/m in series: k_s = {s.kc:.4g} N/m; {blade}"
 
 
-def _campbell(study: Study, model, contact, executor: Executor, progress: bool, staging: Path, files: dict) -> dict:
-    """The Campbell stage: the diagram's summary section, and ``campbell.png`` when pictures are asked for."""
-    diagram, section = campbell_stage(study, model, contact, executor, progress)
-    if "png" in study["output"]["formats"]:
-        from ..io import save_figure
-        from ..post.campbell_plot import campbell_figure
+def _soft_casing(reduced, fe) -> str | None:
+    """The sentence of a compliant casing far softer than the blade's static stiffness at the contact
+    (:func:`~bladecase.post.casing_words.weak_casing_words`), else ``None``."""
+    from ..post.casing_words import weak_casing_words
 
-        w = diagram.speeds
-        bands: dict[int, tuple] = {}
-        for s, band in enumerate(section["bands"]):
-            if band is not None:
-                lo, hi = bands.setdefault(band["mode"], (w, np.full(w.size, np.nan), np.full(w.size, np.nan)))[1:]
-                lo[s], hi[s] = band["low_hz"], band["high_hz"]
-        save_figure(campbell_figure(diagram, bands, title=f"{study.name}: Campbell diagram",
-                                    speed_unit=study["rotation"]["speed_unit"]), staging / "campbell.png", dpi=150)
-        files["campbell"] = "campbell.png"
-    return section
+    s = reduced.system
+    if getattr(s, "contact_model", "newton") != "massless" or np.isinf(s.casing) or not fe.static_compliance > 0:
+        return None
+    return weak_casing_words(float(s.kc), 1.0 / float(fe.static_compliance), casing=float(s.casing))
 
 
 def _animate_forced(study: Study, reduced, section: dict, orbits: list, folder: Path) -> list[dict]:

@@ -29,7 +29,12 @@ from ..fe import BladeGeometry, PlateGeometry
 from ..fe.mesh_checks import LENGTH_UNITS
 from ..post.outputs import FORMATS as OUTPUT_FORMATS
 from ..reduction import METHODS
-from .cross_checks import MASSLESS_METHODS, cross_checks  # noqa: F401 (MASSLESS_METHODS lived here)
+from .cross_checks import (  # noqa: F401 (MASSLESS_METHODS lived here)
+    MASSLESS_METHODS,
+    campbell_only,
+    cross_checks,
+    modes_only_checks,
+)
 from .demo import NEWTON_DEMO, demo_study, demo_text  # noqa: F401 (re-exported: they lived here)
 from .keys import _BOOL, _INT, _LIST, _NUM, _STR, REQUIRED, Key, StudyError, one_line  # noqa: F401
 from .sections import (
@@ -317,6 +322,14 @@ class Study:
         return self.config["study"]["name"]
 
     @property
+    def has_contact(self) -> bool:
+        """False for a study without a contact (no ``[contact] clearance`` and no ``[casing]``): a study of the
+        linear modes and the Campbell diagram alone (``[rotation] speeds`` without ``[contact]``)."""
+        k = self.config.get("casing") or {}
+        return (self.config["contact"].get("clearance") is not None or k.get("radius") is not None
+                or k.get("radii") is not None)
+
+    @property
     def parametric(self) -> bool:
         """True when the blade is generated from ``[geometry]`` (else read from ``[mesh]``)."""
         return "geometry" in self.config
@@ -478,6 +491,8 @@ def validate(raw: dict, source: str = "<string>", base: str | os.PathLike | None
     ``[mesh]``) and the contact clearance may then be left out.
     ``contact=False`` is for the stages before the contact (``bladecase mesh``,
     ``bladecase assemble``): the contact clearance may be left out.
+    A study with ``[rotation] speeds`` and no ``[contact]`` section (nor ``[casing]``) is a study of the linear
+    modes and the Campbell diagram alone (:attr:`Study.has_contact` is False; :func:`modes_only_checks`).
 
     Raises
     ------
@@ -524,7 +539,10 @@ def validate(raw: dict, source: str = "<string>", base: str | os.PathLike | None
             _cap_animate(out, section)
         config[section] = out
     _follow_contact_model(config, raw)
-    cross_checks(config, model=model, contact=contact)
+    modes_only = model and contact and campbell_only(raw)
+    if modes_only:
+        modes_only_checks(config)
+    cross_checks(config, model=model, contact=contact and not modes_only)
     return Study(config=config, source=source, base=Path(base) if base is not None else Path.cwd())
 
 
