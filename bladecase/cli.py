@@ -389,10 +389,9 @@ def _frequencies_at_speed(study, model, count: int) -> str | None:
     speed = operating_speed(study)
     if speed is None:
         return None
-    import math
-
     from .fe import natural_frequencies
     from .fe.rotation import spin
+    from .post.rotation_report import speed_words
     from .study import StudyError
 
     try:
@@ -400,7 +399,7 @@ def _frequencies_at_speed(study, model, count: int) -> str | None:
     except ValueError as exc:
         raise StudyError(f"[rotation] speed: {exc}") from None
     f = natural_frequencies(state.model, count, factor=state.factor)
-    return (f"at the operating speed {speed:.6g} rad/s ({speed * 30 / math.pi:.6g} rpm, [rotation]): linear "
+    return (f"at the operating speed {speed_words(speed, study['rotation']['speed_unit'])} ([rotation]): linear "
             "frequencies (Hz): " + ", ".join(f"{x:.3f}" for x in f) + " — the model file holds the structure at rest; "
             "'bladecase reduce' spins it to this speed")
 

@@ -184,7 +184,8 @@ def test_assemble_gives_the_frequencies_at_the_operating_speed(plate, tmp_path, 
     assert _run("assemble", study, "-o", tmp_path / "m.npz") == 0
     out = capsys.readouterr().out
     rest = [float(x) for x in out.split("linear frequencies (Hz): ")[1].split("\n")[0].split(", ")]
-    line = next(x for x in out.splitlines() if x.startswith("at the operating speed ") and "(3000 rpm" in x)
+    first = "at the operating speed 3000 rpm (314.159 rad/s) "  # the study's unit first
+    line = next(x for x in out.splitlines() if x.startswith(first))
     spun = [float(x) for x in line.split("linear frequencies (Hz): ")[1].split(" — ")[0].split(", ")]
     assert "the model file holds the structure at rest" in line
     assert spun[0] > rest[0]  # stress stiffening of a blade spun about an axis below its root

@@ -102,3 +102,17 @@ def test_a_stage_that_needs_a_contact_is_refused_and_nothing_is_written(tmp_path
 def test_without_speeds_a_contact_is_still_required():
     with pytest.raises(Exception, match=r"\[contact\] clearance: required"):
         loads(NO_CONTACT)
+
+
+def test_reduce_without_a_contact_says_what_is_missing(tmp_path, capsys):
+    """`bladecase reduce` of a study without [contact]: exit 2, the message names the missing section and what the
+    study can give instead (not a 'gap is required' from deep inside)."""
+    path = tmp_path / "s.toml"
+    path.write_text(NO_CONTACT + ROTATION)
+    assert main(["assemble", str(path), "--quiet", "-o", str(tmp_path / "m.npz")]) == 0
+    capsys.readouterr()
+    args = ["--model", str(tmp_path / "m.npz"), "--quiet", "-o", str(tmp_path / "r.npz")]
+    assert main(["reduce", str(path), *args]) == 2
+    err = capsys.readouterr().err
+    assert "[contact]: this study has none" in err and "'bladecase run' gives the linear modes" in err, err
+    assert not (tmp_path / "r.npz").exists()

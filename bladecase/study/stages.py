@@ -273,6 +273,10 @@ def build_contact(study: Study, model: FEModel) -> Contact:
     ``nearest`` → the free node nearest the point (within ``group`` if given);
     otherwise the node of the one-node ``group`` (default ``contact``).
     """
+    if not study.has_contact:
+        raise StudyError("[contact]: this study has none — a contact (its clearance, node or face) is needed for a "
+                         "reduced model and nonsmooth modes; without one, 'bladecase run' gives the linear modes and "
+                         "the Campbell diagram")
     contact = _picked_contact(study, model)
     mesh = model.mesh
     if mesh.numbering == "file":  # the file's number, beside the 0-based index of mesh.vtu

@@ -81,6 +81,8 @@ REASONS = {
     "mesh_error_large": "a headline figure's mesh error estimate exceeds the flag, or it does not converge "
                         "monotonically over the meshes (convergence.flagged)",
     "mesh_error_unknown": "no [convergence] meshes: the figures' mesh error is not measured (summary convergence null)",
+    "no_contact": "the study has no [contact]: linear modes and the Campbell diagram only, no nonsmooth mode "
+                  "(summary contact null)",
     "band_to_tongue": "the main family's band and figures are read up to its first internal-resonance tongue "
                       "(admissible_arcs[*].tongue, backbone_f_hi)",
     "cut_at_amplitude_limit": "admissible arcs were cut where the tip amplitude exceeds [search] amplitude_limit × "
