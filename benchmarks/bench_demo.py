@@ -12,8 +12,8 @@ import argparse
 import tempfile
 import time
 
+from bladecase.study.demo import demo_study
 from bladecase.study.pipeline import run
-from bladecase.study.schema import demo_study
 
 AIM_S = 60.0
 

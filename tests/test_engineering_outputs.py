@@ -27,8 +27,9 @@ import bladecase as bc
 from bladecase.nsm import chain
 from bladecase.nsm.floquet import floquet
 from bladecase.reduction import reduce
+from bladecase.study.demo import demo_study
 from bladecase.study.run import run
-from bladecase.study.schema import demo_study, loads, validate
+from bladecase.study.schema import loads, validate
 
 
 def _small(contact_model: str):

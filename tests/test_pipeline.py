@@ -37,7 +37,8 @@ from bladecase.post.animation import mp4_available
 from bladecase.post.vtk import read_time_series
 from bladecase.reduction import load_reduced, reduce, save_reduced
 from bladecase.study import pipeline
-from bladecase.study.schema import demo_study, loads, validate
+from bladecase.study.demo import demo_study
+from bladecase.study.schema import loads, validate
 
 FRAMES = 8
 WINDOW = (320, 240)

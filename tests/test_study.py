@@ -9,7 +9,8 @@ import pytest
 from _studies import PLATE, ROOT, absolute, as_raw
 
 from bladecase.cli import main
-from bladecase.study.schema import SCHEMA, StudyError, demo_study, demo_text, load_study, loads, validate
+from bladecase.study.demo import demo_study, demo_text
+from bladecase.study.schema import SCHEMA, StudyError, load_study, loads, validate
 
 
 def raw_demo() -> dict:

@@ -18,7 +18,8 @@ from pathlib import Path
 import pytest
 
 from bladecase.fe.geometry import BladeGeometry, PlateGeometry
-from bladecase.study.schema import GEOMETRY_FIELDS, REQUIRED, SCHEMA, demo_text, loads
+from bladecase.study.demo import demo_text
+from bladecase.study.schema import GEOMETRY_FIELDS, REQUIRED, SCHEMA, loads
 
 ROOT = Path(__file__).resolve().parent.parent
 DOC = ROOT / "docs" / "study.md"

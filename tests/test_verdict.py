@@ -19,8 +19,9 @@ from _studies import PLATE, absolute, as_raw
 
 from bladecase.post.report import report
 from bladecase.post.verdict import REASONS, verdict
+from bladecase.study.demo import demo_study
 from bladecase.study.run import run
-from bladecase.study.schema import demo_study, loads, validate
+from bladecase.study.schema import loads, validate
 
 OUTPUT = "\n[output]\nformats = []\nframes = 4\nanimate = 1\n"
 

@@ -9,6 +9,7 @@ import math
 
 from ..fe import Material, PlateGeometry
 from ..fe.geometry import estimate_cells
+from .geometry_section import geometry_of
 from .keys import StudyError, one_line
 from .sections import (
     casing_checks,
@@ -28,9 +29,7 @@ def _cell_checks(c: dict) -> None:
     if "geometry" not in c:
         return
     g, cap = c["geometry"], c["limits"]["cells"]
-    from .schema import Study
-
-    geometry = Study({"geometry": g}).geometry()
+    geometry = geometry_of(g)
     try:
         n = estimate_cells(geometry, size=g["size"], tip_size=g["tip_size"], cells=g["cells"])
     except ValueError as exc:

@@ -14,15 +14,11 @@ types and out-of-range values raise :class:`StudyError` naming the key, e.g.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import os
-import re
-import stat
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 from .. import log
 from ..fe import BladeGeometry, PlateGeometry
@@ -35,8 +31,8 @@ from .cross_checks import (  # noqa: F401 (MASSLESS_METHODS lived here)
     cross_checks,
     modes_only_checks,
 )
-from .demo import NEWTON_DEMO, demo_study, demo_text  # noqa: F401 (re-exported: they lived here)
-from .keys import _BOOL, _INT, _LIST, _NUM, _STR, REQUIRED, Key, StudyError, one_line  # noqa: F401
+from .geometry_section import GEOMETRY_FIELDS, GEOMETRY_KEYS, geometry_of, geometry_section  # noqa: F401
+from .keys import _BOOL, _INT, _LIST, _NUM, _STR, REQUIRED, Key, StudyError, _check_field, _check_value, one_line  # noqa: F401
 from .sections import (
     CASING_KEYS,
     CONVERGENCE_KEYS,
@@ -46,6 +42,7 @@ from .sections import (
     ROTATION_KEYS,
     RUB_KEYS,
 )
+from .study_file import MAX_STUDY_BYTES, MAX_STUDY_FILE_BYTES, content_size, read_study_text  # noqa: F401
 from .values import (  # noqa: F401  (RANGES, LIMITS: part of the schema's documented surface)
     LIMITS,
     MIN_FPS,
@@ -112,15 +109,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
     "study": {
         "name": Key(_STR, "study", "Name used in titles and file names (a plain folder name).", _study_name),
     },
-    "geometry": {
-        "kind": Key(_STR, "blade", "'blade' (3-D lofted solid, tetrahedra) or 'plate' (2-D plane stress).",
-                    _one_of("blade", "plate")),
-        "size": Key(_NUM, None, "Target element size (m); default: the geometry's own default.", _positive),
-        "tip_size": Key(_NUM, None, "Element size at the tip (m, <= size); default: uniform.", _positive),
-        "mesh_order": Key(_INT, 1, "Geometric order of the gmsh mesh (1 or 2).", _one_of(1, 2)),
-        "cells": Key(_STR, "simplex", "'simplex' (tetrahedra, triangles) or 'hexahedron' (gmsh splits each into "
-                     "hexahedra / quadrilaterals; mesh_order 1).", _one_of("simplex", "hexahedron")),
-    },
+    "geometry": GEOMETRY_KEYS,
     "mesh": {
         "path": Key(_STR, REQUIRED, "Mesh file (any meshio format with named groups), relative to the study file.",
                     _file),
@@ -275,13 +264,6 @@ SCHEMA: dict[str, dict[str, Key]] = {
     "limits": LIMIT_KEYS,
 }
 
-#: ``[geometry]`` keys taken from the geometry dataclasses (the parametric shape).
-GEOMETRY_FIELDS = {
-    "blade": tuple(f.name for f in dataclasses.fields(BladeGeometry)),
-    "plate": tuple(f.name for f in dataclasses.fields(PlateGeometry)),
-}
-
-
 @dataclass(frozen=True)
 class Study:
     """A validated study: every section with its defaults filled in.
@@ -299,6 +281,7 @@ class Study:
     --------
     Sections read as dicts, with every default filled in:
 
+    >>> from bladecase.study.demo import demo_study
     >>> study = demo_study()
     >>> study.name, study.source, study.parametric
     ('demo', '<demo>', True)
@@ -336,10 +319,7 @@ class Study:
 
     def geometry(self) -> BladeGeometry | PlateGeometry:
         """The parametric geometry of ``[geometry]``."""
-        g = self.config["geometry"]
-        cls = BladeGeometry if g["kind"] == "blade" else PlateGeometry
-        args = {k: (tuple(v) if isinstance(v, list) else v) for k, v in g.items() if k in GEOMETRY_FIELDS[g["kind"]]}
-        return cls(**args)
+        return geometry_of(self.config["geometry"])
 
     def mesh_path(self) -> Path:
         """The mesh file of ``[mesh]``, resolved against :attr:`base` (``ValueError`` for a parametric study, whose
@@ -358,128 +338,6 @@ class Study:
         if not isinstance(self.name, str) or _study_name(self.name):  # a Study made without validate()
             raise StudyError(f"[study] name: {_study_name('')}, got {show(self.name)}")
         return Path("results") / self.name
-
-
-def _type_name(types: tuple) -> str:
-    names = {str: "a string", int: "an integer", float: "a number", bool: "true/false", list: "a list",
-             dict: "a table"}
-    if types == _NUM:
-        return "a number"
-    return " or ".join(names[t] for t in types)
-
-
-def _integer_hint(value) -> str:
-    """What to write instead of the float ``value`` where an integer is expected (TOML reads ``1e9`` and ``2.0`` as
-    floats), for the message: ``" (TOML reads … as a float: write 1000000000)"``, or ``""``."""
-    if not (isinstance(value, float) and math.isfinite(value) and value.is_integer()):
-        return ""
-    write = f": write {int(value)}" if abs(value) < 2**63 else ""
-    return f" (TOML reads a number with an exponent or a decimal point as a float{write})"
-
-
-def _shown_number(value) -> str:
-    """A float for a message: ``1e+09`` rather than ``1000000000.0``, ``2.0`` as it is."""
-    text = f"{value:g}" if isinstance(value, float) else ""
-    return text if "e" in text else show(value)
-
-
-def _quoted(value) -> str:
-    """``repr(value)``, cut for a message (a huge list or string is not copied into it)."""
-    text = show(value)
-    return text.removeprefix("the string ").removeprefix("a list ").removeprefix("a table ").removeprefix(
-        "the boolean ")
-
-
-def _check_value(section: str, key: str, spec: Key, value) -> Any:
-    where = f"[{section}] {key}"
-    ok = any(isinstance(value, t) and not (t in (int, float) and isinstance(value, bool)) for t in spec.types)
-    if not ok:
-        hint = _integer_hint(value) if spec.types == _INT else ""
-        raise StudyError(f"{where}: expected {_type_name(spec.types)}, got "
-                         f"{_shown_number(value) if hint else show(value)}{hint}")
-    if isinstance(value, float) and not math.isfinite(value):
-        raise StudyError(f"{where}: must be finite, got {value!r}")
-    if spec.check is not None:
-        try:
-            message = spec.check(value)
-        except (TypeError, ValueError, OverflowError, RecursionError):  # an odd item inside a list or table
-            message = "has an item of the wrong type or size"
-        if message:  # a message that names the offending item already says what it got
-            raise StudyError(f"{where}: {message}" + ("" if "got " in message else f", got {_quoted(value)}"))
-    return value
-
-
-def _field_kind(cls, name: str) -> str | None:
-    """What a geometry dataclass field takes, from its annotation: ``"number"``, ``"integer"``, ``"string"`` or
-    ``"numbers"`` (a point); ``None``: left to the dataclass."""
-    annotation = str(next(f.type for f in dataclasses.fields(cls) if f.name == name))
-    base = annotation.replace(" ", "").split("|")
-    if any(b.startswith(("tuple", "list", "Sequence")) for b in base):
-        return "numbers"
-    for kind, word in (("integer", "int"), ("number", "float"), ("string", "str")):
-        if word in base:
-            return kind
-    return None
-
-
-def _check_field(kind: str, cls, key: str, value) -> None:
-    """The type of a ``[geometry]`` field of the dataclass ``cls``, before the dataclass sees it (it would turn
-    the string ``"0.1"`` into a number)."""
-    where = f"[geometry] {key}"
-    want = _field_kind(cls, key)
-    number = isinstance(value, (int, float)) and not isinstance(value, bool)
-    if want == "integer" and not (number and isinstance(value, int)):
-        hint = _integer_hint(value)
-        raise StudyError(f"{where}: expected an integer, got {_shown_number(value) if hint else show(value)}{hint}")
-    if want == "number" and not number:
-        raise StudyError(f"{where}: expected a number, got {show(value)}")
-    if want == "string" and not isinstance(value, str):
-        raise StudyError(f"{where}: expected a string, got {show(value)}")
-    if want == "numbers" and not (isinstance(value, list) and all(
-            isinstance(x, (int, float)) and not isinstance(x, bool) for x in value)):
-        raise StudyError(f"{where}: expected a list of numbers, got {show(value)}")
-    items = value if isinstance(value, list) else [value]
-    if any(isinstance(x, float) and not math.isfinite(x) for x in items):
-        raise StudyError(f"{where}: must be finite, got {_quoted(value)}")
-
-
-def _geometry_section(raw: dict) -> dict:
-    kind = raw.get("kind", "blade")
-    _check_value("geometry", "kind", SCHEMA["geometry"]["kind"], kind)
-    out = {}
-    allowed = set(SCHEMA["geometry"]) | set(GEOMETRY_FIELDS[kind])
-    for key, value in raw.items():
-        if key not in allowed:
-            raise StudyError(
-                f"[geometry] {key}: unknown key for kind = {kind!r} (valid: {', '.join(sorted(allowed))})")
-        if key in SCHEMA["geometry"]:
-            out[key] = _check_value("geometry", key, SCHEMA["geometry"][key], value)
-        else:
-            if isinstance(value, dict):
-                raise StudyError(f"[geometry] {key}: expected a number, string or list, got a table")
-            _check_field(kind, BladeGeometry if kind == "blade" else PlateGeometry, key, value)
-            out[key] = value
-    for key, spec in SCHEMA["geometry"].items():
-        out.setdefault(key, spec.default)
-    try:  # the dataclass validates the shape and names the offending field
-        Study({"geometry": out}).geometry()
-    except TypeError as exc:
-        missing = re.findall(r"'(\w+)'", str(exc))
-        raise StudyError(f"[geometry] {', '.join(missing) or '?'}: required for kind = {kind!r} ({exc})") from None
-    except ValueError as exc:
-        text = one_line(exc)
-        name = re.match(r"(\w+)\b", text)
-        if name and name.group(1) in allowed and not text.startswith(f"{name.group(1)}:"):
-            text = f"{name.group(1)}:{text[name.end():]}"  # "[geometry] span: must be ..."
-        raise StudyError(f"[geometry] {text}") from None
-    g = out
-    if g["tip_size"] is not None and g["size"] is not None and g["tip_size"] > g["size"]:
-        raise StudyError(f"[geometry] tip_size: must not exceed size = {g['size']!r} (it refines the tip), got "
-                         f"{g['tip_size']!r}")
-    if g["cells"] == "hexahedron" and g["mesh_order"] != 1:
-        raise StudyError(f"[geometry] mesh_order: cells = 'hexahedron' makes order-1 cells: mesh_order = 1, got "
-                         f"{g['mesh_order']!r} ([fem] order chooses the element order)")
-    return out
 
 
 def validate(raw: dict, source: str = "<string>", base: str | os.PathLike | None = None,
@@ -518,7 +376,7 @@ def validate(raw: dict, source: str = "<string>", base: str | os.PathLike | None
         if not isinstance(given, dict):
             raise StudyError(f"[{section}]: must be a table ([{section}] with keys), got {type(given).__name__}")
         if section == "geometry":
-            config[section] = _geometry_section(given)
+            config[section] = geometry_section(given)
             continue
         out = {}
         for key, value in given.items():
@@ -592,34 +450,6 @@ def _grid_main_model(r: dict, given: dict) -> None:
         r["size"] = max(r["sizes"])
 
 
-#: Largest study content (characters besides comment lines and blank lines): a study is a few kilobytes; more is
-#: not a study (a mesh, a log).
-MAX_STUDY_BYTES = 1_000_000
-
-#: Largest study file read (bytes): its comments do not count against :data:`MAX_STUDY_BYTES`, so a commented
-#: study may be far bigger; a file above this is refused before it is read.
-MAX_STUDY_FILE_BYTES = 64_000_000
-
-#: A line that is neither a comment nor blank (the lines that count against :data:`MAX_STUDY_BYTES`).
-_CONTENT_LINE = re.compile(r"^[ \t\r]*[^#\s][^\n]*\n?", re.M)
-
-
-def content_size(text: str, stop: int | None = None) -> int:
-    """The characters of the study ``text`` outside its comment lines and blank lines (a comment after a value
-    counts: only whole lines are left out); the count stops once it exceeds ``stop`` (a file of content is not
-    scanned to its end to be refused).
-
-    >>> content_size("# a study\\n[study]\\n\\n  # its name\\nname = 'x'  # here\\n")
-    27
-    """
-    size = 0
-    for line in _CONTENT_LINE.finditer(text):
-        size += line.end() - line.start()
-        if stop is not None and size > stop:
-            break
-    return size
-
-
 def loads(text: str, source: str = "<string>", base: str | os.PathLike | None = None, model: bool = True,
           contact: bool = True) -> Study:
     """Parse and validate a study from TOML text (``model``: see :func:`validate`).
@@ -683,42 +513,4 @@ def load_study(path: str | os.PathLike, model: bool = True, contact: bool = True
     >>> folder.cleanup()
     """
     path = Path(path)
-    data = _read_study_bytes(path)
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        line = data[:exc.start].count(b"\n") + 1
-        raise StudyError(f"cannot read study file {str(path)!r}: not UTF-8 text (byte {exc.start}, line {line}); "
-                         "save it as UTF-8") from None
-    return loads(text.removeprefix("\ufeff"), source=str(path), base=path.resolve().parent, model=model,
-                 contact=contact)
-
-
-def _read_study_bytes(path: Path) -> bytes:
-    """The bytes of a regular file of at most :data:`MAX_STUDY_FILE_BYTES`; a pipe, a device or a folder is refused
-    before it is read (reading a FIFO would wait for a writer forever).  Its content besides comments is checked
-    by :func:`loads`."""
-    where = f"cannot read study file {str(path)!r}"
-    try:
-        info = path.stat()
-    except (OSError, ValueError) as exc:
-        raise StudyError(f"{where}: {getattr(exc, 'strerror', None) or exc}") from None
-    if not stat.S_ISREG(info.st_mode):
-        kind = ("a folder" if stat.S_ISDIR(info.st_mode) else "a named pipe (FIFO)" if stat.S_ISFIFO(info.st_mode)
-                else "a device" if stat.S_ISCHR(info.st_mode) or stat.S_ISBLK(info.st_mode)
-                else "a socket" if stat.S_ISSOCK(info.st_mode) else "a special file")
-        raise StudyError(f"{where}: it is {kind}, not a regular file")
-    if info.st_size > MAX_STUDY_FILE_BYTES:
-        raise StudyError(f"{where}: {info.st_size} bytes, more than a study file's {MAX_STUDY_FILE_BYTES} (is it a "
-                         "study file?)")
-    try:  # O_NONBLOCK: should the path have become a FIFO since the stat, opening it does not wait
-        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
-    except OSError as exc:
-        raise StudyError(f"{where}: {exc.strerror or exc}") from None
-    with os.fdopen(fd, "rb") as f:
-        if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
-            raise StudyError(f"{where}: not a regular file")
-        data = f.read(MAX_STUDY_FILE_BYTES + 1)
-    if len(data) > MAX_STUDY_FILE_BYTES:
-        raise StudyError(f"{where}: more than a study file's {MAX_STUDY_FILE_BYTES} bytes (is it a study file?)")
-    return data
+    return loads(read_study_text(path), source=str(path), base=path.resolve().parent, model=model, contact=contact)
