@@ -193,6 +193,10 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         model = build_model(study, mesh)
         factor = stiffness_factor(model)
         contact = build_contact(study, model)
+        if (study.config.get("rub") or {}).get("speeds"):  # the rub's contact selection, before minutes of work
+            from .rub import check_rub_contact
+
+            check_rub_contact(study, model, contact)
         rest_model, cold_contact = model, contact
         model, contact, factor, rotation = operating_point(study, model, contact, factor)
         if rotation is not None:
