@@ -28,6 +28,7 @@ prestressed modal analysis.
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -37,7 +38,7 @@ from ..checks import finite
 from ..linalg import SPDFactor, spd_factor, symmetric_factor
 from .model import FEModel
 
-__all__ = ["RotationAxis", "SpinState", "coriolis_matrix", "second_order_state", "spin", "to_rad_s"]
+__all__ = ["RotationAxis", "SpinState", "coriolis_matrix", "second_order_state", "spin", "spun_state", "to_rad_s"]
 
 #: The static centrifugal states :func:`spin` solves for (see its ``static``).
 STATIC_STATES = ("linear", "second-order", "nonlinear", "auto")
@@ -358,8 +359,31 @@ def spin(model: FEModel, speed: float, axis: RotationAxis | None = None, *, soft
         raise ValueError(f"at {omega:.6g} rad/s ({rpm:.6g} rpm) the blade is unstable: its stiffness about the "
                          "centrifugal state, K + K_σ − Ω² M⊥, is not positive definite (spin softening beats the "
                          "stiffening); check the speed, the rotation axis and the mesh's length unit") from None
-    return SpinState(omega, axis, replace(model, K=K), u0, softening, stiffening, tangent, used, iterations, change,
-                     steps)
+    out = SpinState(omega, axis, replace(model, K=K), u0, softening, stiffening, tangent, used, iterations, change,
+                    steps)
+    _SPUN[out.model] = (omega, axis, u0, used)
+    return out
+
+
+#: The state each model :func:`spin` returned was linearised about, weakly keyed by that model: :func:`spun_state`.
+_SPUN: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def spun_state(model: FEModel) -> tuple[float, RotationAxis, np.ndarray, str] | None:
+    """``(speed, axis, displacement, static)`` of the centrifugal state a model :func:`spin` returned is linearised
+    about (``displacement`` on its free dofs, ``static`` the state solved: ``"linear"``, ``"second-order"`` or
+    ``"nonlinear"``); ``None`` for a model at rest or not from :func:`spin` in this process (what the results
+    draw the prestress of a study at speed from, without solving it again).
+
+    >>> from bladecase.fe import Mesh, assemble
+    >>> from skfem import MeshTet
+    >>> m = MeshTet.init_tensor(np.linspace(0, 0.1, 4), *2 * [np.linspace(0, 0.01, 2)])
+    >>> rest = assemble(Mesh(m.p.T, {"tetra": m.t.T}, dim=3, groups={"root": np.flatnonzero(m.p[0] == 0)}), "steel")
+    >>> state = spin(rest, 1000.0, RotationAxis((0, 0, 0), (0, 0, 1)))
+    >>> spun_state(rest) is None, spun_state(state.model)[3], spun_state(state.model)[2] is state.displacement
+    (True, 'linear', True)
+    """
+    return _SPUN.get(model)
 
 
 def _linear_state(model: FEModel, ops: _Operators, w2: float, softening: bool, factor, omega: float) -> np.ndarray:

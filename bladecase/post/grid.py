@@ -348,6 +348,43 @@ def nodal_field(model: FEModel, x_free) -> np.ndarray:
     return out if x.ndim == 2 else out[:, :, 0]
 
 
+def node_values(model: FEModel, values, points) -> np.ndarray:
+    """Values at the model's scalar FE nodes (``(N, ...)``, e.g. :func:`bladecase.fe.stress.nodal_stress`, clamped
+    nodes included) at every point of :func:`fe_grid`: a grid point that is an FE node takes its value (found by
+    position: ``points`` ``(N, 3)``, :func:`bladecase.fe.stress.fe_node_points`); the other nodes of a mesh of
+    quadratic cells drawn at order 1 take the mean of their cell's parent corners (as :func:`nodal_field` does).
+
+    >>> from bladecase.fe import Mesh, assemble
+    >>> square = Mesh(points=np.array([[0., 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]),
+    ...               cells={"triangle": np.array([[0, 1, 2], [0, 2, 3]])}, dim=2, groups={"root": np.array([0, 1])})
+    >>> model = assemble(square, "steel", order=2, clamp="root", thickness=0.01)
+    >>> grid = fe_grid(model)
+    >>> node_values(model, grid.points[::-1, 0], grid.points[::-1]).tolist() == grid.points[:, 0].tolist()
+    True
+    """
+    from scipy.spatial import cKDTree
+
+    grid = fe_grid(model)
+    v = np.asarray(values)
+    P = np.asarray(points, dtype=float)
+    if P.shape != (v.shape[0], 3):
+        raise ValueError(f"points must be ({v.shape[0]}, 3): one per value, got {P.shape}")
+    scale = max(float(np.abs(grid.points).max()), 1e-300)
+    dist, near = cKDTree(P).query(grid.points)
+    found = dist <= COORDS_RTOL * scale * 1e3
+    out = np.zeros((len(grid.points),) + v.shape[1:], dtype=float)
+    out[found] = v[near[found]]
+    if not found.all():  # the other nodes of quadratic cells at order 1: the mean of their corners
+        kind = KINDS[model.mesh.body_type]
+        cells = grid.cells[grid.body_type]
+        for j in range(kind.corners, kind.n_nodes):
+            parents = cells[:, list(kind.parents[j])]
+            out[cells[:, j]] = out[parents].mean(axis=1)
+        if not found[cells[:, : kind.corners]].all():
+            raise ValueError("a corner of the grid is no FE node of the model: the points are not the model's")
+    return out
+
+
 def grid_index(model: FEModel, nodes):
     """Grid points of :func:`fe_grid` at mesh nodes (e.g. ``reduced.contact.node``).
 

@@ -42,6 +42,8 @@ def interaction_plot(section: dict, title: str | None = None) -> Figure:
     campbell = bool(section.get("open_hz"))
     series = [("tip_normal_displacement_mm", "peak tip normal displacement (mm)"),
               ("total_force_n", "peak total contact force (N)"), ("max_pressure_mpa", "peak contact pressure (MPa)")]
+    if all(r.get("max_pressure_mpa") is None for r in rows):  # a line of contact nodes: no area, no pressure
+        series = series[:2]
     fig = new_figure(figsize=(7.0, 9.6 if campbell else 7.4), layout="constrained")
     axes = fig.subplots(len(series) + int(campbell), 1, sharex=True)
     lobes = section["lobes"]

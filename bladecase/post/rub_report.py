@@ -38,16 +38,36 @@ from .nodal_report import load_words
 __all__ = ["rub_report"]
 
 
-def _where(along: list[float] | None) -> str:
-    """Where the touching nodes sit along the chord (0 leading edge – 1 trailing edge), in words."""
+def _where(along: list[float] | None, line: bool = False) -> str:
+    """Where the touching nodes sit along the chord (0 leading edge – 1 trailing edge), in words; along a ``line``
+    of nodes (no area: no thick end to tell the leading edge) from the line's first end."""
     if not along:
         return ""
+    if line:
+        return f" — at {min(along):.2f}–{max(along):.2f} of the line from its first end"
     lo, hi = min(along), max(along)
     if hi - lo < 0.15:
         end = "the leading edge" if hi <= 0.2 else "the trailing edge" if lo >= 0.8 else "mid-chord"
         return f" — all near {end} ({lo:.2f}–{hi:.2f} of the chord from it)" if end != "mid-chord" else \
             f" — all near mid-chord ({lo:.2f}–{hi:.2f} of the chord from the leading edge)"
     return f" — spread over {lo:.2f}–{hi:.2f} of the chord from the leading edge"
+
+
+def _line_words(row: dict, section: dict) -> str:
+    """The casing's load in words for a line of contact nodes (no area, so no pressure): the total force and where
+    it sits along the line, from its first end (the end of lowest coordinate along it: a line has no thick end to
+    tell the leading edge).
+
+    >>> _line_words({"total_force_n": 12.0, "load_centre": 0.9, "load_location": "trailing edge"},
+    ...             {"model": {"line_length_mm": 36.05}})
+    'the total contact force peaks at 12 N on the line of contact nodes (36 mm long; a line has no area, so no \
+contact pressure), centred at 0.90 of the line from its first end'
+    """
+    length = (section.get("model") or {}).get("line_length_mm")
+    span = f" ({length:.3g} mm long; a line has no area, so no contact pressure)" if length else ""
+    at = "" if row.get("load_centre") is None else f", centred at {row['load_centre']:.2f} of the line from its " \
+                                                   "first end"
+    return f"the total contact force peaks at {row['total_force_n']:.3g} N on the line of contact nodes{span}{at}"
 
 
 def rub_report(section: dict | None) -> list[str]:
@@ -70,13 +90,15 @@ def rub_report(section: dict | None) -> list[str]:
     touching = w["touching_nodes"]
     if w["total_force_n"] > 0:
         face = (section.get("model") or {}).get("face_area_mm2")
+        line = (section.get("model") or {}).get("contact_measure") == "length"
+        load = _line_words(w, section) if line else load_words(w, face)
         ratio = (f" ({w['speed_ratio']:.3g} × the crossing speed of mode 1)" if w.get("speed_ratio") is not None
                  else "")
         lines.append(f"- The hardest rub is at {w['speed']:.6g} {unit}{ratio}: the tip reaches "
                      f"{w['tip_normal_displacement_mm']:.4g} "
                      f"mm outwards, {w['nodes_touching']} nodes touch (nodes {', '.join(map(str, touching[:12]))}"
-                     f"{', …' if len(touching) > 12 else ''}){_where(w.get('touching_along_tip'))}; "
-                     f"{load_words(w, face)}; a node is in contact for up to {w['contact_fraction']:.0%} of a "
+                     f"{', …' if len(touching) > 12 else ''}){_where(w.get('touching_along_tip'), line)}; "
+                     f"{load}; a node is in contact for up to {w['contact_fraction']:.0%} of a "
                      "revolution"
                      + (f" and the casing yields up to {w['penetration_mm']:.4g} mm under it."
                         if w["penetration_mm"] > 0 else "."))

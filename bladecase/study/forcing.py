@@ -513,6 +513,7 @@ def forced_scene(study, reduced: ReducedModel, orbit: ForcedOrbit, stem: str):
     from ..post import animation
     from ..post.grid import fe_grid, grid_index, nodal_field
     from ..post.outputs import OrbitScene
+    from ..post.prestress import centrifugal_fields
     from .choose import frame_times
 
     o = study["output"]
@@ -531,7 +532,8 @@ def forced_scene(study, reduced: ReducedModel, orbit: ForcedOrbit, stem: str):
     title = (f"{study.name}: forced steady state {orbit.label} at {1 / orbit.forcing_period:.5g} Hz")
     return OrbitScene(stem=stem, title=title, mesh=mesh, orbit=orbit, times=times, u=u, v=vel, impact=impact,
                       contact_node=int(grid_index(model, reduced.contact.node)),
-                      normal=reduced.contact.normal_for(model), scale=scale, options=o, branch=None)
+                      normal=reduced.contact.normal_for(model), scale=scale, options=o, branch=None,
+                      point_data=centrifugal_fields(model))
 
 
 def _massless_contact_dofs(study, reduced: ReducedModel, orbit: ForcedOrbit, times, x, v, x_free, v_free):

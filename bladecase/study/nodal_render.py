@@ -29,6 +29,7 @@ import numpy as np
 from .. import log
 from ..post.grid import fe_grid, grid_index, nodal_field
 from ..post.outputs import FORMATS, OrbitScene
+from ..post.prestress import centrifugal_fields
 from .reference import nodal_drift, open_start, phase_changes
 
 __all__ = ["animate_nodal", "nodal_frames", "return_error"]
@@ -107,7 +108,7 @@ def _scene(study, nodal, orbit, stem: str) -> tuple[OrbitScene, dict]:
                        f"({len(nodes)} nodes)", mesh=mesh, orbit=orbit, times=times, u=u, v=vel, impact=touching,
                        contact_node=int(points[worst]), normal=nodal.contact.normal_for(model),
                        scale=scale, options=o, branch=None, face_points=points, face_beyond=un > d[:, None],
-                       point_data={"contact_node": mask},
+                       point_data={"contact_node": mask, **(centrifugal_fields(model) or {})},
                        frame_data={"normal_gap": on_face(d[:, None] - un, np.nan),
                                    "contact_pressure": on_face(pressure, 0.0), "casing_yield": on_face(yield_, 0.0)},
                        casing_gap=float(d[worst]))

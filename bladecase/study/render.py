@@ -16,6 +16,7 @@ from ..nsm.verify import verify
 from ..post.grid import fe_grid, grid_index, nodal_field
 from ..post.outputs import FORMATS, OrbitScene
 from ..post.plots import is_massless
+from ..post.prestress import centrifugal_fields
 from ..post.report import engineering_words, orbit_words
 from ..post.tip_excursion import tip_excursion
 from ..post.tip_excursion import words as tip_words
@@ -30,7 +31,8 @@ from .stages import period_unit
 
 
 def orbit_scene(study: Study, reduced: ReducedModel, families: list[Branch], choice: Choice) -> OrbitScene:
-    """The chosen orbit at ``[output] frames`` instants, on every node of the FE model (quadratic cells whole)."""
+    """The chosen orbit at ``[output] frames`` instants, on every node of the FE model (quadratic cells whole); at
+    speed, the centrifugal state as constant point data (:func:`~bladecase.post.prestress.centrifugal_fields`)."""
     from ..post import animation
 
     o = study["output"]
@@ -56,7 +58,8 @@ def orbit_scene(study: Study, reduced: ReducedModel, families: list[Branch], cho
                       mesh=mesh, orbit=orbit, times=times, u=u, v=v, impact=impact,
                       contact_node=int(grid_index(model, reduced.contact.node)),
                       normal=reduced.contact.normal_for(model), scale=scale, options=o,
-                      branch=families[choice.family], face_points=face_points, face_beyond=face_beyond)
+                      branch=families[choice.family], face_points=face_points, face_beyond=face_beyond,
+                      point_data=centrifugal_fields(model))
 
 
 def render(study: Study, reduced: ReducedModel, families: list[Branch], choice: Choice, folder: Path,

@@ -35,11 +35,12 @@ from ..fe.rotation import SPEED_UNITS, RotationAxis, spin, to_rad_s
 from ..io import csv_cell, save_figure, write_text
 from ..nsm.damping import Damping
 from ..nsm.massless.rub import RUN_ON_FACTOR, rub_response
-from ..reduction.contact import Contact, tributary_areas
+from ..reduction.contact import Contact
 from ..reduction.nodes import chord_positions, contact_pressure, nodal_model
 from .keys import StudyError
+from .rub_contact import check_rub_contact, contact_measure
 
-__all__ = ["crossing_speed", "node_angles", "rub_stage"]
+__all__ = ["check_rub_contact", "contact_measure", "crossing_speed", "node_angles", "rub_stage"]
 
 #: Columns of ``rub.csv``: name (its unit is the suffix) → what it holds.
 COLUMNS = {
@@ -47,12 +48,14 @@ COLUMNS = {
     "speed_rad_s": "the speed (rad/s)",
     "speed_ratio": "the speed over the crossing speed of mode 1 with the lobes' excitation (empty: no crossing)",
     "tip_normal_displacement_mm": "the largest peak outward normal displacement over the contact nodes (mm)",
-    "max_pressure_mpa": "the largest contact pressure over the nodes and the window (MPa): force over tributary area",
+    "max_pressure_mpa": "the largest contact pressure over the nodes and the window (MPa): force over tributary area "
+                        "(empty for a line of nodes: no area)",
     "total_force_n": "the peak over the window of the total contact force, the sum over the nodes (N)",
     "loaded_area_mm2": "the area of the nodes in contact at the instant of that peak (mm²)",
     "peak_loaded_area_mm2": "the largest area in contact over the window (mm²)",
-    "load_centre": "the force-weighted centroid at that peak along the chord: 0 leading edge, 1 trailing edge",
-    "load_location": "that centroid's third of the chord: leading edge, mid-chord or trailing edge",
+    "load_centre": "the force-weighted centroid at that peak along the chord: 0 leading edge, 1 trailing edge (a "
+                   "line of nodes: from its end of lowest coordinate)",
+    "load_location": "that centroid's third of the chord: leading edge, mid-chord or trailing edge (empty for a line)",
     "max_node_force_n": "the largest peak force on one node (N; a mesh quantity: it falls like the node's area)",
     "contact_fraction": "the largest fraction of a revolution a node spends in contact",
     "penetration_mm": "the casing's largest yield under a node (mm; 0 for a rigid casing)",
@@ -93,23 +96,21 @@ def _axis(study) -> RotationAxis:
     return RotationAxis(k["origin"], k["direction"])
 
 
-def _node_stiffness(study, model, contact: Contact) -> np.ndarray:
-    """The casing's stiffness at each node (N/m): per area × tributary area, or the total shared by area."""
+def _node_stiffness(study, model, contact: Contact, shares: np.ndarray | None = None) -> np.ndarray:
+    """The casing's stiffness at each node (N/m): per area × tributary area, or the total shared by each node's
+    ``shares`` (of the face's area, or of a line's length: :func:`check_rub_contact`, which gives them when
+    ``None``)."""
+    if shares is None:
+        shares = check_rub_contact(study, model, contact)[1]
     c = study["contact"]
-    m = len(contact.nodes)
     if c.get("casing_stiffness_per_area") is not None:
-        return c["casing_stiffness_per_area"] * tributary_areas(model, contact.nodes)
+        return c["casing_stiffness_per_area"] * shares
     from .stages import casing_stiffness
 
     total = casing_stiffness(study)
     if total is None:
-        return np.full(m, np.inf)
-    area = tributary_areas(model, contact.nodes)
-    if np.any(area <= 0):
-        bad = [model.mesh.node_id(k) for k, a in zip(contact.nodes, area) if a <= 0]
-        raise StudyError(f"[contact] casing_stiffness: the contact nodes {bad} have no share of the face's area, so a "
-                         "stiffness shared by area cannot reach them")
-    return total * area / area.sum()
+        return np.full(shares.size, np.inf)
+    return total * shares / shares.sum()
 
 
 def _damping(r: dict) -> Damping:
@@ -230,6 +231,7 @@ def rub_stage(study, model, contact: Contact, *, families=None, executor=None, p
     """The rub response over ``[rub] speeds`` (module docstring) of ``model`` at rest with its cold ``contact`` (a
     face on the [casing]); writes ``rub.csv``, ``rub_nodes.csv`` and ``rub.png`` into ``folder``; returns the
     summary section."""
+    kind, shares = check_rub_contact(study, model, contact)  # before any factorisation
     r, k = study["rub"], study["casing"]
     unit = r["speed_unit"]
     speeds = np.array([to_rad_s(v, unit) for v in r["speeds"]])
@@ -237,7 +239,12 @@ def rub_stage(study, model, contact: Contact, *, families=None, executor=None, p
     static = (study.config.get("rotation") or {}).get("static", "auto")
     nodes = list(contact.nodes)
     angles = node_angles(model, nodes, axis)
-    casing = _node_stiffness(study, model, contact)
+    casing = _node_stiffness(study, model, contact, shares)
+    if kind == "length":
+        log.info("rub: the %d contact nodes are a line (they hold no facet of the body): each is weighted by its "
+                 "tributary length along it (%.4g to %.4g mm of %.4g mm); no contact pressure or loaded area (a "
+                 "line has no area): the forces are read", len(nodes), shares.min() * 1e3, shares.max() * 1e3,
+                 shares.sum() * 1e3)
     middle = float(np.sqrt(speeds.min() * speeds.max()))
     try:
         base = spin(model, middle, axis, static=static)
@@ -259,7 +266,7 @@ def rub_stage(study, model, contact: Contact, *, families=None, executor=None, p
                               progress=progress)
     except ValueError as exc:
         raise StudyError(f"[rub] speeds: {exc}") from None
-    section = _summary(study, speeds, points, families, contact, model, casing)
+    section = _summary(study, speeds, points, families, contact, model, casing, (kind, shares))
     points = [p for p in points if "error" not in p]  # aligned with the rows
     if folder is not None:
         section["files"] = _write(Path(folder), section, points, figures, title)
@@ -286,8 +293,9 @@ def _write_vtu(path: Path, model, contact: Contact, section: dict, points: list[
     idx = np.asarray(contact.nodes)
     worst = points[int(np.argmax([r["tip_normal_displacement_mm"] for r in section["rows"]]))]
     data = {}
-    for key, scale, unit in (("peak_displacement", 1e3, "mm"), ("peak_force", 1.0, "n"),
-                             ("contact_fraction", 1.0, ""), ("penetration", 1e3, "mm"), ("peak_pressure", 1.0, "")):
+    keys = (("peak_displacement", 1e3, "mm"), ("peak_force", 1.0, "n"), ("contact_fraction", 1.0, ""),
+            ("penetration", 1e3, "mm"), ("peak_pressure", 1.0, ""))
+    for key, scale, unit in keys[:-1] if _line(section) else keys:  # a line of nodes has no area: no pressure
         name = f"{key}_{unit}" if unit else key
         at, top = np.zeros(n), np.zeros(n)
         at[idx] = np.asarray(worst[key]) * scale
@@ -309,7 +317,7 @@ def _write_vtu(path: Path, model, contact: Contact, section: dict, points: list[
 
 
 def _summary(study, speeds: np.ndarray, points: list[dict], families, contact: Contact, model,
-             casing: np.ndarray) -> dict:
+             casing: np.ndarray, measure: tuple[str, np.ndarray]) -> dict:
     r, k = study["rub"], study["casing"]
     unit = r["speed_unit"]
     scale = SPEED_UNITS[unit.lower()]
@@ -324,7 +332,7 @@ def _summary(study, speeds: np.ndarray, points: list[dict], families, contact: C
         if "error" in p:
             failed.append({"speed": float(given), "reason": p["error"]})
             continue
-        row = _row(float(given), float(w), p, crossing, k["lobes"])
+        row = _row(float(given), float(w), p, crossing, k["lobes"], line=measure[0] == "length")
         rows.append(row)
         if row["response"] != "settled" or row["revolutions_run"] > r["revolutions"]:
             characterised.append({"speed": row["speed"], "response": p["response"], "settled": bool(p["settled"]),
@@ -337,7 +345,7 @@ def _summary(study, speeds: np.ndarray, points: list[dict], families, contact: C
     worst = int(np.argmax([row["tip_normal_displacement_mm"] for row in rows]))
     p = good[worst]
     touching = [i for i, f in enumerate(p["contact_fraction"]) if f > 0]
-    where = _along_tip(model, contact, touching)
+    where = _along_tip(model, contact, touching, measure[1] if measure[0] == "area" else None)
     resonances = _resonances(speeds[ok], open_hz, k["lobes"]) if ok.sum() > 1 else []
     for res in resonances:
         res["speed"] = res["speed_rad_s"] / scale
@@ -358,16 +366,20 @@ def _summary(study, speeds: np.ndarray, points: list[dict], families, contact: C
         "nonsmooth_bands_hz": _bands(families),
         "bands_at": _bands_at(study),
         "model": {"size": r["size"], "contact_nodes": len(contact.nodes),
-                  "face_area_mm2": float(tributary_areas(model, contact.nodes).sum()) * 1e6,
+                  "face_area_mm2": float(measure[1].sum()) * 1e6 if measure[0] == "area" else None,
+                  "contact_measure": measure[0],
+                  "line_length_mm": float(measure[1].sum()) * 1e3 if measure[0] == "length" else None,
                   "casing_n_per_m": None if np.isinf(casing).all() else float(casing.sum())},
     }
 
 
-def _row(speed: float, w: float, p: dict, crossing: dict | None, lobes: int) -> dict:
-    """One speed's row of ``rub.csv`` (:data:`COLUMNS`) from its point (:func:`_rub_point`)."""
+def _row(speed: float, w: float, p: dict, crossing: dict | None, lobes: int, line: bool = False) -> dict:
+    """One speed's row of ``rub.csv`` (:data:`COLUMNS`) from its point (:func:`_rub_point`); for a ``line`` of
+    nodes the pressure and the loaded areas are empty (a line has no area), and so is the load's third of the chord
+    (no thick end tells the leading edge: ``load_centre`` is then from the line's end of lowest coordinate)."""
     frac = np.array(p["contact_fraction"])
     load = p["load"]
-    return {"speed": speed, "speed_rad_s": w,
+    row = {"speed": speed, "speed_rad_s": w,
             "speed_ratio": None if crossing is None else w / crossing["speed_rad_s"],
             "tip_normal_displacement_mm": 1e3 * max(p["peak_displacement"]),
             "max_pressure_mpa": 1e-6 * max(p["peak_pressure"]), "total_force_n": float(p["total_force"]),
@@ -378,6 +390,14 @@ def _row(speed: float, w: float, p: dict, crossing: dict | None, lobes: int) -> 
             "switches": p["switches"], "settled": bool(p["settled"]), "response": p["response"],
             "period_revolutions": None if p["period"] is None else p["period"] / lobes,
             "revolutions_run": p["revolutions_run"]}
+    if line:
+        row.update(max_pressure_mpa=None, loaded_area_mm2=None, peak_loaded_area_mm2=None, load_location=None)
+    return row
+
+
+def _line(section: dict) -> bool:
+    """Whether the contact nodes of the section are a line (no area: no pressure)."""
+    return (section.get("model") or {}).get("contact_measure") == "length"
 
 
 def _bands_at(study) -> str:
@@ -389,13 +409,15 @@ def _bands_at(study) -> str:
     return f"at {speed:.6g} {r.get('speed_unit', 'rpm')}"
 
 
-def _along_tip(model, contact: Contact, touching: list[int]) -> list[float] | None:
+def _along_tip(model, contact: Contact, touching: list[int], areas: np.ndarray | None) -> list[float] | None:
     """Where the touching nodes sit along the tip's chord (0 leading edge – 1 trailing edge:
-    :func:`bladecase.reduction.nodes.chord_positions`)."""
+    :func:`bladecase.reduction.nodes.chord_positions`; a line of nodes, ``areas`` ``None``, has no thick end: its 0
+    is the end of lowest coordinate along it)."""
     if not touching:
         return None
     nodes = list(contact.nodes)
-    s = chord_positions(np.asarray(model.mesh.points, dtype=float)[nodes], tributary_areas(model, nodes))
+    s = chord_positions(np.asarray(model.mesh.points, dtype=float)[nodes],
+                        np.zeros(len(nodes)) if areas is None else areas)
     return [float(np.round(s[i], 3)) for i in touching]
 
 
@@ -407,10 +429,11 @@ def _write(folder: Path, section: dict, points: list[dict], figures: bool, title
     write_text(folder / "rub.csv", "\n".join(lines) + "\n")
     node_lines = ["speed,speed_rad_s,node,peak_displacement_mm,peak_force_n,contact_pressure_mpa,contact_fraction,"
                   "penetration_mm,clearance_mm"]
+    line = _line(section)
     for row, p in zip(rows, points):
         for j, n in enumerate(p["nodes"]):
             node_lines.append(f"{row['speed']:.9g},{row['speed_rad_s']:.9g},{n},{p['peak_displacement'][j] * 1e3:.9g},"
-                              f"{p['peak_force'][j]:.9g},{p['peak_pressure'][j] * 1e-6:.9g},"
+                              f"{p['peak_force'][j]:.9g},{csv_cell(None if line else p['peak_pressure'][j] * 1e-6)},"
                               f"{p['contact_fraction'][j]:.9g},{p['penetration'][j] * 1e3:.9g},"
                               f"{p['clearances_m'][j] * 1e3:.9g}")
     write_text(folder / "rub_nodes.csv", "\n".join(node_lines) + "\n")

@@ -24,6 +24,7 @@ from ..io import write_json, write_text
 from ..post.compare import ModelResult, fe_reference
 from ..post.modes_report import modes_verdict
 from ..post.outputs import FORMATS, PlotScene
+from ..post.prestress import add_to_mesh_file
 from ..post.report import report
 from ..post.verdict import verdict
 from ..progress import progress_counter
@@ -197,10 +198,15 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         model = build_model(study, mesh)
         factor = stiffness_factor(model)
         contact = build_contact(study, model)
+        if (study.config.get("rub") or {}).get("speeds"):  # the rub's contact selection, before minutes of work
+            from .rub import check_rub_contact
+
+            check_rub_contact(study, model, contact)
         rest_model, cold_contact = model, contact
         model, contact, factor, rotation = operating_point(study, model, contact, factor)
         if rotation is not None:
             rotation["axis"] = study["rotation"]["axis"]
+            add_to_mesh_file(staging / "mesh.vtu", mesh, model)  # the centrifugal state at the mesh's nodes
             cold_contact = dataclasses.replace(cold_contact, gap=rotation["clearance_cold_m"])
         count = min(study["fem"]["frequencies"], model.n_dofs - 1)
         fe = fe_reference(model, contact, min(max(count, FE_MODES), model.n_dofs - 1), factor=factor)
