@@ -39,8 +39,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..linalg import Factor, spd_factor, symmetric_factor
+from .centrifugal import RotationAxis, _operators, to_rad_s
 from .model import FEModel
-from .rotation import RotationAxis, _operators, to_rad_s
 
 __all__ = ["MIN_STEP", "NonlinearState", "StVenantKirchhoff", "nonlinear_state", "svk_forms"]
 
