@@ -10,32 +10,13 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 
+from .cli_backbone import cmd_backbone as _cmd_backbone
+from .cli_backbone import plot as _plot
 from .cli_input import _floats, _ipp, _periods, _positive_int
 from .cli_input import check_outputs as _check_outputs
 from .cli_input import load_system as _load_system
-
-
-def _out_dir(text: str) -> Path:
-    """``--out DIR``: a folder name (an empty one would mean the working folder)."""
-    if not text.strip():
-        raise argparse.ArgumentTypeError(f"expected a folder, got an empty name {text!r} (it would mean the working "
-                                         "folder; give e.g. results/NAME)")
-    return Path(text)
-
-
-def _not_onto_inputs(outputs: dict[str, Path | None], inputs: dict[str, Path | None]) -> None:
-    """Refuse (before any work) an output file that is one of the command's inputs, or two outputs in one file."""
-    seen: dict[str, str] = {}
-    for label, path in inputs.items():
-        if path is not None and os.path.lexists(path):
-            seen[os.path.realpath(path)] = f"its input {label} {str(path)!r}"
-    for label, path in outputs.items():
-        if path is None:
-            continue
-        real = os.path.realpath(path)
-        if real in seen:
-            raise ValueError(f"{label} {str(path)!r} is {seen[real]}: it would be overwritten; write to another file")
-        seen[real] = f"also given as {label}"
+from .cli_input import not_onto_inputs as _not_onto_inputs
+from .cli_input import out_dir as _out_dir
 
 
 class _Parser(argparse.ArgumentParser):
@@ -482,63 +463,6 @@ def _cmd_animate(args) -> int:
 
 class _NothingToAnimate(Exception):
     """``bladecase animate`` found no orbit to animate (exit 1; the output folder untouched)."""
-
-
-def _cmd_backbone(args) -> int:
-    from .io import save_figure, write_json, write_text, written_together
-    from .nsm import backbone
-
-    _check_outputs(args.table, args.json, args.plot)
-    _not_onto_inputs({"--table": args.table, "--json": args.json, "--plot": args.plot},
-                     {"--matrices": args.matrices})
-    system = _load_system(args)
-    progress = not args.no_progress and sys.stderr.isatty()
-    if args.ipp == 1:
-        result = backbone(system, args.periods, ipp=1, progress=progress)
-        curves = [result]
-        table = result.table()
-        summary = table.split("\n\n", 1)[-1]
-        data = result.to_dict()
-    else:
-        from .nsm import nonsmooth_mode
-
-        P = args.periods
-        if P.size < 2 or P[0] == P[-1]:
-            raise ValueError("--ipp K >= 2 needs a period range: START < STOP and COUNT >= 2")
-        curves = nonsmooth_mode(system, args.ipp, (P[0], P[-1]), scan=P.size, progress=progress)
-        if curves:
-            summary = "\n".join(f.table() for f in curves)
-            table = summary if args.quiet else "\n\n".join(f.table(points=True) for f in curves)
-        else:
-            summary = table = f"no {args.ipp}-ipp family found in T in [{P[0]:g}, {P[-1]:g}]"
-        data = {
-            "ipp": args.ipp,
-            "system": {"n": system.n, "gap": system.gap},
-            "T_range": [float(P[0]), float(P[-1])],
-            "families": [f.to_dict() for f in curves],
-        }
-    figure = _plot(curves) if args.plot else None  # before anything is written: nothing to plot is an error
-    with written_together(args.table, args.json, args.plot) as (table_out, json_out, plot_out):
-        if args.table:
-            write_text(table_out, table + "\n")
-        if args.json:
-            write_json(json_out, data)
-        if figure is not None:
-            save_figure(figure, plot_out, dpi=150)
-    print(summary if args.quiet else table)
-    for label, path in (("table", args.table), ("json", args.json), ("plot", args.plot)):
-        if path:
-            print(f"wrote {label}: {path}", file=sys.stderr)
-    return 0
-
-
-def _plot(curves):
-    """The frequency–energy plot (a Figure) of backbones/families; ``ValueError`` when there is none."""
-    from .post.plots import frequency_energy
-
-    if not curves:
-        raise ValueError("nothing to plot: no family found (--plot needs one; leave it out, or widen the periods)")
-    return frequency_energy(curves)
 
 
 class _Terminated(KeyboardInterrupt):

@@ -12,6 +12,8 @@ argparse.ArgumentTypeError: impacts per period must be an integer with 1 <= K <=
 from __future__ import annotations
 
 import argparse
+import os
+from pathlib import Path
 
 import numpy as np
 
@@ -111,3 +113,26 @@ def check_outputs(*paths) -> None:
     for path in paths:
         if path is not None:
             check_output_file(path)
+
+
+def out_dir(text: str) -> Path:
+    """``--out DIR``: a folder name (an empty one would mean the working folder)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(f"expected a folder, got an empty name {text!r} (it would mean the working "
+                                         "folder; give e.g. results/NAME)")
+    return Path(text)
+
+
+def not_onto_inputs(outputs: dict[str, Path | None], inputs: dict[str, Path | None]) -> None:
+    """Refuse (before any work) an output file that is one of the command's inputs, or two outputs in one file."""
+    seen: dict[str, str] = {}
+    for label, path in inputs.items():
+        if path is not None and os.path.lexists(path):
+            seen[os.path.realpath(path)] = f"its input {label} {str(path)!r}"
+    for label, path in outputs.items():
+        if path is None:
+            continue
+        real = os.path.realpath(path)
+        if real in seen:
+            raise ValueError(f"{label} {str(path)!r} is {seen[real]}: it would be overwritten; write to another file")
+        seen[real] = f"also given as {label}"

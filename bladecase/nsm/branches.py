@@ -241,7 +241,7 @@ class Branch:
         """
         system = self._bound()
         if getattr(system, "contact_model", "newton") == "massless":
-            from .massless.branches import massless_orbit_at
+            from .massless.orbit_at import massless_orbit_at
 
             return massless_orbit_at(system, self.orbits, T)
         out = []
@@ -485,11 +485,3 @@ Family = Branch
 Backbone = Branch
 #: Former name of the admissible stretch of a 1-ipp scan: the same type as :class:`Arc`.
 Interval = Arc
-
-
-def __getattr__(name: str):
-    if name == "nonsmooth_mode":  # lives in .modes (imports this module)
-        from .modes import nonsmooth_mode
-
-        return nonsmooth_mode
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
