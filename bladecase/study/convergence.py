@@ -33,7 +33,7 @@ import numpy as np
 from .. import log
 from .schema import Study, StudyError
 
-__all__ = ["FIGURES", "FLAG", "convergence_stage", "mesh_figures", "richardson", "scaled_study"]
+__all__ = ["FIGURES", "FLAG", "convergence_stage", "mesh_figures", "mesh_row", "richardson", "scaled_study"]
 
 #: An error estimate (relative) above which a figure is flagged.
 FLAG = 0.02
@@ -169,6 +169,24 @@ def mesh_figures(model, reduced, families, f1_hz: float, ratio: float | None, ip
         out.update(energy_j=float(o.energy), tip_amplitude_mm=e["tip_amplitude_mm"],
                    contact_force_n=e.get("contact_force_n"), contact_fraction=e.get("contact_fraction"))
     return out
+
+
+def mesh_row(study: Study, factor: float, ratio: float | None, ipp: int) -> dict:
+    """The figures of ``study`` run by itself on its mesh × ``factor`` (:func:`scaled_study`; the study's own
+    search), read at ``T/T₁ = ratio`` on the ``ipp`` family: one row of the convergence table (``factor``, ``dofs``
+    and the keys of :data:`FIGURES` that this mesh has).
+
+    >>> from bladecase.study.schema import loads
+    >>> strip = loads('study = {name = "s"}\\ngeometry = {kind = "plate", span = 0.1, chord = 0.02, size = 0.01}\\n'
+    ...               'fem = {order = 1, thickness = 0.002}\\ncontact = {clearance = 1e-4, model = "massless", '
+    ...               'casing_stiffness = 1e6, face = "tip", normal = [1.0, 0.0]}\\n'
+    ...               'reduction = {method = "massless", size = 4}\\n'
+    ...               'search = {ipp = [1], periods = [0.95, 1.0], scan = 4}\\n')
+    >>> row = mesh_row(strip, 0.5, None, 1)
+    >>> row["factor"], row["dofs"] > 0, round(row["f1_hz"], -1) > 0
+    (0.5, True, True)
+    """
+    return _mesh_task(factor, study=study, ratio=ratio, ipp=ipp)
 
 
 def _mesh_task(factor: float, *, study: Study, ratio: float | None, ipp: int) -> dict:
