@@ -62,7 +62,16 @@ def node_amplitude(nodal, orbit, samples: int = AMPLITUDE_SAMPLES) -> float:
     """The largest normal displacement ``|u_j|`` of a contact node over one orbit of the every-node model ``nodal``
     (m): towards the casing its exact peak (the clearance plus the casing's yield, ``NodalOrbit.max_tip``), away from
     it ``u = Wᵀx − H_s λ`` sampled at ``samples`` instants of the period — the tip amplitude of the small-displacement
-    limit (:mod:`~bladecase.study.validity`)."""
+    limit (:mod:`~bladecase.study.validity`).
+
+    >>> import numpy as np
+    >>> from types import SimpleNamespace
+    >>> from bladecase.nsm.massless import NodalSystem, nodal_family
+    >>> s = NodalSystem(np.eye(1), 4.0 * np.eye(1), np.ones((1, 1)), np.zeros((1, 1)), gap=[1.0], casing=[1e6])
+    >>> o = nodal_family(s, 0, freq_ratio=1.01).orbits[0]      # grazing: the linear mode just touching, amplitude 1
+    >>> round(node_amplitude(SimpleNamespace(system=s), o), 9), round(o.max_tip, 9)
+    (1.0, 1.0)
+    """
     s = nodal.system
     t = np.linspace(0.0, orbit.T, samples, endpoint=False)
     x, _ = orbit.state(t)

@@ -105,7 +105,22 @@ def first_beyond(orbits: Sequence, amplitude: Callable, limit: float) -> tuple[i
 def cut_family(family, index: int, stop: str, end: dict):
     """``family`` (a :class:`~bladecase.nsm.massless.NodalFamily`) up to, not including, orbit ``index``: its tongues
     clipped there (a tongue left beyond it, or reaching past it, is ``left = "cut"``), its ``stop`` and ``end`` the
-    given ones."""
+    given ones.
+
+    >>> import numpy as np
+    >>> from bladecase.nsm.massless import NodalSystem, nodal_family
+    >>> K = np.array([[18.0, -8.0, 0.0, 0.0, 0.0], [-8.0, 34.0, -6.0, -20.0, 0.0], [0.0, -6.0, 21.0, 0.0, -15.0],
+    ...               [0.0, -20.0, 0.0, 25.0, -5.0], [0.0, 0.0, -15.0, -5.0, 20.0]])
+    >>> i, c = [0, 1, 2], [3, 4]
+    >>> Kcc, Kci = K[np.ix_(c, c)], K[np.ix_(c, i)]
+    >>> s = NodalSystem(np.diag([2.0, 1.5, 0.7]), K[np.ix_(i, i)] - Kci.T @ np.linalg.solve(Kcc, Kci),
+    ...                 -Kci.T @ np.linalg.inv(Kcc), np.linalg.inv(Kcc), gap=[0.2, 0.3])
+    >>> fam = nodal_family(s, mode=0, freq_ratio=1.15)
+    >>> k, _ = first_beyond(fam.orbits, lambda o: o.max_tip, 0.25)   # the first orbit reaching past 0.25
+    >>> cut = cut_family(fam, k, "cut at 0.25", {"kind": "amplitude_limit"})
+    >>> len(fam.orbits) > k == len(cut.orbits), max(o.max_tip for o in cut.orbits) <= 0.25, cut.stop
+    (True, True, 'cut at 0.25')
+    """
     tongues = []
     for t in family.tongues:
         if t["start"] >= index:
