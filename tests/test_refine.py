@@ -19,7 +19,7 @@ from bladecase.fe.cells import KINDS
 from bladecase.fe.refine import refine_mesh
 
 TYPES = ["tetra", "tetra10", "hexahedron", "hexahedron20", "hexahedron27", "wedge", "wedge15", "wedge18",
-         "triangle", "triangle6", "quad", "quad8"]
+         "triangle", "triangle6", "quad", "quad8", "quad9"]
 
 
 def box_mesh(btype: str) -> Mesh:
@@ -50,10 +50,9 @@ def test_a_straight_mesh_is_refilled_exactly(btype, n):
     axis = kind.dim - 1
     on_top = np.flatnonzero(np.abs(fine.points[:, axis] - mesh.points[:, axis].max()) < 1e-12)
     assert fine.groups["top"].tolist() == on_top.tolist()
-    # the original nodes keep coordinates and numbers (the corners always; midside nodes when n is even)
-    kept = np.unique(mesh.cells[btype][:, :kind.corners]) if n % 2 else np.arange(len(mesh.points))
-    assert np.array_equal(fine.points[:kept.size], mesh.points[kept]) and np.array_equal(fine.node_ids[:kept.size],
-                                                                                         kept)
+    # every original node keeps its coordinates and number, first (midside, face-centre, centre nodes included)
+    k = len(mesh.points)
+    assert np.array_equal(fine.points[:k], mesh.points) and np.array_equal(fine.node_ids[:k], mesh.node_ids)
 
 
 def chord_volume(mesh: Mesh) -> float:
@@ -105,3 +104,21 @@ def test_unsupported_splits_are_refused():
         with pytest.raises(ValueError, match=r"n \(parts per edge\) must be an integer from 1 to 6"):
             refine_mesh(mesh, bad)
     assert refine_mesh(mesh, 1) is mesh
+
+
+@pytest.mark.parametrize("btype", ["tetra10", "hexahedron20", "hexahedron27", "wedge15", "wedge18", "triangle6",
+                                   "quad8"])
+def test_every_cell_puts_a_shared_node_at_the_same_place(btype):
+    """A node made once for all the cells around an edge or face: each of those cells' own curved map puts it at
+    the same point (measured ≤ 8e-13 on distorted curved meshes, split in 3)."""
+    from bladecase.fe import refine as r
+
+    kind = KINDS[btype]
+    mesh = annulus(btype, 8, distort=0.2) if kind.dim == 3 else annulus(btype, 8, n_r=2, distort=0.2)
+    cells, n = np.asarray(mesh.cells[btype]), 3
+    U = np.unique(r._sub_cells(btype, n).reshape(-1, kind.dim).round(12), axis=0)
+    Wi = np.rint(r._basis(btype, 1, U) * (2 * n) ** kind.dim).astype(np.int64)
+    nodemap, new_points, _ = r._number_nodes(mesh, kind, cells, U, Wi)
+    points = np.concatenate([mesh.points, new_points])
+    own = np.einsum("qa,cai->cqi", r._basis(btype, kind.order, U), mesh.points[cells])
+    assert np.abs(points[nodemap] - own).max() < 1e-11

@@ -6,8 +6,8 @@ maps it with, :func:`bladecase.fe.isoparametric.element`): a curved second-order
 ``hexahedron20``, …) gives curved sub-cells on the same curved surface, not cells on straight chords; a straight
 cell gives straight sub-cells that fill it exactly. Hexahedra, quadrilaterals and the layers of a wedge are cut on
 their reference grid, simplices (and a wedge's triangle) by the Freudenthal–Kuhn subdivision of the reference
-simplex. The original nodes keep their coordinates and numbers (a second-order cell's midside node is the corner
-of sub-cells when ``n`` is even and is dropped when ``n`` is odd); the new nodes are numbered after the largest.
+simplex. The original nodes keep their coordinates and numbers, first (a second-order cell's midside, face-centre and
+centre nodes included: they are nodes of its sub-cells for every ``n``); the new nodes are numbered after them.
 
 A new node shared by cells — on an edge or face of the original mesh — is made once: it is identified by the
 original corners of the smallest edge or face it lies on and its weights on them (exact rationals), so neighbours
@@ -203,21 +203,18 @@ def _number_nodes(mesh: Mesh, kind, cells: np.ndarray, U: np.ndarray, Wi: np.nda
     nodemap[:, interior] = start + np.arange(C * len(interior)).reshape(C, len(interior))
     first = [np.repeat(np.arange(C), len(interior)), np.tile(interior, C)]
     start += C * len(interior)
-    # nodes on an original edge or face: keyed by its corners and their weights
-    if shared.size:
-        width = int(count[shared].max())
-        rows = np.full((C, shared.size, 2 * width), -1, dtype=np.int64)
-        for j, q in enumerate(shared):
-            corners = np.flatnonzero(nz[q])
-            ids = cells[:, corners]
-            order = np.argsort(ids, axis=1)
-            rows[:, j, :corners.size] = np.take_along_axis(ids, order, axis=1)
-            rows[:, j, width:width + corners.size] = Wi[q, corners][order]
-        flat = rows.reshape(-1, 2 * width)
-        _, index, inverse = np.unique(flat, axis=0, return_index=True, return_inverse=True)
-        nodemap[:, shared] = start + inverse.reshape(C, shared.size)
-        first = [np.concatenate([first[0], index // shared.size]),
-                 np.concatenate([first[1], shared[index % shared.size]])]
+    # nodes on an original edge or face: keyed by its corners (sorted) and their weights, one table per corner count
+    for k in np.unique(count[shared]):
+        qs = shared[count[shared] == k]
+        corners = np.array([np.flatnonzero(nz[q]) for q in qs])  # (nq, k)
+        ids = cells[:, corners].astype(np.int32)  # (C, nq, k)
+        order = np.argsort(ids, axis=2)
+        w = np.take_along_axis(np.broadcast_to(Wi[qs[:, None], corners].astype(np.int32), ids.shape), order, axis=2)
+        rows = np.concatenate([np.take_along_axis(ids, order, axis=2), w[..., :-1]], axis=2).reshape(C * qs.size, -1)
+        _, index, inverse = np.unique(rows, axis=0, return_index=True, return_inverse=True)
+        nodemap[:, qs] = start + inverse.reshape(C, qs.size)
+        first = [np.concatenate([first[0], index // qs.size]), np.concatenate([first[1], qs[index % qs.size]])]
+        start += index.size
     first_cell, first_point = first
     phi = _basis(kind.name, kind.order, U)  # (Q, A)
     x = np.asarray(mesh.points, dtype=float)[cells[first_cell]]  # (N, A, 3)
@@ -250,8 +247,8 @@ def _groups(mesh: Mesh, kind, cells: np.ndarray, Wi: np.ndarray, nodemap: np.nda
         whole_facet = boundary & np.stack([in_corner[:, list(f)].all(axis=1) for f in facets], axis=1)
         has_area = bool(whole_cell.any() or whole_facet.any())
         # each (cell, point): every corner of its entity in the group, and the entity on a group facet or cell
-        every = ~((~in_corner[:, None, :]) & nz[None]).any(axis=2)  # (C, Q)
-        on_facet = (whole_facet[:, None, :] & inside[None]).any(axis=2)  # (C, Q)
+        every = ((~in_corner).astype(np.int32) @ nz.T.astype(np.int32)) == 0  # (C, Q)
+        on_facet = (whole_facet.astype(np.int32) @ inside.T.astype(np.int32)) > 0  # (C, Q)
         ok = every & (on_facet | whole_cell[:, None]) if has_area else every
         new = nodemap >= start
         member[nodemap[ok & new]] = True
@@ -260,7 +257,7 @@ def _groups(mesh: Mesh, kind, cells: np.ndarray, Wi: np.ndarray, nodemap: np.nda
 
 
 def _compact(mesh: Mesh, name: str, points: np.ndarray, cells: np.ndarray, groups: dict, n: int) -> Mesh:
-    """The refined mesh without the original nodes no cell uses any more (midside nodes when ``n`` is odd)."""
+    """The refined mesh without any original node no cell uses (one the input's cells did not use either)."""
     used = np.zeros(len(points), dtype=bool)
     used[cells.ravel()] = True
     renumber = np.cumsum(used) - 1
