@@ -65,11 +65,14 @@ def test_the_schema_refuses_meshes_it_cannot_measure(meshes, words):
         loads(STRIP + f"[convergence]\nmeshes = {meshes}\n")
 
 
-def test_a_mesh_file_study_is_told_how_to_check_its_mesh(tmp_path):
+def test_a_mesh_file_study_is_told_which_splits_its_factors_make(tmp_path):
     from _studies import PLATE, absolute
 
-    with pytest.raises(StudyError, match=r"\[convergence\] meshes: the meshes are made from \[geometry\]"):
+    with pytest.raises(StudyError, match=r"\[convergence\] meshes: with a \[mesh\] file the finer meshes split every "
+                       r"cell edge in n parts .*: 1 → n = 1, 0.7 → n = 1, 0.5 → n = 2; give factors that make 3 "
+                       r"different n, e\.g\. \[1, 0\.5, 0\.33\]"):
         loads(absolute(PLATE) + "[convergence]\nmeshes = [1, 0.7, 0.5]\n")
+    assert loads(absolute(PLATE) + "[convergence]\nmeshes = [1, 0.5, 0.33]\n")["convergence"]["meshes"]
 
 
 @pytest.fixture(scope="module")

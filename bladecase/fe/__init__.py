@@ -10,7 +10,8 @@ Modules: :mod:`~bladecase.fe.naca` (sections), :mod:`~bladecase.fe.geometry` (pa
 :mod:`~bladecase.fe.select` (:func:`select_nodes`: nodes by group name or coordinates),
 :mod:`~bladecase.fe.material` (:class:`Material`, presets), :mod:`~bladecase.fe.model` (:class:`FEModel`,
 :class:`DofMap`), :mod:`~bladecase.fe.assembly` (:func:`assemble`), :mod:`~bladecase.fe.isoparametric` (the
-curved map of quadratic cells through their midside nodes), :mod:`~bladecase.fe.rotation`
+curved map of quadratic cells through their midside nodes), :mod:`~bladecase.fe.refine` (:func:`refine_mesh`: a
+mesh's cells split, every edge in ``n``), :mod:`~bladecase.fe.rotation`
 (:func:`~bladecase.fe.rotation.spin`), :mod:`~bladecase.fe.nonlinear_static` (:func:`nonlinear_state`: the
 geometrically nonlinear static state, large rotations), :mod:`~bladecase.fe.campbell` (frequencies against speed),
 :mod:`~bladecase.fe.eigen` (:func:`natural_frequencies`, :func:`stiffness_factor`),
@@ -27,6 +28,7 @@ from .mesh import Mesh, load_mesh, save_mesh
 from .model import DofMap, FEModel, node_operator
 from .naca import naca_parameters, naca_section
 from .nonlinear_static import NonlinearState, nonlinear_state
+from .refine import refine_mesh, splits_for
 from .select import select_nodes
 from .storage import load_model, model_from_arrays, model_to_arrays, save_model, sparse_from_arrays, sparse_to_arrays
 
@@ -35,8 +37,7 @@ __all__ = [
     "BladeGeometry", "DofMap", "FEModel", "MappingCurved", "Material", "Mesh", "NonlinearState", "PlateGeometry",
     "assemble", "blade_mesh", "cad_volume", "curved_geometry", "load_mesh", "load_model", "model_from_arrays",
     "model_to_arrays",
-    "naca_parameters", "naca_section", "natural_frequencies", "node_operator", "nonlinear_state", "save_mesh",
-    "save_model",
-    "select_nodes",
-    "sparse_from_arrays", "sparse_to_arrays", "stiffness_factor",
+    "naca_parameters", "naca_section", "natural_frequencies", "node_operator", "nonlinear_state", "refine_mesh",
+    "save_mesh", "save_model",
+    "select_nodes", "sparse_from_arrays", "sparse_to_arrays", "splits_for", "stiffness_factor",
 ]

@@ -33,11 +33,16 @@ def convergence_report(section: dict | None) -> list[str]:
     dofs = ", ".join(str(d) for d in section["dofs"])
     at = (f"; the orbit's figures at T/T₁ = {ratio:.6g} (each mesh's own T₁, the backbone's admissible orbit of least "
           "energy)" if ratio is not None else "")
+    made = "element sizes × each factor"
+    if section.get("refinement") == "split":
+        made = (f"the study's mesh file with every cell edge split in {', '.join(str(n) for n in section['splits'])} "
+                f"parts (sizes {', '.join(f'×{h:.4g}' for h in meshes)}; asked "
+                f"{', '.join(f'×{h:g}' for h in section['requested'])})")
     lines = ["", "## Mesh convergence", "",
-             f"The study run on meshes {', '.join(f'×{h:g}' for h in meshes)} (element sizes × each factor; {dofs} "
+             f"The study run on meshes {', '.join(f'×{h:.4g}' for h in meshes)} ({made}; {dofs} "
              f"free dofs){at}. Error: 1.25 × the distance of this study's value from the Richardson extrapolation of "
              f"the three finest meshes, relative; above {100 * section['flag']:g} % in bold.", "",
-             "| figure | " + " | ".join(f"×{h:g}" + (" (this study)" if h == 1 else "") for h in meshes)
+             "| figure | " + " | ".join(f"×{h:.4g}" + (" (this study)" if h == 1 else "") for h in meshes)
              + " | observed order | converged (Richardson) | error of this study's mesh |",
              "|---|" + "---:|" * (len(meshes) + 3)]
     for f in section["figures"].values():
@@ -48,7 +53,7 @@ def convergence_report(section: dict | None) -> list[str]:
         order = "—" if f["order"] is None else f"{f['order']:.2g}"
         lines.append(f"| {f['words']}{unit} | " + " | ".join(_value(v) for v in f["values"])
                      + f" | {order} | {_value(f['extrapolated'])} | {error} |")
-    missing = [f"×{h:g}" for h, row in zip(meshes, section.get("rows", [])) if row.get("energy_j") is None]
+    missing = [f"×{h:.4g}" for h, row in zip(meshes, section.get("rows", [])) if row.get("energy_j") is None]
     if ratio is not None and missing:
         lines += ["", f"No admissible orbit at T/T₁ = {ratio:.6g} on mesh(es) {', '.join(missing)}: the orbit's "
                   "figures there are missing."]

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["backbone_rows", "end_words", "load_words", "nodal_report", "tongue_words"]
+__all__ = ["backbone_rows", "end_words", "limit_words", "load_words", "nodal_report", "tongue_words"]
 
 
 def load_words(row: dict, face_mm2: float | None = None) -> str:
@@ -83,6 +83,8 @@ the blade; below it the backbone rises 3.5 Hz per doubling of the energy (f ≈ 
 ln(E / 0.00925 J), from 211.3 Hz): extrapolate along it to read the backbone beyond.
     """
     end = section.get("end")
+    if end and end.get("kind") == "amplitude_limit":
+        return limit_words(end)
     if not end or end.get("kind") != "internal_resonance":
         return f"- The family ends: {section.get('stop', 'where the continuation stopped')}."
     return (f"- The family ends in an internal resonance at {end['frequency_hz']:.5g} Hz: its motion turns into the "
@@ -91,6 +93,32 @@ ln(E / 0.00925 J), from 211.3 Hz): extrapolate along it to read the backbone bey
             f"{end.get('other_share', 1 - end['share']):.0%} of the modal energy. Where such a resonance falls depends "
             "on the mesh (the high modes move with it), so this is where the mesh ends the backbone, not the blade"
             f"{_trend_words(end.get('trend'))}.")
+
+
+def limit_words(end: dict) -> str:
+    """The report's line on a family cut at the small-displacement limit (``end["kind"] == "amplitude_limit"``,
+    :func:`bladecase.study.nodal.nodal_stage`): where, why, and how far the continuation went on unreported.
+
+    >>> print(limit_words({"frequency_beyond_hz": 231.2, "energy_beyond_j": 4.1, "tip_amplitude_beyond_mm": 7.9,
+    ...     "limit_mm": 7.6, "amplitude_limit": 0.05, "span_mm": 152.9, "frequency_cut_hz": 230.8,
+    ...     "energy_cut_j": 3.2, "tip_amplitude_cut_mm": 7.1, "orbits_beyond": 40, "continuation_top_energy_j": 4e14,
+    ...     "continuation_top_yield_mm": 3.2e6}))
+    - **The family is cut at the small-displacement limit**: at 231.2 Hz (4.1 J) a contact node moves 7.9 mm, \
+more than 7.6 mm (5 % of the blade's 153 mm span, `[search] amplitude_limit`), where a linear-elastic, \
+small-displacement model of the blade no longer holds; every figure above stops at the last orbit within it, \
+230.8 Hz (3.2 J, 7.1 mm). The continuation went on for 40 more orbits, to 4e+14 J and a casing yield of 3.2e+06 \
+mm: not figures of the blade.
+    """
+    last = ("the grazing orbit is already beyond it" if end.get("frequency_cut_hz") is None else
+            f"every figure above stops at the last orbit within it, {end['frequency_cut_hz']:.5g} Hz "
+            f"({end['energy_cut_j']:.3g} J, {end['tip_amplitude_cut_mm']:.3g} mm)")
+    return (f"- **The family is cut at the small-displacement limit**: at {end['frequency_beyond_hz']:.5g} Hz "
+            f"({end['energy_beyond_j']:.3g} J) a contact node moves {end['tip_amplitude_beyond_mm']:.3g} mm, more "
+            f"than {end['limit_mm']:.3g} mm ({100 * end['amplitude_limit']:g} % of the blade's {end['span_mm']:.3g} mm "
+            "span, `[search] amplitude_limit`), where a linear-elastic, small-displacement model of the blade no "
+            f"longer holds; {last}. The continuation went on for {end['orbits_beyond']} more orbits, to "
+            f"{end['continuation_top_energy_j']:.3g} J and a casing yield of "
+            f"{end['continuation_top_yield_mm']:.3g} mm: not figures of the blade.")
 
 
 def tongue_words(section: dict) -> str | None:
@@ -121,8 +149,12 @@ in `nodal_modes.csv`). Where a tongue sits depends on the mesh; the backbone on 
 def nodal_report(section: dict | None) -> list[str]:
     """Markdown lines for ``summary["nodal_modes"]`` (:func:`bladecase.study.nodal.nodal_stage`)."""
     if not section or not section.get("rows"):
-        return [] if not section else ["", "## Every face node a contact", "",
-                                       f"- No orbit: {section.get('stop', 'the family could not be started')}."]
+        if not section:
+            return []
+        end = section.get("end") or {}
+        return ["", "## Every face node a contact", "",
+                limit_words(end) if end.get("kind") == "amplitude_limit" else
+                f"- No orbit: {section.get('stop', 'the family could not be started')}."]
     rows = section["rows"]
     top = max(backbone_rows(section), key=lambda r: r["energy_j"])
     lo, hi = section["frequency_range_hz"]

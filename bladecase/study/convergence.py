@@ -11,11 +11,18 @@ figures are read on each mesh at the same places:
   widest arc, or ``[convergence] ratio``), the backbone's admissible orbit of least energy: ``energy_j``,
   ``tip_amplitude_mm``, ``contact_force_n`` (the total normal force on the contact) and ``contact_fraction``.
 
-For each figure, with ``h`` the factors: the observed order ``p`` of the three finest meshes (``f = f₀ + C hᵖ``
-solved exactly for unequal refinement ratios), the Richardson extrapolation ``f₀`` and the error estimate of the
-study's own mesh, ``1.25 |f(h_study) − f₀|`` (Roache's safety factor for three meshes), relative to ``f₀``. A
-sequence that does not converge monotonically has no order; its error is bounded by ``1.25 ×`` the largest change
-between meshes and said to be so. An estimate above :data:`FLAG` (2 %) is flagged in the report and the verdict.
+A study that reads its mesh from a file (``[mesh] path``) is refined by splitting every cell
+(:func:`bladecase.fe.refine_mesh`): each edge in ``n = round(1/factor)`` parts (0.5 → 2, each edge halved; 0.33 →
+3), the new nodes on the cells' own (curved) isoparametric map, the named groups and so the contact face carried.
+The sizes actually used, ``1/n``, are the ``h`` of the order and the extrapolation (``meshes`` in the summary; the
+factors asked for are its ``requested``, the parts per edge its ``splits``).
+
+For each figure, with ``h`` the element-size ratios: the observed order ``p`` of the three finest meshes
+(``f = f₀ + C hᵖ`` solved exactly for unequal refinement ratios), the Richardson extrapolation ``f₀`` and the
+error estimate of the study's own mesh, ``1.25 |f(h_study) − f₀|`` (Roache's safety factor for three meshes),
+relative to ``f₀``. A sequence that does not converge monotonically has no order; its error is bounded by ``1.25 ×``
+the largest change between meshes and said to be so. An estimate above :data:`FLAG` (2 %) is flagged in the report
+and the verdict.
 
 >>> row = richardson([1.0, 0.7, 0.5], [210.5, 212.479, 213.094])
 >>> round(row["order"], 2), round(row["extrapolated"], 2), round(100 * row["error"], 2)
@@ -31,9 +38,11 @@ from collections.abc import Sequence
 import numpy as np
 
 from .. import log
+from ..fe import splits_for
 from .schema import Study, StudyError
 
-__all__ = ["FIGURES", "FLAG", "convergence_stage", "mesh_figures", "richardson", "scaled_study"]
+__all__ = ["FIGURES", "FLAG", "convergence_stage", "mesh_figures", "mesh_row", "mesh_size", "refined_mesh",
+           "richardson", "scaled_study"]
 
 #: An error estimate (relative) above which a figure is flagged.
 FLAG = 0.02
@@ -110,9 +119,22 @@ def richardson(h: Sequence[float], values: Sequence[float | None], study_h: floa
 
 # ----------------------------------------------------------------------------- the meshes
 
+def _quiet(study: Study) -> dict:
+    """``study``'s config searching as the study does and writing nothing (no figures, animations, reference model,
+    sweeps)."""
+    config = {k: (dict(v) if isinstance(v, dict) else v) for k, v in study.config.items()}
+    config["output"] = dict(config["output"], formats=[], animate=0, orbits=[], reference=False)
+    for section in ("convergence", "rub", "forcing"):
+        config.pop(section, None)
+    if config.get("rotation"):
+        config["rotation"] = dict(config["rotation"], speeds=[])
+    return config
+
+
 def scaled_study(study: Study, factor: float) -> Study:
     """``study`` on a mesh ``factor`` times as fine (element sizes × ``factor``), searching as the study does and
-    writing nothing (no figures, animations, reference model, sweeps).
+    writing nothing (no figures, animations, reference model, sweeps). A ``[mesh]`` file study is refined by
+    :func:`refined_mesh` instead.
 
     >>> from bladecase.study.demo import demo_study
     >>> s = scaled_study(demo_study(), 0.5)
@@ -121,21 +143,41 @@ def scaled_study(study: Study, factor: float) -> Study:
     (0.5, 0.5)
     """
     if not study.parametric:
-        raise StudyError("[convergence] meshes: the meshes are refined from [geometry] (element sizes × each "
-                         "factor); with a [mesh] file, run the study on your own refined meshes and compare their "
-                         "summaries")
-    config = {k: (dict(v) if isinstance(v, dict) else v) for k, v in study.config.items()}
+        raise StudyError("scaled_study: the study reads the mesh file [mesh] path; its finer meshes split the "
+                         "file's cells (refined_mesh), they do not scale [geometry]")
+    config = _quiet(study)
     g = config["geometry"]
     size = g["size"] if g["size"] is not None else study.geometry().default_size()
     g["size"] = size * factor
     if g.get("tip_size") is not None:
         g["tip_size"] = g["tip_size"] * factor
-    config["output"] = dict(config["output"], formats=[], animate=0, orbits=[], reference=False)
-    for section in ("convergence", "rub", "forcing"):
-        config.pop(section, None)
-    if config.get("rotation"):
-        config["rotation"] = dict(config["rotation"], speeds=[])
     return dataclasses.replace(study, config=config)
+
+
+def mesh_size(study: Study, factor: float) -> float:
+    """The element-size ratio actually used for ``factor``: ``factor`` itself for a ``[geometry]`` study, ``1/n``
+    for a ``[mesh]`` file split in ``n`` parts per edge (:func:`bladecase.fe.refine.splits_for`).
+
+    >>> from bladecase.study.demo import demo_study
+    >>> mesh_size(demo_study(), 0.7)
+    0.7
+    """
+    return float(factor) if study.parametric else 1.0 / splits_for(factor)
+
+
+def refined_mesh(study: Study, factor: float):
+    """The study (quiet, as :func:`scaled_study`) and its mesh file's mesh with every cell split in
+    ``splits_for(factor)`` parts per edge (:func:`bladecase.fe.refine.refine_mesh`: the cells' own isoparametric
+    map, the named groups — the contact face among them — carried)."""
+    from ..fe import refine_mesh
+    from .stages import build_mesh
+
+    quiet = dataclasses.replace(study, config=_quiet(study))
+    n = splits_for(factor)
+    mesh = refine_mesh(build_mesh(quiet), n)
+    log.info("mesh %s: every edge split in %d (element size × 1/%d for the factor %g): %d nodes, %d cells", mesh.source,
+             n, n, factor, len(mesh.points), len(mesh.cells[mesh.body_type]))
+    return quiet, mesh
 
 
 def mesh_figures(model, reduced, families, f1_hz: float, ratio: float | None, ipp: int) -> dict:
@@ -171,14 +213,35 @@ def mesh_figures(model, reduced, families, f1_hz: float, ratio: float | None, ip
     return out
 
 
+def mesh_row(study: Study, factor: float, ratio: float | None, ipp: int) -> dict:
+    """The figures of ``study`` run by itself on its mesh × ``factor`` (:func:`scaled_study`; the study's own
+    search), read at ``T/T₁ = ratio`` on the ``ipp`` family: one row of the convergence table (``factor``, ``dofs``
+    and the keys of :data:`FIGURES` that this mesh has).
+
+    >>> from bladecase.study.schema import loads
+    >>> strip = loads('study = {name = "s"}\\ngeometry = {kind = "plate", span = 0.1, chord = 0.02, size = 0.01}\\n'
+    ...               'fem = {order = 1, thickness = 0.002}\\ncontact = {clearance = 1e-4, model = "massless", '
+    ...               'casing_stiffness = 1e6, face = "tip", normal = [1.0, 0.0]}\\n'
+    ...               'reduction = {method = "massless", size = 4}\\n'
+    ...               'search = {ipp = [1], periods = [0.95, 1.0], scan = 4}\\n')
+    >>> row = mesh_row(strip, 0.5, None, 1)
+    >>> row["factor"], row["dofs"] > 0, round(row["f1_hz"], -1) > 0
+    (0.5, True, True)
+    """
+    return _mesh_task(factor, study=study, ratio=ratio, ipp=ipp)
+
+
 def _mesh_task(factor: float, *, study: Study, ratio: float | None, ipp: int) -> dict:
     """One mesh of the convergence study (a module-level task for the executor)."""
     from ..fe import natural_frequencies, stiffness_factor
     from .rotation import operating_point
     from .stages import build_contact, build_mesh, build_model, build_reduced, search
 
-    s = scaled_study(study, factor)
-    mesh = build_mesh(s)
+    if study.parametric:
+        s = scaled_study(study, factor)
+        mesh = build_mesh(s)
+    else:
+        s, mesh = refined_mesh(study, factor)
     model = build_model(s, mesh)
     factor_k = stiffness_factor(model)
     contact = build_contact(s, model)
@@ -186,7 +249,8 @@ def _mesh_task(factor: float, *, study: Study, ratio: float | None, ipp: int) ->
     f1 = float(natural_frequencies(model, 1, factor=factor_k)[0])
     reduced = build_reduced(s, model, contact, factor=factor_k)
     families = search(s, reduced.system, progress=False)
-    return {"factor": float(factor), **mesh_figures(model, reduced, families, f1, ratio, ipp)}
+    return {"factor": float(factor), "size": mesh_size(study, factor),
+            **mesh_figures(model, reduced, families, f1, ratio, ipp)}
 
 
 def convergence_stage(study: Study, main: dict, ratio: float | None, ipp: int, executor, progress: bool = False
@@ -198,9 +262,9 @@ def convergence_stage(study: Study, main: dict, ratio: float | None, ipp: int, e
     others = [x for x in factors if x != 1.0]
     rows = executor.map(_mesh_task, others, shared={"study": study, "ratio": ratio, "ipp": ipp},
                         desc="meshes", progress=progress)
-    by_factor = {1.0: {"factor": 1.0, **main}, **{r["factor"]: r for r in rows}}
+    by_factor = {1.0: {"factor": 1.0, "size": 1.0, **main}, **{r["factor"]: r for r in rows}}
     table = [by_factor[x] for x in sorted(by_factor, reverse=True)]
-    h = [r["factor"] for r in table]
+    h = [r["size"] for r in table]  # the sizes used: with a mesh file, 1/n (n parts per edge), not the factors
     figures = {}
     for key in FIGURES:
         values = [r.get(key) for r in table]
@@ -215,5 +279,8 @@ def convergence_stage(study: Study, main: dict, ratio: float | None, ipp: int, e
         f = figures[k]
         log.warning("mesh convergence: %s is off its mesh-converged value by %.2g %% on the study's mesh%s",
                     f["words"], 100 * f["error"], "" if f["monotone"] else " (not monotone over the meshes)")
-    return {"meshes": h, "dofs": [r["dofs"] for r in table], "ratio": ratio, "ipp": ipp, "flag": FLAG,
-            "rows": table, "figures": figures, "flagged": flagged}
+    out = {"meshes": h, "dofs": [r["dofs"] for r in table], "ratio": ratio, "ipp": ipp, "flag": FLAG,
+           "rows": table, "figures": figures, "flagged": flagged}
+    if not study.parametric:
+        out.update(refinement="split", requested=[r["factor"] for r in table], splits=[round(1 / x) for x in h])
+    return out

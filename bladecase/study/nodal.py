@@ -13,9 +13,12 @@ contact at the instant of that peak, and the largest over the period) and where 
 node's own force falls like its area as the tip mesh is refined, so it is no figure of the mode; with ``[output]
 reference``, up to
 :data:`REFERENCE_CHECKS` orbits, evenly spread, re-simulated for one period in the nodal model's Krylov extension
-(four times its dofs, :func:`bladecase.reduction.nodes.nodal_extension`). Outputs: ``nodal_modes.csv`` (one
-row per orbit), ``nodal_modes.png`` (frequency–energy of both models, and the largest penetration over the face's
-nodes against energy), ``summary.json["nodal_modes"]``, a section of the report.
+(four times its dofs, :func:`bladecase.reduction.nodes.nodal_extension`). The family is cut at the small-displacement
+limit as the face mean's arcs are (:mod:`~bladecase.study.validity`, ``[search] amplitude_limit`` × the span): at its
+first orbit on which a contact node moves farther than that (:func:`node_amplitude`), its figures stop at the orbit
+before, and ``summary.json["nodal_modes"]["validity"]`` and the report say where and why. Outputs:
+``nodal_modes.csv`` (one row per orbit), ``nodal_modes.png`` (frequency–energy of both models, and the largest
+penetration over the face's nodes against energy), ``summary.json["nodal_modes"]``, a section of the report.
 """
 
 from __future__ import annotations
@@ -30,7 +33,7 @@ from ..nsm.massless.nodal_modes import nodal_family
 from ..reduction.nodes import contact_pressure, nodal_extension, nodal_model
 from .reference import REFERENCE_FACTOR, check_nodal_in_reference
 
-__all__ = ["nodal_stage", "orbit_load"]
+__all__ = ["node_amplitude", "nodal_stage", "orbit_load"]
 
 COLUMNS = ("frequency_hz", "period_s", "energy_j", "nodes_touching", "touching_nodes", "max_pressure_mpa",
            "total_force_n", "loaded_area_mm2", "peak_loaded_area_mm2", "load_centre", "load_location",
@@ -49,6 +52,65 @@ def orbit_load(nodal, orbit) -> dict:
             "total_force_n": float(orbit.total_force), "loaded_area_mm2": at["loaded_area_m2"] * 1e6,
             "peak_loaded_area_mm2": orbit.loaded_area(nodal.areas) * 1e6,
             "load_centre": at["centre"], "load_location": at["location"]}
+
+
+#: Instants per period at which :func:`node_amplitude` samples the nodes' swing away from the casing.
+AMPLITUDE_SAMPLES = 64
+
+
+def node_amplitude(nodal, orbit, samples: int = AMPLITUDE_SAMPLES) -> float:
+    """The largest normal displacement ``|u_j|`` of a contact node over one orbit of the every-node model ``nodal``
+    (m): towards the casing its exact peak (the clearance plus the casing's yield, ``NodalOrbit.max_tip``), away from
+    it ``u = Wᵀx − H_s λ`` sampled at ``samples`` instants of the period — the tip amplitude of the small-displacement
+    limit (:mod:`~bladecase.study.validity`).
+
+    >>> import numpy as np
+    >>> from types import SimpleNamespace
+    >>> from bladecase.nsm.massless import NodalSystem, nodal_family
+    >>> s = NodalSystem(np.eye(1), 4.0 * np.eye(1), np.ones((1, 1)), np.zeros((1, 1)), gap=[1.0], casing=[1e6])
+    >>> o = nodal_family(s, 0, freq_ratio=1.01).orbits[0]      # grazing: the linear mode just touching, amplitude 1
+    >>> round(node_amplitude(SimpleNamespace(system=s), o), 9), round(o.max_tip, 9)
+    (1.0, 1.0)
+    """
+    s = nodal.system
+    t = np.linspace(0.0, orbit.T, samples, endpoint=False)
+    x, _ = orbit.state(t)
+    u = s.W.T @ x - s.flexibility @ s.forces(x)
+    return float(max(orbit.max_tip, np.abs(u).max()))
+
+
+def _small_displacements(study, model, nodal, fam):
+    """The family cut at its first orbit beyond ``[search] amplitude_limit`` × the span, and the section's
+    ``validity`` record (``cut``: where, how far the continuation went on; None when the family stays within)."""
+    from .validity import blade_span, cut_family, first_beyond
+
+    span = blade_span(model)
+    share = study["search"]["amplitude_limit"]
+    limit = share * span
+    record = {"span_m": span, "amplitude_limit": share, "limit_m": limit, "cut": None}
+    k, amps = first_beyond(fam.orbits, lambda o: node_amplitude(nodal, o), limit)
+    if k is None:
+        return fam, record
+    beyond, last = fam.orbits[k], (fam.orbits[k - 1] if k else None)
+    top = max(fam.orbits[k:], key=lambda o: o.energy)
+    cut = {"index": k, "frequency_beyond_hz": float(beyond.frequency), "energy_beyond_j": float(beyond.energy),
+           "tip_amplitude_beyond_mm": amps[k] * 1e3,
+           "frequency_cut_hz": None if last is None else float(last.frequency),
+           "energy_cut_j": None if last is None else float(last.energy),
+           "tip_amplitude_cut_mm": None if last is None else amps[k - 1] * 1e3,
+           "orbits_beyond": len(fam.orbits) - k, "continuation_top_energy_j": float(top.energy),
+           "continuation_top_yield_mm": float(np.max(top.penetration)) * 1e3, "continuation_stop": fam.stop}
+    record["cut"] = cut
+    stop = (f"cut at the small-displacement limit: at {beyond.frequency:.6g} Hz ({beyond.energy:.4g} J) a contact node "
+            f"moves {amps[k] * 1e3:.4g} mm, more than {limit * 1e3:.4g} mm ({100 * share:g} % of the {span * 1e3:.4g} "
+            "mm span, [search] amplitude_limit)")
+    end = {"kind": "amplitude_limit", "frequency_hz": cut["frequency_cut_hz"], "energy_j": cut["energy_cut_j"],
+           "limit_mm": limit * 1e3, "span_mm": span * 1e3, "amplitude_limit": share, **cut}
+    log.warning("every face node a contact: the family is %s; its figures stop at %s (the continuation went on to "
+                "%.3g J, a casing yield of %.3g mm: not reported)", stop,
+                "its first orbit" if last is None else f"{last.frequency:.6g} Hz ({last.energy:.4g} J)",
+                top.energy, cut["continuation_top_yield_mm"])
+    return cut_family(fam, k, stop, end), record
 
 
 def _face_penetration(reduced, contact, model, family) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -142,6 +204,7 @@ def nodal_stage(study, model, contact, families, reduced, *, factor=None, folder
     top = _face_top_energy(families)
     cap = {"energy_max": top} if top is not None else {"freq_ratio": 1.0 / study["search"]["periods"][0]}
     fam = nodal_family(nodal.system, 0, through_resonances=True, **cap)  # up to the face mean's energy
+    fam, validity = _small_displacements(study, model, nodal, fam)
     orbits = fam.orbits
     reference = (nodal_extension(nodal, REFERENCE_FACTOR * nodal.n, factor) if study["output"]["reference"]
                  and orbits else None)
@@ -160,7 +223,7 @@ def nodal_stage(study, model, contact, families, reduced, *, factor=None, folder
         "first_touch_nodes": next((r["touching_nodes"].split() for r in rows if r["touching_nodes"]), []),
         "most_nodes_touching": max((r["nodes_touching"] for r in rows), default=0),
         "reference": None if checks is None else {k: v for k, v in checks.items() if k != "drifts"},
-        "rows": rows,
+        "validity": validity, "rows": rows,
     }
     face = [f for f in families if f.arcs]
     if face:
@@ -178,7 +241,8 @@ def nodal_stage(study, model, contact, families, reduced, *, factor=None, folder
 
         section["animations"] = animate_nodal(study, nodal, fam, folder, target_energy, reference,
                                               lambda o: _row(nodal, o),
-                                              extend=lambda count: nodal_extension(nodal, count, factor))
+                                              extend=lambda count: nodal_extension(nodal, count, factor)) \
+            if orbits else []
         lines = [",".join(COLUMNS)] + [",".join(csv_cell(r[c]) for c in COLUMNS) for r in rows]
         write_text(folder / "nodal_modes.csv", "\n".join(lines) + "\n")
         section["files"] = {"csv": "nodal_modes.csv"}

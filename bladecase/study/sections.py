@@ -420,7 +420,8 @@ def _meshes(v) -> str | None:
 CONVERGENCE_KEYS: dict[str, Key] = {
     "meshes": Key(_LIST, [], "Element-size factors of the meshes the study is run on, 1 (the study's own) included, "
                   "e.g. [1, 0.7, 0.5]: each headline figure is given with its observed order and the Richardson "
-                  "estimate of its mesh error ([geometry] studies).", _meshes),
+                  "estimate of its mesh error. With a [mesh] file each finer mesh splits every cell edge in "
+                  "n = round(1/factor) parts.", _meshes),
     "ratio": Key(_NUM, None, "T/T1 at which the orbit's figures (energy, tip amplitude, contact force) are compared "
                  "across the meshes (each mesh's own T1). Not set: the animated orbit's, else the middle of the "
                  "widest admissible arc.", lambda v: None if 0 < v < 100 else "must be in (0, 100) (× T1)"),
@@ -428,10 +429,17 @@ CONVERGENCE_KEYS: dict[str, Key] = {
 
 
 def convergence_checks(c: dict) -> None:
-    """``[convergence] meshes`` (when given): a parametric ``[geometry]``, whose element sizes are scaled."""
+    """``[convergence] meshes`` (when given): with a ``[mesh]`` file, the factors must give three different numbers
+    of parts per edge (:func:`bladecase.fe.refine.splits_for`)."""
     v = c.get("convergence")
-    if not v or not v["meshes"]:
+    if not v or not v["meshes"] or "geometry" in c:
         return
-    if "geometry" not in c:
-        raise StudyError("[convergence] meshes: the meshes are made from [geometry] (its element sizes × each factor); "
-                         "with a [mesh] file, run the study on your own refined meshes and compare their summaries")
+    from ..fe import splits_for
+
+    factors = sorted({float(x) for x in v["meshes"]}, reverse=True)
+    splits = [splits_for(x) for x in factors]
+    if len(set(splits)) < 3:
+        raise StudyError("[convergence] meshes: with a [mesh] file the finer meshes split every cell edge in n parts "
+                         "(element size × 1/n, n the nearest to 1/factor): "
+                         + ", ".join(f"{x:g} → n = {n}" for x, n in zip(factors, splits))
+                         + f"; give factors that make 3 different n, e.g. [1, 0.5, 0.33], got {v['meshes']}")

@@ -9,6 +9,10 @@ blades): an orbit whose tip amplitude (the largest ``|u|`` of a contact node
 over the period, :func:`~bladecase.study.render.orbit_engineering`) exceeds it is not part of an arc, and the report
 says where each arc was cut and why. The span is the distance from the clamp's centroid to the farthest node.
 
+The every-node family (``[contact] points = "nodes"``, :mod:`~bladecase.study.nodal`) is one followed curve, not a set
+of arcs: it is cut at its first orbit beyond the limit (:func:`first_beyond`, :func:`cut_family`), and its figures
+— energy, pressure, total force, casing yield — stop at the last orbit within it.
+
 >>> from bladecase.nsm import backbone, chain
 >>> branch = backbone(chain(2, k=1.0, m=0.5, gap=1.0), [4.0, 4.5, 5.0, 5.5, 6.0, 6.5, 7.0])
 >>> [(a.start, a.stop) for a in branch.arcs]
@@ -27,7 +31,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-__all__ = ["blade_span", "cut_arcs"]
+__all__ = ["blade_span", "cut_arcs", "cut_family", "first_beyond"]
 
 
 def blade_span(model) -> float:
@@ -81,3 +85,51 @@ def _sub_arc(fam, arc, start: int, stop: int):
         arc, start=start, stop=stop, T_lo=arc.T_lo if keep_lo else float(T.min()),
         T_hi=arc.T_hi if keep_hi else float(T.max()), refined_lo=bool(arc.refined_lo and keep_lo),
         refined_hi=bool(arc.refined_hi and keep_hi))
+
+
+def first_beyond(orbits: Sequence, amplitude: Callable, limit: float) -> tuple[int | None, list[float]]:
+    """The index of the first of ``orbits`` (in order along a family) whose ``amplitude(orbit)`` exceeds ``limit``
+    (``None``: none does) and the amplitudes measured up to it.
+
+    >>> first_beyond([1.0, 2.0, 3.0, 1.0], lambda a: a, 2.5)
+    (2, [1.0, 2.0, 3.0])
+    """
+    measured = []
+    for i, o in enumerate(orbits):
+        measured.append(float(amplitude(o)))
+        if measured[-1] > limit:
+            return i, measured
+    return None, measured
+
+
+def cut_family(family, index: int, stop: str, end: dict):
+    """``family`` (a :class:`~bladecase.nsm.massless.NodalFamily`) up to, not including, orbit ``index``: its tongues
+    clipped there (a tongue left beyond it, or reaching past it, is ``left = "cut"``), its ``stop`` and ``end`` the
+    given ones.
+
+    >>> import numpy as np
+    >>> from bladecase.nsm.massless import NodalSystem, nodal_family
+    >>> K = np.array([[18.0, -8.0, 0.0, 0.0, 0.0], [-8.0, 34.0, -6.0, -20.0, 0.0], [0.0, -6.0, 21.0, 0.0, -15.0],
+    ...               [0.0, -20.0, 0.0, 25.0, -5.0], [0.0, 0.0, -15.0, -5.0, 20.0]])
+    >>> i, c = [0, 1, 2], [3, 4]
+    >>> Kcc, Kci = K[np.ix_(c, c)], K[np.ix_(c, i)]
+    >>> s = NodalSystem(np.diag([2.0, 1.5, 0.7]), K[np.ix_(i, i)] - Kci.T @ np.linalg.solve(Kcc, Kci),
+    ...                 -Kci.T @ np.linalg.inv(Kcc), np.linalg.inv(Kcc), gap=[0.2, 0.3])
+    >>> fam = nodal_family(s, mode=0, freq_ratio=1.15)
+    >>> k, _ = first_beyond(fam.orbits, lambda o: o.max_tip, 0.25)   # the first orbit reaching past 0.25
+    >>> cut = cut_family(fam, k, "cut at 0.25", {"kind": "amplitude_limit"})
+    >>> len(fam.orbits) > k == len(cut.orbits), max(o.max_tip for o in cut.orbits) <= 0.25, cut.stop
+    (True, True, 'cut at 0.25')
+    """
+    tongues = []
+    for t in family.tongues:
+        if t["start"] >= index:
+            continue
+        t = dict(t)
+        if t["stop"] >= index or t.get("landing", -1) >= index:
+            t.update(stop=min(t["stop"], index - 1), left="cut")
+            for key in ("landing", "from_frequency_hz", "to_frequency_hz", "to_energy_j"):
+                t.pop(key, None)
+        tongues.append(t)
+    return dataclasses.replace(family, orbits=list(family.orbits[:index]), stop=stop, tongues=tuple(tongues),
+                               end=end)
