@@ -238,7 +238,7 @@ class _Trust(_Base):
         if not c:
             self.code("mesh_error_unknown")
             return
-        meshes = ", ".join(f"×{h:g}" for h in c["meshes"])
+        meshes = ", ".join(f"×{h:.4g}" for h in c["meshes"])
         figures = c["figures"]
         if c["flagged"]:
             self.code("mesh_error_large")
