@@ -27,7 +27,9 @@ has contact phases of finite duration instead of impacts. One module per step:
 - :mod:`~bladecase.nsm.massless.friction` — Coulomb friction at the contact nodes, sliding dominated by the
   rotation (:class:`Friction`, :func:`simulate_friction`: non-symmetric phases flown exactly), and
   :mod:`~bladecase.nsm.massless.friction_energy` — the energy balance with friction, per revolution, and the rub
-  with friction (:func:`energy_balance`, :func:`friction_rub`);
+  with friction (:func:`energy_balance`, :func:`friction_rub`), and :mod:`~bladecase.nsm.massless.friction_modes` —
+  a mode's frequency and damping ratio with friction by the extended periodic motion concept
+  (:func:`friction_mode`);
 - :mod:`~bladecase.nsm.massless.wear` — an abradable coating round the casing worn by the tip (:class:`Abradable`,
   :class:`WearProfile`, :func:`pass_tip`);
 - :mod:`~bladecase.nsm.massless.rub` — the rub response of a turning blade at one speed and over speeds
@@ -58,6 +60,7 @@ from .friction import (
     sliding_check,
 )
 from .friction_energy import FrictionEnergy, FrictionRub, energy_balance, friction_rub, per_revolution
+from .friction_modes import FrictionMode, decay_ratio, friction_mode
 from .model import (
     MASSLESS_DENSE_LIMIT,
     BoundOrbit,
@@ -103,6 +106,7 @@ __all__ = [
     # friction, friction_energy, wear
     "FRICTION_MODELS", "Friction", "FrictionFlight", "SlidingCheck", "friction_flight", "lemke", "simulate_friction",
     "sliding_check", "FrictionEnergy", "FrictionRub", "energy_balance", "friction_rub", "per_revolution",
+    "FrictionMode", "decay_ratio", "friction_mode",
     "Abradable", "WearProfile", "pass_tip",
     # bar
     "CONTACT_MODELS", "bar", "bar_continuum_band_energy", "bar_continuum_energy", "bar_continuum_field",

@@ -18,7 +18,9 @@ still LINEAR, ``λ_A = G_A(W_Aᵀx − g_A)`` with ``G_A = (H_μ)_AA⁻¹``, but
 its first-order system (``x``, ``x'``: the reduced size, dense), with the harmonic particular solution of the
 out-of-round casing, and its first switch found by the same certified search as without friction. A phase whose
 non-symmetric stiffness makes it grow (friction-induced flutter) is refused with a clear message: the certified
-search needs decaying or neutral terms. The set of closed contacts at a switch solves the complementarity problem
+search needs decaying or neutral terms (the extended periodic motion concept of
+:mod:`~bladecase.nsm.massless.friction_modes`, which feeds its phases on purpose, flies them with its own search).
+The set of closed contacts at a switch solves the complementarity problem
 with the non-symmetric ``H_μ`` (:func:`lemke`).
 
 **When the assumption holds.** The direction of the friction is that of the sliding velocity
@@ -229,7 +231,8 @@ class _FrictionPhase(_Phase):
                                  "of a contact phase with friction: add damping or change the speed") from None
         lam, V = np.linalg.eig(np.block([[np.zeros((n, n)), np.eye(n)], [-K, -C]]))
         grow = lam.real.max()
-        if grow > FLUTTER_RTOL * np.abs(lam).max():
+        growth = getattr(fl, "allow_growth", False)  # the extended periodic motion concept feeds its phases
+        if not growth and grow > FLUTTER_RTOL * np.abs(lam).max():
             raise ValueError(f"a contact phase with friction (nodes {[s.nodes[k] for k in idx]} closed, mu = "
                              f"{fr.mu:g}) is unstable: it grows at {grow:.3g} 1/s (friction-induced flutter); the "
                              "exact flight needs decaying phases: add damping or lower mu")
@@ -238,7 +241,8 @@ class _FrictionPhase(_Phase):
         if not rcond * EIGVEC_COND_LIMIT > 1:
             raise ValueError("a contact phase with friction is nearly defective (two of its modes coincide): change "
                              "mu or the damping slightly")
-        self.lam, self.Vx, self.Vv = np.minimum(lam.real, 0.0) + 1j * lam.imag, V[:n], V[n:]
+        self.lam = lam if growth else np.minimum(lam.real, 0.0) + 1j * lam.imag
+        self.Vx, self.Vv = V[:n], V[n:]
         self._Vinv = sla.lu_solve(self._lu, np.eye(2 * n, dtype=complex))
         self._psi = None
         self.LVx = L @ self.Vx
