@@ -5,7 +5,10 @@ the energy balance closes.
    energy balance of every revolution (casing input = friction + damping + change of stored energy; goal: 1e-9
    relative), the friction work per revolution, the sliding check (ΩR against the tips' tangential vibration
    velocity), and friction off against the plain simulation (bit for bit).
-2. The cost of a 50-speed friction sweep (each speed: its own centrifugal state and nodal model, the rub with
+2. The first mode with friction by the extended periodic motion concept at 1.2 and 1.5 times its grazing amplitude
+   (0.5 % damping): frequency, damping ratio with and without friction, and the free decay's ratio (certified
+   simulator) beside it.
+3. The cost of a 50-speed friction sweep (each speed: its own centrifugal state and nodal model, the rub with
    friction over ``--revolutions`` turns, the per-revolution energy balance) and of a wear pass of each speed's
    last revolution over a 360-cell abradable profile (in turn, one process).
 
@@ -28,7 +31,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from bench_rub import at_speed, demo  # noqa: E402
 
 from bladecase.nsm import Damping  # noqa: E402
+from bladecase.nsm.massless.friction import Friction  # noqa: E402
 from bladecase.nsm.massless.friction_energy import friction_rub  # noqa: E402
+from bladecase.nsm.massless.friction_modes import decay_ratio, friction_mode  # noqa: E402
 from bladecase.nsm.massless.nodes import Rub, simulate_nodes  # noqa: E402
 from bladecase.nsm.massless.wear import Abradable, WearProfile, pass_tip  # noqa: E402
 from bladecase.reduction.nodal_friction import nodal_friction  # noqa: E402
@@ -64,10 +69,27 @@ def one_speed(study, model, contact, rpm: float, revolutions: int) -> None:
           f"{off.worst_relative:.1e}")
 
 
+def modes(study, model, contact, rpm: float) -> None:
+    reduced, _, _, fr = friction_at(study, model, contact, rpm)
+    s = reduced.system
+    omega, phi = s.modes
+    grazing = float(np.min(s.gap / np.abs(s.W.T @ phi[:, 0])))
+    print(f"2. mode 1 with friction at {rpm:g} rpm (f1 = {omega[0] / 2 / np.pi:.2f} Hz open), 0.5 % damping")
+    for k in (1.2, 1.5):
+        for mu in (0.0, MU):
+            f = Friction(mu, T=fr.T, C_nt=fr.C_nt, C_tt=fr.C_tt, radius=fr.radius)
+            t = time.perf_counter()
+            m = friction_mode(s, f, amplitude=k * grazing, damping=DAMPING)
+            z = decay_ratio(s, f, m, DAMPING)
+            print(f"   {k:.1f} x grazing, mu = {mu:4.2f}: f = {m.frequency / 2 / np.pi:.3f} Hz "
+                  f"({m.frequency / omega[0] - 1:+.2e}), zeta {m.zeta:.6f}, free decay {z:.6f} "
+                  f"({z / m.zeta - 1:+.1e}), closed to {m.residual:.0e}, {time.perf_counter() - t:.1f} s")
+
+
 def sweep(study, model, contact, count: int, revolutions: int) -> None:
     speeds = np.linspace(1400, 1700, count)
     coating = Abradable(thickness=1e-3, yield_pressure=5e6, stiffness=1e12, cells=360, radius=0.4505, width=0.02)
-    print(f"2. a {count}-speed friction/wear sweep ({speeds[0]:g}-{speeds[-1]:g} rpm, {revolutions} revolutions each)")
+    print(f"3. a {count}-speed friction/wear sweep ({speeds[0]:g}-{speeds[-1]:g} rpm, {revolutions} revolutions each)")
     t0 = time.perf_counter()
     worst, t_model, t_rub, t_wear = 0.0, 0.0, 0.0, 0.0
     for rpm in speeds:
@@ -96,9 +118,12 @@ def main() -> None:
     ap.add_argument("--revolutions", type=int, default=4)
     ap.add_argument("--rpm", type=float, default=1650.0)
     ap.add_argument("--skip-sweep", action="store_true")
+    ap.add_argument("--skip-modes", action="store_true")
     a = ap.parse_args()
     study, model, contact = demo()
     one_speed(study, model, contact, a.rpm, a.revolutions)
+    if not a.skip_modes:
+        modes(study, model, contact, a.rpm)
     if not a.skip_sweep:
         sweep(study, model, contact, a.speeds, a.revolutions)
 
