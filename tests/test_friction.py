@@ -270,3 +270,12 @@ def test_rub_response_with_friction():
     assert abs(on.peak_force.max() - max(plain["peak_force"])) > 1e-3 * max(plain["peak_force"])
     swept = rub_sweep(s, [0.4], 3, 1.2, [0.0, 0.3], d, revolutions=6, window=3, friction=f)
     assert swept[0].as_dict() == on.as_dict()
+
+
+def test_lemke_is_scale_free():
+    """Flexibilities of a blade's tip nodes are ~1e-8 m/N: the same answer at any scale."""
+    H = np.array([[2.0, 0.3, 0.1], [0.7, 1.0, 0.2], [0.0, 0.4, 1.5]])
+    q = np.array([-1.0, 0.5, -0.2])
+    z = lemke(q, H)
+    for s in (1e-9, 1e6):
+        assert np.allclose(lemke(q * s, H * s), z, rtol=1e-12, atol=0)

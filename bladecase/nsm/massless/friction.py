@@ -153,9 +153,10 @@ def lemke(q, M, max_pivots: int | None = None) -> np.ndarray:
     n = q.size
     if np.all(q >= 0):
         return np.zeros(n)
-    tab = np.hstack([np.eye(n), -M, -np.ones((n, 1)), q[:, None]])
+    sc = float(np.abs(M).max()) or 1.0  # the same z for (q, M) / sc: a tableau of numbers near 1
+    tab = np.hstack([np.eye(n), -M / sc, -np.ones((n, 1)), q[:, None] / sc])
     basis = np.arange(n)
-    tol = 1e-13 * max(1.0, float(np.abs(M).max()))
+    tol = 1e-13
 
     def pivot(r: int, c: int) -> None:
         tab[r] /= tab[r, c]
