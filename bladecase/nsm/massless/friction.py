@@ -105,7 +105,8 @@ class Friction:
 
     def __post_init__(self) -> None:
         mu = self.mu
-        if isinstance(mu, bool) or not isinstance(mu, (int, float, np.floating)) or not np.isfinite(mu) or mu < 0:
+        number = isinstance(mu, (int, float, np.integer, np.floating)) and not isinstance(mu, bool)
+        if not number or not np.isfinite(mu) or mu < 0:
             raise ValueError(f"friction coefficient mu must be a finite number >= 0, got {mu!r}")
         if self.model not in FRICTION_MODELS:
             raise ValueError(f"friction model {self.model!r} is not flown here (valid: {', '.join(FRICTION_MODELS)})")
