@@ -182,8 +182,9 @@ def reference(s: NodalSystem, f: Friction, x0, v0, t_end, damping, rub):
     return np.array(times), y
 
 
-def test_against_an_independent_integrator():
-    s, f, d, rub = chain(12.0), chain_friction(0.2), Damping(zeta=0.02), Rub(3, 0.3, 0.7, (0.0, 0.4))
+@pytest.mark.parametrize("casing", [np.inf, 12.0], ids=["rigid", "compliant"])
+def test_against_an_independent_integrator(casing):
+    s, f, d, rub = chain(casing), chain_friction(0.2), Damping(zeta=0.02), Rub(3, 0.3, 0.7, (0.0, 0.4))
     t_end = 12.0
     tr = simulate_friction(s, f, X0, V0, t_end, damping=d, rub=rub)
     times, y = reference(s, f, X0, V0, t_end, d, rub)
