@@ -189,8 +189,8 @@ def test_against_an_independent_integrator(casing):
     tr = simulate_friction(s, f, X0, V0, t_end, damping=d, rub=rub)
     times, y = reference(s, f, X0, V0, t_end, d, rub)
     assert tr.switch_times.size == times.size >= 6
-    assert np.max(np.abs(tr.switch_times - times)) < 1e-6
-    assert np.max(np.abs(tr.x_end - y[: s.n])) < 1e-6 * np.abs(y[: s.n]).max()
+    assert np.max(np.abs(tr.switch_times - times)) < 1e-8  # the reference steps 1e-9 s off each surface
+    assert np.max(np.abs(tr.x_end - y[: s.n])) < 1e-8 * np.abs(y[: s.n]).max()
 
 
 # ----------------------------------------------------------------------------- energy balance, checks
