@@ -24,6 +24,14 @@ has contact phases of finite duration instead of impacts. One module per step:
   touching nodes (:func:`nodal_family`, :class:`NodalFamily`);
 - :mod:`~bladecase.nsm.massless.nodal_resonance` — that family followed step by step through the internal-resonance
   tongues it meets, recorded and crossed (:func:`backbone_trend`, :func:`resonance_ratio`);
+- :mod:`~bladecase.nsm.massless.friction` — Coulomb friction at the contact nodes, sliding dominated by the
+  rotation (:class:`Friction`, :func:`simulate_friction`: non-symmetric phases flown exactly), and
+  :mod:`~bladecase.nsm.massless.friction_energy` — the energy balance with friction, per revolution, and the rub
+  with friction (:func:`energy_balance`, :func:`friction_rub`), and :mod:`~bladecase.nsm.massless.friction_modes` —
+  a mode's frequency and damping ratio with friction by the extended periodic motion concept
+  (:func:`friction_mode`);
+- :mod:`~bladecase.nsm.massless.wear` — an abradable coating round the casing worn by the tip (:class:`Abradable`,
+  :class:`WearProfile`, :func:`pass_tip`);
 - :mod:`~bladecase.nsm.massless.rub` — the rub response of a turning blade at one speed and over speeds
   (:func:`rub_response`, :func:`rub_sweep`);
 - :mod:`~bladecase.nsm.massless.forced` — forced and damped simulation (:func:`simulate_forced_massless`;
@@ -41,6 +49,18 @@ from .bar import CONTACT_MODELS, bar, bar_continuum_band_energy, bar_continuum_e
 from .branches import ARC_RTOL, massless_mode, massless_modes, massless_orbit_at
 from .follow import EDGE_RTOL, MAX_HALF_PHASES, VANISH_RTOL, follow_mode, solve_at_period
 from .forced import ExpSignal, MasslessForcedFlight, MasslessForcedTrajectory, simulate_forced_massless
+from .friction import (
+    FRICTION_MODELS,
+    Friction,
+    FrictionFlight,
+    SlidingCheck,
+    friction_flight,
+    lemke,
+    simulate_friction,
+    sliding_check,
+)
+from .friction_energy import FrictionEnergy, FrictionRub, energy_balance, friction_rub, per_revolution
+from .friction_modes import FrictionMode, decay_ratio, friction_mode
 from .model import (
     MASSLESS_DENSE_LIMIT,
     BoundOrbit,
@@ -75,6 +95,7 @@ from .orbits import (
 )
 from .phases import PHASES, PhasedOrbit, solve_half, split_at, violation
 from .rub import RubResponse, rub_response, rub_sweep
+from .wear import Abradable, WearProfile, pass_tip
 
 __all__ = [
     # nodes, nodal_modes, nodal_resonance, rub
@@ -82,6 +103,11 @@ __all__ = [
     "BACKBONE_SHARE", "RESONANCE_SHARE", "TONGUE_POINTS", "backbone_trend", "resonance_ratio",
     "NodalFlight", "NodalSystem", "NodalTrajectory", "Rub", "lcp", "simulate_nodes", "RubResponse", "rub_response",
     "rub_sweep",
+    # friction, friction_energy, wear
+    "FRICTION_MODELS", "Friction", "FrictionFlight", "SlidingCheck", "friction_flight", "lemke", "simulate_friction",
+    "sliding_check", "FrictionEnergy", "FrictionRub", "energy_balance", "friction_rub", "per_revolution",
+    "FrictionMode", "decay_ratio", "friction_mode",
+    "Abradable", "WearProfile", "pass_tip",
     # bar
     "CONTACT_MODELS", "bar", "bar_continuum_band_energy", "bar_continuum_energy", "bar_continuum_field",
     # branches

@@ -42,6 +42,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from .friction import friction_flight
 from .nodes import NodalFlight, NodalSystem, NodalTrajectory, Rub, simulate_nodes
 
 __all__ = ["Character", "RubResponse", "characterise", "rub_response", "rub_sweep", "zero_one_test"]
@@ -352,20 +353,22 @@ def _checked(revolutions, window, max_revolutions, speed) -> tuple[int, float]:
 
 def rub_response(system: NodalSystem, speed: float, lobes: int, amplitude: float, angles, damping=None,
                  revolutions: int = 40, window: int = 10, max_switches: int = 2_000_000,
-                 areas=None, max_revolutions: int | None = None) -> RubResponse:
+                 areas=None, max_revolutions: int | None = None, friction=None) -> RubResponse:
     """The rub response at ``speed`` (rad/s) from rest, over ``revolutions`` turns and on, a ``window`` at a time,
     until it settles or ``max_revolutions`` (default ``10 × revolutions``) have run; read on the last ``window``
     (or a whole number of its periods) and characterised when it did not settle (module docstring). ``angles``: each
     contact node's angle about the engine axis (rad); ``damping``: a :class:`~bladecase.nsm.damping.Damping` of the
     open-phase modes (``None``: undamped); ``areas``: each node's tributary area (m², ``(m,)``) for the largest
-    loaded area (``loaded_area``; ``None`` without); ``max_switches``: over the whole run."""
+    loaded area (``loaded_area``; ``None`` without); ``max_switches``: over the whole run; ``friction``: a
+    :class:`~bladecase.nsm.massless.friction.Friction` at the contact nodes (``None`` or ``μ = 0``: none, the
+    results bit for bit those without)."""
     cap, speed = _checked(revolutions, window, max_revolutions, speed)
     if areas is not None:
         areas = np.asarray(areas, dtype=float)
         if areas.shape != (system.m,):
             raise ValueError(f"areas must hold one value per contact node ({system.m}), got shape {areas.shape}")
     rub = Rub(lobes, amplitude, speed, angles)
-    fl = NodalFlight(system, damping, rub)
+    fl = NodalFlight(system, damping, rub) if friction is None else friction_flight(system, friction, damping, rub)
     turn = 2 * np.pi / speed
     passing = turn / lobes
     W = window * lobes  # lobe passings per window
@@ -427,20 +430,21 @@ def rub_response(system: NodalSystem, speed: float, lobes: int, amplitude: float
 
 
 def _one(args) -> RubResponse:
-    system, speed, lobes, amplitude, angles, damping, revolutions, window, cap = args
-    return rub_response(system, speed, lobes, amplitude, angles, damping, revolutions, window, max_revolutions=cap)
+    system, speed, lobes, amplitude, angles, damping, revolutions, window, cap, friction = args
+    return rub_response(system, speed, lobes, amplitude, angles, damping, revolutions, window, max_revolutions=cap,
+                        friction=friction)
 
 
 def rub_sweep(system: NodalSystem, speeds, lobes: int, amplitude: float, angles, damping=None,
               revolutions: int = 40, window: int = 10, executor=None, progress=None,
-              max_revolutions: int | None = None) -> list[RubResponse]:
+              max_revolutions: int | None = None, friction=None) -> list[RubResponse]:
     """:func:`rub_response` at every speed of ``speeds`` (rad/s), through ``executor`` (anything with a ``map``
     of a function over a list, e.g. the study's executors; default: in turn)."""
     speeds = np.asarray(speeds, dtype=float).reshape(-1)
     if speeds.size == 0 or not np.all(np.isfinite(speeds)) or np.any(speeds <= 0):
         raise ValueError(f"speeds must be finite numbers > 0 (rad/s), got {speeds.tolist()}")
     jobs = [(system, float(w), lobes, amplitude, tuple(np.asarray(angles, dtype=float).tolist()), damping,
-             revolutions, window, max_revolutions) for w in speeds]
+             revolutions, window, max_revolutions, friction) for w in speeds]
     if executor is None:
         out = []
         for job in jobs:
