@@ -32,8 +32,8 @@ from bench_rub import at_speed, demo  # noqa: E402
 
 from bladecase.nsm import Damping  # noqa: E402
 from bladecase.nsm.massless.friction import Friction  # noqa: E402
-from bladecase.nsm.massless.friction_energy import friction_rub  # noqa: E402
 from bladecase.nsm.massless.friction_modes import decay_ratio, friction_mode  # noqa: E402
+from bladecase.nsm.massless.friction_rub import friction_rub  # noqa: E402
 from bladecase.nsm.massless.nodes import Rub, simulate_nodes  # noqa: E402
 from bladecase.nsm.massless.wear import Abradable, WearProfile, pass_tip  # noqa: E402
 from bladecase.reduction.nodal_friction import nodal_friction  # noqa: E402

@@ -12,7 +12,8 @@ from test_nodes import V0, X0, chain
 
 from bladecase.nsm import Damping
 from bladecase.nsm.massless.friction import Friction, FrictionFlight, lemke, simulate_friction, sliding_check
-from bladecase.nsm.massless.friction_energy import energy_balance, friction_rub, stored_energy
+from bladecase.nsm.massless.friction_energy import energy_balance, stored_energy
+from bladecase.nsm.massless.friction_rub import friction_rub
 from bladecase.nsm.massless.nodes import NodalFlight, NodalSystem, Rub, simulate_nodes
 
 

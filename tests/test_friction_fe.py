@@ -12,7 +12,7 @@ from skfem import MeshTri
 
 from bladecase.fe import Mesh, assemble
 from bladecase.nsm import Damping
-from bladecase.nsm.massless.friction_energy import friction_rub
+from bladecase.nsm.massless.friction_rub import friction_rub
 from bladecase.reduction import Contact
 from bladecase.reduction.nodal_friction import nodal_friction, tangential_map
 from bladecase.reduction.nodes import nodal_model

@@ -59,8 +59,9 @@ from .friction import (
     simulate_friction,
     sliding_check,
 )
-from .friction_energy import FrictionEnergy, FrictionRub, energy_balance, friction_rub, per_revolution
+from .friction_energy import FrictionEnergy, energy_balance, per_revolution
 from .friction_modes import FrictionMode, decay_ratio, friction_mode
+from .friction_rub import FrictionRub, friction_rub
 from .model import (
     MASSLESS_DENSE_LIMIT,
     BoundOrbit,
