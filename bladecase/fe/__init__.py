@@ -15,10 +15,13 @@ curved map of quadratic cells through their midside nodes), :mod:`~bladecase.fe.
 geometrically nonlinear static state, large rotations), :mod:`~bladecase.fe.campbell` (frequencies against speed),
 :mod:`~bladecase.fe.eigen` (:func:`natural_frequencies`, :func:`stiffness_factor`),
 :mod:`~bladecase.fe.storage` (stage files), :mod:`~bladecase.fe.calculix` (the model as a CalculiX deck, its
-frequencies back).
+frequencies back), :mod:`~bladecase.fe.cyclic` (:func:`fe_sector`, :func:`cyclic_modes`: a bladed disk's modes by
+nodal diameter from one sector) + :mod:`~bladecase.fe.cyclic_waves` (a sector mode on the whole disk, standing or
+travelling).
 """
 
 from .assembly import assemble
+from .cyclic import CyclicModes, CyclicSector, cyclic_modes, cyclic_spectrum, fe_sector
 from .eigen import natural_frequencies, stiffness_factor
 from .geometry import BladeGeometry, PlateGeometry, blade_mesh, cad_volume
 from .isoparametric import MappingCurved, curved_geometry
@@ -32,8 +35,10 @@ from .storage import load_model, model_from_arrays, model_to_arrays, save_model,
 
 __all__ = [
     "AL6061T6", "INCONEL718", "PRESETS", "STEEL", "TI6AL4V",
-    "BladeGeometry", "DofMap", "FEModel", "MappingCurved", "Material", "Mesh", "NonlinearState", "PlateGeometry",
-    "assemble", "blade_mesh", "cad_volume", "curved_geometry", "load_mesh", "load_model", "model_from_arrays",
+    "BladeGeometry", "CyclicModes", "CyclicSector",
+    "DofMap", "FEModel", "MappingCurved", "Material", "Mesh", "NonlinearState", "PlateGeometry",
+    "assemble", "blade_mesh", "cad_volume", "curved_geometry", "cyclic_modes", "cyclic_spectrum", "fe_sector",
+    "load_mesh", "load_model", "model_from_arrays",
     "model_to_arrays",
     "naca_parameters", "naca_section", "natural_frequencies", "node_operator", "nonlinear_state", "save_mesh",
     "save_model",
