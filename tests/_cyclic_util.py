@@ -42,11 +42,13 @@ def hex_sector(sectors: int, *, r_hub=0.10, r_rim=0.16, r_tip=0.26, thickness=0.
     return Mesh(points, {"hexahedron": cells}, dim=3, groups=groups, source=f"hex_sector({sectors})")
 
 
-def annulus(mesh: Mesh, sectors: int, tol: float = 1e-9) -> Mesh:
-    """The whole disk: ``mesh`` rotated by ``j·360°/N`` about +x (scipy), coincident nodes merged."""
+def annulus(mesh: Mesh, sectors: int, tol: float = 1e-9, origin=(0.0, 0.0, 0.0)) -> Mesh:
+    """The whole disk: ``mesh`` rotated by ``j·360°/N`` about the line through ``origin`` along +x (scipy),
+    coincident nodes merged."""
     btype = mesh.body_type
     n = mesh.points.shape[0]
-    pts = np.vstack([Rotation.from_rotvec([2 * np.pi * j / sectors, 0, 0]).apply(mesh.points)
+    o = np.asarray(origin, dtype=float)
+    pts = np.vstack([Rotation.from_rotvec([2 * np.pi * j / sectors, 0, 0]).apply(mesh.points - o) + o
                      for j in range(sectors)])
     cells = np.vstack([np.asarray(mesh.cells[btype]) + j * n for j in range(sectors)])
     tree = cKDTree(pts)

@@ -17,7 +17,7 @@ geometrically nonlinear static state, large rotations), :mod:`~bladecase.fe.camp
 :mod:`~bladecase.fe.storage` (stage files), :mod:`~bladecase.fe.calculix` (the model as a CalculiX deck, its
 frequencies back), :mod:`~bladecase.fe.cyclic` (:func:`fe_sector`, :func:`cyclic_modes`: a bladed disk's modes by
 nodal diameter from one sector) + :mod:`~bladecase.fe.cyclic_waves` (a sector mode on the whole disk, standing or
-travelling).
+travelling), :mod:`~bladecase.fe.sector` (:func:`sector_mesh`: a parametric bladed-disk sector).
 """
 
 from .assembly import assemble
@@ -30,6 +30,7 @@ from .mesh import Mesh, load_mesh, save_mesh
 from .model import DofMap, FEModel, node_operator
 from .naca import naca_parameters, naca_section
 from .nonlinear_static import NonlinearState, nonlinear_state
+from .sector import SectorGeometry, sector_mesh
 from .select import select_nodes
 from .storage import load_model, model_from_arrays, model_to_arrays, save_model, sparse_from_arrays, sparse_to_arrays
 
@@ -37,11 +38,12 @@ __all__ = [
     "AL6061T6", "INCONEL718", "PRESETS", "STEEL", "TI6AL4V",
     "BladeGeometry", "CyclicModes", "CyclicSector",
     "DofMap", "FEModel", "MappingCurved", "Material", "Mesh", "NonlinearState", "PlateGeometry",
+    "SectorGeometry",
     "assemble", "blade_mesh", "cad_volume", "curved_geometry", "cyclic_modes", "cyclic_spectrum", "fe_sector",
     "load_mesh", "load_model", "model_from_arrays",
     "model_to_arrays",
     "naca_parameters", "naca_section", "natural_frequencies", "node_operator", "nonlinear_state", "save_mesh",
     "save_model",
-    "select_nodes",
+    "sector_mesh", "select_nodes",
     "sparse_from_arrays", "sparse_to_arrays", "stiffness_factor",
 ]
