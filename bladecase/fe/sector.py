@@ -206,6 +206,9 @@ def sector_mesh(geometry: SectorGeometry, size: float | None = None, order: int 
             raise
         except Exception as exc:
             raise RuntimeError(f"gmsh failed to mesh {g!r}: {exc}") from None
-        mesh = load_mesh(target)
+        try:
+            mesh = load_mesh(target)
+        except ValueError as exc:
+            raise RuntimeError(f"gmsh made an invalid mesh of {g!r} (try another size or order): {exc}") from None
     groups = _groups(mesh, g, g.blade.contact_point)
     return replace(mesh, groups=groups, source=f"sector_mesh({g!r})")
