@@ -193,3 +193,27 @@ def test_order_two_sector_on_first_order_cells_matches_its_annulus():
     below = f_ring[f_ring < complete * (1 - 1e-6)]
     assert below.size >= 10
     assert np.max(np.abs(union[:below.size] - below) / below) < 1e-8
+
+
+def test_an_unmatched_face_node_is_named(disk):
+    import dataclasses
+
+    n = 8
+    model, _ = disk[n]
+    mesh = model.mesh
+    theta = np.arctan2(-mesh.points[:, 1], mesh.points[:, 2])
+    right = np.flatnonzero(np.isclose(theta, np.pi / n))
+    moved = right[np.argmax(np.hypot(mesh.points[right, 1], mesh.points[right, 2]))]  # a tip node of the face
+    pts = mesh.points.copy()
+    pts[moved, 0] += 1e-4
+    bent = assemble(dataclasses.replace(mesh, points=pts), "steel", order=1, clamp="hub")
+    left = np.flatnonzero(np.isclose(theta, -np.pi / n))
+    partner = Rotation.from_rotvec([-2 * np.pi / n, 0, 0]).apply(mesh.points[moved])
+    (twin,) = left[np.linalg.norm(mesh.points[left] - partner, axis=1) < 1e-12]
+    x, y, z = mesh.points[twin]
+    with pytest.raises(ValueError, match=rf"^1 node\(s\) of the left cyclic face, rotated by 360°/8 about the axis, "
+                                         rf"meet no free node of the right face within tol = 2.6e-07: node {twin} at "
+                                         rf"\({x:.6g}, {y:.6g}, {z:.6g}\) \(nearest at 0.0001;"):
+        fe_sector(bent, n, AXIS, left=left, right=right)
+    with pytest.raises(ValueError, match="K is not symmetric"):
+        CyclicSector(sp.csr_array([[2.0, -1.0], [0.0, 1.0]]), sp.eye_array(2), 4, left=[0], right=[1])

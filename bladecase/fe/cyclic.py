@@ -41,7 +41,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
-from ..checks import integer
+from ..checks import integer, symmetric
 from ..linalg import DENSE_LIMIT, lowest_modes, spd_factor
 from .model import FEModel
 from .rotation import RotationAxis
@@ -127,6 +127,10 @@ class CyclicSector:
         if self.K.shape != (n, n) or self.M.shape != (n, n):
             raise ValueError(f"K {self.K.shape} and M {self.M.shape} must be square matrices of one size")
         object.__setattr__(self, "sectors", integer("sectors", self.sectors, 2))
+        for name in ("K", "M"):
+            a = sp.csr_array(getattr(self, name), dtype=float)
+            symmetric(name, a)
+            object.__setattr__(self, name, a)
         left, right = (np.asarray(v, dtype=np.int64).ravel() for v in (self.left, self.right))
         if left.size != right.size or left.size == 0:
             raise ValueError(f"the cyclic faces must have the same number (>= 1) of dofs: left {left.size}, "

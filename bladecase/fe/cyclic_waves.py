@@ -48,6 +48,9 @@ def rotate_field(sector: CyclicSector, u: np.ndarray, angle: float) -> np.ndarra
     u = np.array(u, dtype=np.result_type(u, float))
     if sector.triples is None or angle == 0.0:
         return u
+    if sector.triples.size != sector.n_dofs:
+        raise ValueError(f"{sector.n_dofs - sector.triples.size} dofs of the sector sit at nodes with some but not "
+                         "all directions fixed: their displacement cannot be turned into another sector's frame")
     R = rotation_matrix(sector.axis.direction, angle)
     t = sector.triples
     block = u[t]                                   # (q, 3) or (q, 3, c)
