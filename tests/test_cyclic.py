@@ -212,8 +212,33 @@ def test_an_unmatched_face_node_is_named(disk):
     (twin,) = left[np.linalg.norm(mesh.points[left] - partner, axis=1) < 1e-12]
     x, y, z = mesh.points[twin]
     with pytest.raises(ValueError, match=rf"^1 node\(s\) of the left cyclic face, rotated by 360°/8 about the axis, "
-                                         rf"meet no free node of the right face within tol = 2.6e-07: node {twin} at "
+                                         rf"meet no free node of the right face within tol = 2.6e-07 m: node {twin} at "
                                          rf"\({x:.6g}, {y:.6g}, {z:.6g}\) \(nearest at 0.0001;"):
         fe_sector(bent, n, AXIS, left=left, right=right)
+    assert len(fe_sector(bent, n, AXIS, left=left, right=right, tol=2e-4).pairs) == len(left) - 3  # hub nodes
+    with pytest.raises(ValueError, match=r"within tol = 0.05 mm: node"):
+        fe_sector(dataclasses.replace(bent, mesh=dataclasses.replace(mesh, unit="mm")), n, AXIS, left=left,
+                  right=right, tol=0.05)
+    with pytest.raises(ValueError, match=r"tol must be a finite length > 0 \(in the mesh's unit, m\), got -1"):
+        fe_sector(model, n, AXIS, tol=-1)
     with pytest.raises(ValueError, match="K is not symmetric"):
         CyclicSector(sp.csr_array([[2.0, -1.0], [0.0, 1.0]]), sp.eye_array(2), 4, left=[0], right=[1])
+
+
+def test_any_axis_gives_the_same_spectrum(disk):
+    """The 8-sector disk moved to an oblique axis through another point (and the axis reversed): the same
+    frequencies for every nodal diameter, the faces found by angle and matched by the rotation about that axis."""
+    import dataclasses
+
+    n = 8
+    model, _ = disk[n]
+    ref = cyclic_spectrum(fe_sector(model, n, AXIS), count=3)
+    a = np.array([1.0, 2.0, -2.0]) / 3.0
+    turn = Rotation.align_vectors([a], [[1.0, 0.0, 0.0]])[0]  # +x onto a
+    origin = np.array([0.1, -0.2, 0.3])
+    mesh = dataclasses.replace(model.mesh, points=turn.apply(model.mesh.points) + origin)
+    moved = assemble(mesh, "steel", order=1, clamp="hub")
+    for direction in (a, -a):
+        spectrum = cyclic_spectrum(fe_sector(moved, n, RotationAxis(origin, direction)), count=3)
+        for k in ref:
+            assert np.allclose(spectrum[k].frequencies, ref[k].frequencies, rtol=1e-9, atol=0)

@@ -43,6 +43,7 @@ from scipy.spatial import cKDTree
 
 from ..checks import integer, symmetric
 from ..linalg import DENSE_LIMIT, lowest_modes, spd_factor
+from .mesh_checks import LENGTH_UNITS
 from .model import FEModel
 from .rotation import RotationAxis
 
@@ -425,7 +426,9 @@ def fe_sector(model: FEModel, sectors: int, axis: RotationAxis, *, left=None, ri
         The cyclic faces as node groups of the mesh (names or node indices); ``None`` (both): found by the sector
         angle — the nodes at its least and greatest angle about the axis (within ``tol``).
     tol : float or None
-        Matching tolerance in the mesh's length unit (``None``: ``1e-6`` × the largest radius).
+        Matching tolerance in the mesh file's length unit (``mesh.unit``, e.g. millimetres for a deck read with
+        ``unit="mm"``; ``None``: ``1e-6`` × the sector's largest radius).  The mesh's points, the axis and the
+        coordinates in messages are in metres, as everywhere in bladecase.
 
     Raises
     ------
@@ -442,9 +445,14 @@ def fe_sector(model: FEModel, sectors: int, axis: RotationAxis, *, left=None, ri
         raise ValueError(f"axis must be a RotationAxis (the engine axis), got {axis!r}")
     pts, triples = _locations(model)
     radius = float(sector_angles(pts, axis)[0].max())
-    tol = FACE_RTOL * radius if tol is None else float(tol)
-    if not (math.isfinite(tol) and tol > 0):
-        raise ValueError(f"tol must be a finite length > 0 (the mesh's unit), got {tol!r}")
+    unit = model.mesh.unit if model.mesh.unit in LENGTH_UNITS else "m"
+    if tol is None:
+        tol = FACE_RTOL * radius
+    else:
+        given = float(tol) if isinstance(tol, (int, float, np.integer, np.floating)) else float("nan")
+        if isinstance(tol, bool) or not (math.isfinite(given) and given > 0):
+            raise ValueError(f"tol must be a finite length > 0 (in the mesh's unit, {unit}), got {tol!r}")
+        tol = given * LENGTH_UNITS[unit]  # the points are in metres
     li, ri = _faces(model, pts, triples, axis, sectors, left, right, tol)
     for name, idx in (("left", li), ("right", ri)):
         partial = idx[(triples[idx] < 0).any(axis=1)]
@@ -457,7 +465,8 @@ def fe_sector(model: FEModel, sectors: int, axis: RotationAxis, *, left=None, ri
     bad = dist > tol
     if bad.any():
         raise ValueError(f"{int(bad.sum())} node(s) of the left cyclic face, rotated by 360°/{sectors} about the axis, "
-                         f"meet no free node of the right face within tol = {tol:g}: {_name_nodes(model, pts[li[bad]])}"
+                         f"meet no free node of the right face within tol = {tol / LENGTH_UNITS[unit]:g} {unit}: "
+                         f"{_name_nodes(model, pts[li[bad]])}"
                          f" (nearest at {dist[bad].min():.3g}; right = left rotated by +360°/N about the axis "
                          "direction: swapped faces, a wrong axis, or a non-conforming mesh?)")
     if np.unique(j).size != li.size or li.size != ri.size:
