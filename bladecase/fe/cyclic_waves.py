@@ -32,11 +32,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from ..checks import finite, integer
 from .cyclic import CyclicModes, CyclicSector, rotation_matrix
+from .mesh import Mesh
+from .model import FEModel, node_operator
 
-__all__ = ["WAVES", "annulus_field", "annulus_points", "rotate_field"]
+__all__ = ["WAVES", "annulus_field", "annulus_mesh", "annulus_nodes", "annulus_points", "rotate_field"]
 
 #: The expansions of :func:`annulus_field`.
 WAVES = ("cos", "sin", "forward", "backward")
@@ -98,3 +101,41 @@ def annulus_points(points: np.ndarray, sector: CyclicSector) -> np.ndarray:
     o = sector.axis.origin
     return np.stack([(pts - o) @ rotation_matrix(sector.axis.direction, j * sector.alpha).T + o
                      for j in range(sector.sectors)])
+
+
+def annulus_mesh(mesh: Mesh, sector: CyclicSector, tol: float | None = None) -> tuple[Mesh, np.ndarray]:
+    """The whole disk as one mesh: sector 0's ``mesh`` placed in every sector, the coincident nodes of the cut
+    faces merged (within ``tol`` m; ``None``: ``1e-9`` of the largest coordinate).
+
+    Returns
+    -------
+    (Mesh, (N, nodes) int ndarray)
+        The disk's mesh (body cells only; each group of the sector's mesh holds its nodes in every sector) and the
+        disk node of each sector's node.
+    """
+    pts = annulus_points(mesh.points, sector)
+    n_sec, n = pts.shape[:2]
+    flat = pts.reshape(-1, 3)
+    tol = 1e-9 * float(np.abs(flat).max()) if tol is None else float(tol)
+    rep = np.arange(flat.shape[0])
+    for a, b in sorted(cKDTree(flat).query_pairs(tol)):
+        rep[max(a, b)] = min(rep[a], rep[b])
+    rep = rep[rep]
+    used, inverse = np.unique(rep, return_inverse=True)
+    index = inverse.reshape(n_sec, n)
+    btype = mesh.body_type
+    cells = np.vstack([index[j][np.asarray(mesh.cells[btype])] for j in range(n_sec)])
+    groups = {name: np.unique(index[:, np.asarray(g)]) for name, g in mesh.groups.items()}
+    out = Mesh(flat[used], {btype: cells}, dim=3, groups=groups, source=f"annulus of {n_sec} sectors of "
+               f"{mesh.source or 'a sector'}", unit=mesh.unit)
+    return out, index
+
+
+def annulus_nodes(model: FEModel, field: np.ndarray, index: np.ndarray) -> np.ndarray:
+    """``(disk nodes, 3)``: the displacements of :func:`annulus_field` (rows: sectors) at the nodes of the disk's
+    mesh (``index`` from :func:`annulus_mesh`); a node shared by two sectors gets the same value from both."""
+    ops = node_operator(model)
+    out = np.zeros((int(index.max()) + 1, 3))
+    for j, row in enumerate(np.asarray(field)):
+        out[index[j]] = (ops @ row).reshape(-1, 3)
+    return out
