@@ -265,3 +265,13 @@ def test_annulus_mesh_carries_the_expanded_wave(disk):
     assert np.abs(u_nodes[mesh.group("hub")]).max() == 0.0
     Ku = ring.K @ u
     assert np.linalg.norm(Ku - modes.lam[1] * (ring.M @ u)) / np.linalg.norm(Ku) < 1e-8
+
+
+def test_pairs_list_mesh_nodes_only():
+    n = 6
+    mesh = hex_sector(n, nr=1, nb=2, nt=2, nx=1, band=(0, 2))
+    p1 = fe_sector(assemble(mesh, "steel", order=1, clamp="hub"), n, AXIS)
+    p2 = fe_sector(assemble(mesh, "steel", order=2, clamp="hub"), n, AXIS)
+    assert np.array_equal(p1.pairs, p2.pairs) and len(p2.left) > len(p1.left)
+    turned = Rotation.from_rotvec([2 * np.pi / n, 0, 0]).apply(mesh.points[p1.pairs[:, 0]])
+    assert np.allclose(turned, mesh.points[p1.pairs[:, 1]], atol=1e-12)

@@ -110,7 +110,8 @@ class CyclicSector:
     axis : RotationAxis or None
         The engine axis (``None`` for a lumped model).
     pairs : (m, 2) int array or None
-        The matched ``(left, right)`` mesh nodes (:func:`fe_sector`), for reference.
+        The matched ``(left, right)`` mesh nodes with free dofs (:func:`fe_sector`; the edge and face dofs of an
+        order-2 model on first-order cells, which sit at no mesh node, are matched too but not listed here).
     """
 
     K: object
@@ -477,7 +478,9 @@ def fe_sector(model: FEModel, sectors: int, axis: RotationAxis, *, left=None, ri
     L, Rt = triples[li], triples[ri[j]]
     link = sp.block_diag([sp.csr_array(R)] * li.size, format="csr")
     full = triples[(triples >= 0).all(axis=1)]
-    _, node_l = cKDTree(model.mesh.points).query(pts[li])
-    _, node_r = cKDTree(model.mesh.points).query(pts[ri[j]])
+    tree = cKDTree(model.mesh.points)
+    (dl, node_l), (dr, node_r) = tree.query(pts[li]), tree.query(pts[ri[j]])
+    at_nodes = (dl <= 1e-9 * radius) & (dr <= 1e-9 * radius)  # not the edge dofs of P2 on first-order cells
+    node_l, node_r = node_l[at_nodes], node_r[at_nodes]
     return CyclicSector(model.K, model.M, sectors, L.ravel(), Rt.ravel(), link, full, axis,
                         np.column_stack([node_l, node_r]))
