@@ -17,7 +17,8 @@ geometrically nonlinear static state, large rotations), :mod:`~bladecase.fe.camp
 :mod:`~bladecase.fe.storage` (stage files), :mod:`~bladecase.fe.calculix` (the model as a CalculiX deck, its
 frequencies back), :mod:`~bladecase.fe.cyclic` (:func:`fe_sector`, :func:`cyclic_modes`: a bladed disk's modes by
 nodal diameter from one sector) + :mod:`~bladecase.fe.cyclic_waves` (a sector mode on the whole disk, standing or
-travelling), :mod:`~bladecase.fe.sector` (:func:`sector_mesh`: a parametric bladed-disk sector).
+travelling) + :mod:`~bladecase.fe.cyclic_spin` (a spinning disk from one sector, Campbell per nodal diameter),
+:mod:`~bladecase.fe.sector` (:func:`sector_mesh`: a parametric bladed-disk sector).
 """
 
 from .assembly import assemble
