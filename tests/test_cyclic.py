@@ -275,3 +275,21 @@ def test_pairs_list_mesh_nodes_only():
     assert np.array_equal(p1.pairs, p2.pairs) and len(p2.left) > len(p1.left)
     turned = Rotation.from_rotvec([2 * np.pi / n, 0, 0]).apply(mesh.points[p1.pairs[:, 0]])
     assert np.allclose(turned, mesh.points[p1.pairs[:, 1]], atol=1e-12)
+
+
+def test_sector_modes_satisfy_the_cyclic_constraint_and_are_normalised(disk):
+    n = 8
+    model, _ = disk[n]
+    sector = fe_sector(model, n, AXIS)
+    R = Rotation.from_rotvec([2 * np.pi / n, 0, 0]).as_matrix()
+    for k in (0, 1, 3, 4):
+        modes = cyclic_modes(sector, k, 3)
+        phi = modes.shapes
+        assert np.allclose(phi.conj().T @ (model.M @ phi), np.eye(3), atol=1e-10)
+        left = phi[sector.left].reshape(-1, 3, 3)   # (face nodes, xyz, modes)
+        right = phi[sector.right].reshape(-1, 3, 3)
+        assert np.allclose(right, np.exp(1j * k * 2 * np.pi / n) * np.einsum("ab,qbm->qam", R, left), atol=1e-12)
+        top = phi[np.argmax(np.abs(phi), axis=0), range(3)]
+        assert np.allclose(top.imag, 0, atol=1e-15) and np.all(top.real > 0)
+        if k in (0, 4):
+            assert np.abs(phi.imag).max() < 1e-12  # standing waves only: a real mode

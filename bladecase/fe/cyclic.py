@@ -201,8 +201,9 @@ class CyclicModes:
     lam : (c,) ndarray
         Eigenvalues ``ω²`` (rad²/s²), ascending.
     shapes : (n, c) complex ndarray
-        The sector's complex modes on all its dofs, ``φᴴ M φ = 1``; the real part is the cosine standing wave,
-        the imaginary part the sine one (real for ``k = 0`` and ``k = N/2``).
+        The sector's complex modes on all its dofs, ``φᴴ M φ = 1``, each with its largest entry real and positive;
+        the real part is the cosine standing wave, the imaginary part the sine one (real for ``k = 0`` and
+        ``k = N/2``).
     size : int
         Unknowns of the solved real problem (``m``, or ``2m`` for ``0 < k < N/2``).
     seconds : float
@@ -257,7 +258,9 @@ def _complex_modes(sector: CyclicSector, Tr, Ti, lam: np.ndarray, V: np.ndarray,
             out.append(b)
         start = stop
     order = np.argsort(out_lam)[:count]
-    return np.asarray(out_lam)[order], np.column_stack(out)[:, order]
+    shapes = np.column_stack(out)[:, order]
+    top = shapes[np.argmax(np.abs(shapes), axis=0), np.arange(shapes.shape[1])]
+    return np.asarray(out_lam)[order], shapes * (np.abs(top) / top)[None, :]  # largest entry real and positive
 
 
 def _real_form(sector: CyclicSector, k: int):
