@@ -133,8 +133,8 @@ def numbers(name: str, a, complex_ok: bool = False) -> None:
 
 
 def _max_abs(a) -> float:
-    if hasattr(a, "nnz"):  # scipy sparse
-        return float(abs(a).max()) if a.nnz else 0.0
+    if hasattr(a, "nnz"):  # scipy sparse, whatever its format (a dia array has no max: its stored values)
+        return float(np.abs(a.tocoo().data).max(initial=0.0))
     return float(np.abs(a).max()) if a.size else 0.0
 
 

@@ -20,7 +20,7 @@ import scipy.sparse as sp
 from ..linalg import spd_factor, symmetric_factor
 from .cyclic import CyclicSector, cyclic_basis, cyclic_modes, nodal_diameters
 from .model import FEModel
-from .rotation import _operators, to_rad_s
+from .centrifugal import _operators, to_rad_s
 
 __all__ = ["CyclicSpin", "cyclic_campbell", "cyclic_spin"]
 
