@@ -18,9 +18,9 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..linalg import spd_factor, symmetric_factor
+from .centrifugal import _operators, to_rad_s
 from .cyclic import CyclicSector, cyclic_basis, cyclic_modes, nodal_diameters
 from .model import FEModel
-from .centrifugal import _operators, to_rad_s
 
 __all__ = ["CyclicSpin", "cyclic_campbell", "cyclic_spin"]
 
