@@ -349,11 +349,11 @@ def test_interrupted_run_leaves_previous_results_untouched(tmp_path, plate_toml,
 
 
 def test_ctrl_c_in_a_stage_command(capsys, monkeypatch):
-    import bladecase.cli as cli
+    import bladecase.cli_backbone as backbone
 
     def interrupted(args):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(cli, "_load_system", interrupted)
+    monkeypatch.setattr(backbone, "load_system", interrupted)
     code, err = _run(CHAIN, capsys)
     assert code == 130 and _one_error_line(err) == "bladecase backbone: interrupted, previous results untouched"
