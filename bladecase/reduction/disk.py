@@ -261,6 +261,17 @@ def disk_model(sector: CyclicSector, contact, gap, count: int = 4, *, cutoff: fl
         The casing's stiffness at each contact of a blade (N/m; ``None``: rigid).
     diameters : dict or None
         ``{k: Diameter}`` already computed (:func:`diameter`), reused.
+
+    A lumped disk of 5 blades (disk, blade, massless tip per sector), every mode kept: the residual flexibility is
+    the tips' own springs (1/2 each, uncoupled):
+
+    >>> import scipy.sparse as sp
+    >>> from bladecase.fe.cyclic import CyclicSector
+    >>> K = np.array([[4.7, -1.0, 0.0, -0.7], [-1.0, 3.0, -2.0, 0.0], [0.0, -2.0, 2.0, 0.0], [-0.7, 0.0, 0.0, 0.7]])
+    >>> ring = CyclicSector(sp.csr_array(K), sp.csr_array(np.diag([2.0, 0.5, 0.0, 0.0])), 5, left=[0], right=[3])
+    >>> disk = disk_model(ring, [[0.0], [0.0], [1.0], [0.0]], 0.1, count=2)
+    >>> disk.system.n, bool(np.allclose(disk.system.flexibility, np.eye(5) / 2.0))
+    (10, True)
     """
     start = time.perf_counter()
     W, gap = _check_contact(sector, contact, gap)

@@ -127,6 +127,17 @@ def rotating_orbit(system: NodalSystem, shift, fraction: int, guess, *, energy: 
     (module docstring), the phase fixed by ``v₀[phase] = 0`` (default: the guess's largest displacement).
 
     Raises ``ValueError`` when Newton does not converge (the period and the residual are named).
+
+    Two blades (unit masses on unit springs, coupled by 0.1, massless tips on unit springs at a clearance 0.1):
+    the wave of nodal diameter 1 (blade 1 half a period after blade 0), ``x(T/2) = P x(0)``, ``P`` the swap:
+
+    >>> s = NodalSystem(np.eye(2), np.array([[1.1, -0.1], [-0.1, 1.1]]), np.eye(2), np.eye(2),
+    ...                 gap=[0.1, 0.1])
+    >>> P = np.array([[0.0, 1.0], [1.0, 0.0]])
+    >>> w = np.sqrt(1.2)                                  # the opposed linear mode (1, −1)
+    >>> o = rotating_orbit(s, P, 2, (0.12 * np.array([1.0, -1.0]), np.zeros(2), 2 * np.pi / w), T=0.97 * 2 * np.pi / w)
+    >>> bool(o.touching), bool(return_error(s, o.x0, o.v0, o.T, periods=5) < 1e-10)
+    (True, True)
     """
     if (T is None) == (energy is None):
         raise ValueError("rotating_orbit: give exactly one of T and energy")
