@@ -185,3 +185,30 @@ def test_bad_input_is_refused_with_its_reason():
         disk.travelling_wave(3)
     with pytest.raises(ValueError, match="exactly one"):
         rotating_orbit(disk.system, disk.shift(1), 6, (np.ones(disk.system.n), np.zeros(disk.system.n), 1.0))
+
+
+def test_the_disk_rubs_an_out_of_round_casing_through_the_executor():
+    """Each blade sees the lobes at its own angle. Lobes ≡ 0 (mod N): every blade sees the same clearance at the
+    same instant, the response is the nodal-diameter-0 sector's alone (its own model, angle 0). Any lobes: the
+    pattern travels round the disk, every blade rubs as hard as the others."""
+    from bladecase.nsm import Damping
+    from bladecase.nsm.massless.rub import rub_response, rub_sweep
+    from bladecase.study.executor import make_executor
+
+    n = 6
+    ring = _ring(n)
+    disk = disk_model(ring, TIP, GAP, count=2)
+    damping = Damping(zeta=0.05)
+    speeds = [0.9 / n]  # lobes × Ω below the first frequency, 1 rad/s
+    out = rub_sweep(disk.system, speeds, n, 0.15, disk.angles(), damping, revolutions=12, window=3,
+                    executor=make_executor("serial"))
+    one = sector_system(ring, TIP, GAP, 0, count=2)
+    for speed, r in zip(speeds, out):
+        ref = rub_response(one, speed, n, 0.15, [0.0], damping, revolutions=12, window=3)
+        assert r.peak_force.max() > 0 and r.touching == tuple(range(n))
+        assert np.allclose(r.peak_force, ref.peak_force[0], rtol=1e-8), (r.peak_force, ref.peak_force)
+        assert np.allclose(r.contact_fraction, ref.contact_fraction[0], rtol=1e-8)
+    r = rub_sweep(disk.system, [1.05], 1, 0.15, disk.angles(), Damping(zeta=0.1), revolutions=12, window=3,
+                  executor=make_executor("serial"))[0]
+    assert r.settled and r.peak_force.max() > 0  # settled to 2 %: the blades alike to that
+    assert np.ptp(r.peak_force) <= 0.02 * r.peak_force.max(), r.peak_force

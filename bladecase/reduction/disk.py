@@ -223,6 +223,23 @@ class DiskModel:
         v0[b] = omega if k < self.sectors / 2 else -omega
         return x0, v0, omega
 
+    def angles(self, offsets=None) -> np.ndarray:
+        """Each contact's angle about the engine axis (rad), blade-major: ``jα + offsets[i]`` for contact ``i`` of
+        blade ``j`` (``offsets``: the contacts' own angles within blade 0, default 0) — the ``angles`` of
+        :func:`~bladecase.nsm.massless.rub.rub_response` for the disk in an out-of-round casing (each blade sees the
+        lobes at its own angle).
+
+        >>> import scipy.sparse as sp
+        >>> from bladecase.fe.cyclic import CyclicSector
+        >>> s = CyclicSector(sp.csr_array([[3.0, -1.0, -1.0], [-1.0, 1.0, 0.0], [-1.0, 0.0, 1.0]]),
+        ...                  sp.csr_array(np.diag([1.0, 0.0, 0.0])), 4, left=[0], right=[2])
+        >>> np.degrees(disk_model(s, [[0.0], [1.0], [0.0]], 0.1, 1).angles()).round(9).tolist()
+        [0.0, 90.0, 180.0, 270.0]
+        """
+        off = np.zeros(self.per_blade) if offsets is None else np.broadcast_to(
+            np.asarray(offsets, dtype=float), (self.per_blade,))
+        return (np.arange(self.sectors)[:, None] * self.alpha + off[None, :]).ravel()
+
     def blade_displacements(self, x) -> np.ndarray:
         """``(N, n_dofs)``: every sector's displacements in its own frame for the reduced state ``x`` (every contact
         open; the contact dofs follow statically)."""
