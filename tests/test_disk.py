@@ -88,6 +88,10 @@ def test_the_blade_shift_commutes_with_the_model():
         Pb = np.roll(np.eye(n), -shift, axis=0)
         assert np.allclose(Pb @ s.H @ Pb.T, s.H, atol=1e-14)
     assert np.allclose(np.linalg.matrix_power(disk.shift(1), n), np.eye(s.n), atol=1e-12)
+    x = np.random.default_rng(2).normal(size=s.n)  # every sector's displacements: its contact is the model's
+    u = disk.blade_displacements(x)
+    assert np.allclose(u @ np.asarray(TIP)[:, 0], s.W.T @ x, atol=1e-13)
+    assert np.allclose(u[:, 3], np.roll(u[:, 0], -1), atol=1e-13)  # right face = next sector's left face
 
 
 def test_a_standing_wave_of_one_blade_is_the_annulus_orbit():
