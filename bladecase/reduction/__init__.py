@@ -14,6 +14,7 @@ method), :mod:`~bladecase.reduction.storage` (stage files).
 """
 
 from .contact import Contact, radial_normal
+from .disk import DiskModel, disk_model, massless_sector, sector_system
 from .extension import krylov_extension
 from .lanczos import LanczosChain, chain_grounding, chain_jacobi, lanczos_chain
 from .loads import EngineOrderLoad, engine_order_load, nodal_load, pressure_load, project_load
@@ -25,7 +26,8 @@ from .storage import load_reduced, save_reduced
 from .symmetry import MassFactor, PerDofDefect, SymmetryBasis, mass_factor, per_dof_defect, per_dof_law
 
 __all__ = [
-    "FULL_LIMIT", "METHODS", "Contact", "EngineOrderLoad", "LanczosChain", "MassFactor", "MasslessReducedModel",
+    "FULL_LIMIT", "METHODS", "Contact", "DiskModel", "disk_model", "massless_sector", "sector_system",
+    "EngineOrderLoad", "LanczosChain", "MassFactor", "MasslessReducedModel",
     "PerDofDefect",
     "ReducedModel", "Registry", "SymmetryBasis", "chain_grounding", "chain_jacobi", "krylov_extension",
     "lanczos_chain", "load_reduced",

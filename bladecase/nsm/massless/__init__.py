@@ -47,6 +47,7 @@ this package is the function; the module is ``bladecase.nsm.massless.bar`` in ``
 
 from .bar import CONTACT_MODELS, bar, bar_continuum_band_energy, bar_continuum_energy, bar_continuum_field
 from .branches import ARC_RTOL, massless_mode, massless_modes, massless_orbit_at
+from .disk_modes import RotatingOrbit, full_orbit, return_error, rotating_family, rotating_orbit
 from .follow import EDGE_RTOL, MAX_HALF_PHASES, VANISH_RTOL, follow_mode, solve_at_period
 from .forced import ExpSignal, MasslessForcedFlight, MasslessForcedTrajectory, simulate_forced_massless
 from .friction import (
@@ -100,6 +101,7 @@ from .wear import Abradable, WearProfile, pass_tip
 
 __all__ = [
     # nodes, nodal_modes, nodal_resonance, rub
+    "RotatingOrbit", "full_orbit", "return_error", "rotating_family", "rotating_orbit",
     "NodalFamily", "NodalOrbit", "flow_map", "grazing_orbit", "nodal_family", "nodal_orbit", "transfer_state",
     "BACKBONE_SHARE", "RESONANCE_SHARE", "TONGUE_POINTS", "backbone_trend", "resonance_ratio",
     "NodalFlight", "NodalSystem", "NodalTrajectory", "Rub", "lcp", "simulate_nodes", "RubResponse", "rub_response",
