@@ -38,7 +38,7 @@ from .documents import model_summary
 from .executor import Executor
 from .modes_run import compute_modes
 from .schema import Study, StudyError
-from .stages import build_mesh, build_model, selected_nodes
+from .stages import build_model, selected_nodes
 
 __all__ = ["compute_cyclic", "compute_linear", "deck_cyclic", "engine_order_table"]
 
@@ -90,6 +90,21 @@ def _sector_mesh(study: Study):
     return study, mesh, geometry
 
 
+def _file_mesh(study: Study):
+    """The study's mesh file (``[mesh]``), its clamp group checked (a disk has no contact group to check)."""
+    from ..fe import load_mesh
+
+    source, m = study.mesh_path(), study["mesh"]
+    if not source.exists():
+        raise StudyError(f"[mesh] path: no such file {str(source)!r}")
+    mesh = load_mesh(source, unit=m.get("unit") or "m", file_format=m.get("format"))
+    clamp = study["fem"]["clamp"]
+    if isinstance(clamp, str) and clamp not in mesh.groups:
+        raise StudyError(f"[fem] clamp: the mesh {mesh.source} has no group {clamp!r} (groups: "
+                         f"{', '.join(sorted(mesh.groups)) or 'none'})")
+    return mesh
+
+
 def _setup(study: Study, mesh, deck: dict | None, geometry) -> dict:
     """N, the axis (m), the face groups and the tolerance (mesh unit) of the study's sector."""
     cy = study["cyclic"]
@@ -108,6 +123,8 @@ def _setup(study: Study, mesh, deck: dict | None, geometry) -> dict:
         except ValueError as exc:
             raise StudyError(f"the deck's *CYCLIC SYMMETRY MODEL axis ({deck['where']}): {exc}") from None
         faces, tol, where = (deck["left"], deck["right"]), deck.get("tol"), f"the deck ({deck['where']})"
+        if deck.get("problem") and cy["left"] is None:
+            raise StudyError(f"[cyclic] left, right: {deck['problem']} ({deck['where']})")
     else:
         n = cy["sectors"]
         if n is None:
@@ -253,7 +270,7 @@ def compute_cyclic(study: Study, staging: Path, stage, progress: bool, executor:
         if study.parametric:
             study, mesh, geometry = _sector_mesh(study)
         else:
-            mesh = build_mesh(study)
+            mesh = _file_mesh(study)
         setup = _setup(study, mesh, deck, geometry)
         study, mesh = _clamp_images(study, mesh, setup)
         save_mesh(mesh, staging / "mesh.vtu")
