@@ -169,3 +169,11 @@ def test_an_element_based_tie_surface_needs_groups(tmp_path, capsys):
     deck = sector_deck().replace("*SURFACE, NAME=SLEFT, TYPE=NODE\nLEFT", "*SURFACE, NAME=SLEFT\n1, S1")
     err = _fails(tmp_path, capsys, deck)
     assert "surface 'SLEFT' is element-based" in err and "[cyclic] left and right" in err, err
+
+
+def test_an_empty_cyclic_section_needs_a_cyclic_deck(tmp_path, capsys):
+    deck = sector_deck()
+    deck = deck[:deck.index("*SURFACE")] + deck[deck.index("*STEP"):]
+    deck = re.sub(r"\*SELECT CYCLIC SYMMETRY MODES.*\n", "", deck)
+    err = _fails(tmp_path, capsys, deck)
+    assert "declares no *CYCLIC SYMMETRY MODEL: give [cyclic] sectors = N" in err, err

@@ -67,6 +67,9 @@ def compute_linear(study: Study, staging: Path, stage, progress: bool, executor:
     deck = deck_cyclic(study)
     if cyclic_requested(study.config) or deck is not None:
         return compute_cyclic(study, staging, stage, progress, executor, deck)
+    if not (study.config.get("rotation") or {}).get("speeds"):
+        raise StudyError(f"[cyclic]: the mesh {study.mesh_path()} declares no *CYCLIC SYMMETRY MODEL: give [cyclic] "
+                         "sectors = N (and [rotation] axis, the engine axis) for a sector mesh")
     return compute_modes(study, staging, stage, progress, executor)
 
 

@@ -12,6 +12,11 @@ CalculiX/Abaqus deck that declares ``*CYCLIC SYMMETRY MODEL`` is cyclic too with
 ... ''')
 >>> cyclic_requested(s.config), s["cyclic"]["diameters"], s["cyclic"]["expand"]
 (True, [0, 1, 6], {'diameter': 1, 'mode': 1, 'wave': 'backward'})
+>>> cyclic_requested(loads('''
+... mesh = {path = "blade.inp"}
+... contact = {clearance = 1e-4}
+... ''').config)
+False
 """
 
 from __future__ import annotations
@@ -91,7 +96,7 @@ def cyclic_requested(c: dict) -> bool:
     if (c.get("geometry") or {}).get("kind") == "sector":
         return True
     cy = c.get("cyclic") or {}
-    return any(cy.get(k) not in (None, []) for k in CYCLIC_KEYS)
+    return any(k in cy and cy[k] != spec.default for k, spec in CYCLIC_KEYS.items())
 
 
 def expand_spec(cy: dict, sectors: int) -> dict:
