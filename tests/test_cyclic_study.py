@@ -115,3 +115,40 @@ def test_too_few_sectors_for_a_sector_geometry(tmp_path, capsys):
     path.write_text(GEOMETRY.replace(f"sectors = {N}", "sectors = 2") + "\n")
     assert main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 2
     assert "[geometry] sectors: must be" in capsys.readouterr().err
+
+
+def _vtu_study(tmp_path, cyclic: str) -> str:
+    from _cyclic_util import hex_sector
+
+    from bladecase.fe import save_mesh
+
+    save_mesh(hex_sector(8), tmp_path / "sector.vtu")
+    path = tmp_path / "s.toml"
+    path.write_text('mesh = {path = "sector.vtu"}\nmaterial = {preset = "steel"}\nfem = {order = 1, clamp = "hub"}\n'
+                    'output = {formats = []}\nrotation = {axis = {origin = [0, 0, 0], direction = [1, 0, 0]}}\n'
+                    f"[cyclic]\n{cyclic}\n")
+    return str(path)
+
+
+def test_a_sector_mesh_file_with_faces_found_by_angle(tmp_path):
+    from _cyclic_util import hex_sector
+
+    assert main(["run", _vtu_study(tmp_path, "sectors = 8\nmodes = 2"), "--out", str(tmp_path / "out"),
+                 "--quiet"]) == 0
+    rows = list(csv.DictReader(open(tmp_path / "out" / "cyclic.csv")))
+    f = np.sort(np.concatenate([[float(r["frequency_hz"])] * int(r["multiplicity"]) for r in rows]))
+    whole = assemble(annulus(hex_sector(8), 8), "steel", order=1, clamp="hub")
+    ref = natural_frequencies(whole, 8)
+    n = int(np.sum(f < min(float(r["frequency_hz"]) for r in rows if r["mode"] == "2")))
+    assert n >= 8 and np.max(np.abs(f[:n] / ref[:n] - 1)) < 1e-8
+    s = json.loads((tmp_path / "out" / "summary.json").read_text())["cyclic"]
+    assert s["faces"]["from"] == "sector angle" and s["expanded"] is None
+
+
+@pytest.mark.parametrize("cyclic, words", [
+    ("sectors = 7", "the sector spans 45° about the axis, but 7 sectors need 51.4286°"),
+    ("modes = 2", "[cyclic] sectors: required for a sector mesh without *CYCLIC SYMMETRY MODEL"),
+])
+def test_a_sector_mesh_file_errors(tmp_path, capsys, cyclic, words):
+    assert main(["run", _vtu_study(tmp_path, cyclic), "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    assert words in capsys.readouterr().err
