@@ -303,7 +303,8 @@ def compute_cyclic(study: Study, staging: Path, stage, progress: bool, executor:
         write_text(staging / "cyclic.csv", _csv(spectrum))
         files["cyclic"] = "cyclic.csv"
         freq = {k: m.frequencies for k, m in spectrum.items()}
-        orders = cy["engine_orders"] or list(range(1, n + 1))
+        orders = (cy["engine_orders"] or (study.config.get("rotation") or {}).get("engine_orders")
+                  or list(range(1, n + 1)))
         table = engine_order_table(freq, n, speed, orders)
         if "png" in o["formats"]:
             from ..post.safe_plot import safe_figure

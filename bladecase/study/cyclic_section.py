@@ -82,7 +82,7 @@ CYCLIC_KEYS: dict[str, Key] = {
                  "[rotation] speed, else the highest of [rotation] speeds, else at rest without engine-order lines.",
                  lambda v: None if v >= 0 and v == v and v != float("inf") else "must be a finite number >= 0"),
     "engine_orders": Key(_LIST, [], "Engine orders reported (the nodal diameter each excites, the modes it meets "
-                         "and at which speed); default []: 1 … N.", _orders),
+                         "and at which speed); default []: [rotation] engine_orders, else 1 … N.", _orders),
     "expand": Key((dict,), None, "The mode expanded to the whole disk (vtk/annulus_*.pvd): {diameter = k, mode = j, "
                   "wave = 'forward'} — wave 'cos' or 'sin' (standing), 'forward' or 'backward' (travelling, "
                   "0 < k < N/2). Default: mode 1 of nodal diameter 1 as a forward wave (a standing wave for N < 3).",
