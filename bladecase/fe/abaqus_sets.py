@@ -162,8 +162,8 @@ def log_boundary(source: str, fixed: dict[str, np.ndarray], full: np.ndarray, id
 def node_surface(deck, place, params, data) -> None:
     """``*SURFACE, NAME=…, TYPE=NODE``: its nodes (node numbers or node sets, one a line, an optional weight after
     them) become a node set of the surface's name — a group of the mesh, e.g. a cyclic face of a ``*TIE``. An
-    element-based surface (the default ``TYPE=ELEMENT``) is left out; a name already taken by a ``*NSET`` keeps
-    the set."""
+    element-based surface (the default ``TYPE=ELEMENT``), one naming a set not defined before it, and a name
+    already taken by a ``*NSET`` (which keeps the set) are left out, with a log line for the last two."""
     from .abaqus import _Members
 
     name = params.get("NAME")
@@ -177,8 +177,12 @@ def node_surface(deck, place, params, data) -> None:
         first = text.split(",")[0].strip()
         if first.lstrip("+-").isdigit():
             members.add("node", [int(first)], where)
-        else:
-            members.extend(deck._lookup(deck.nsets, first, where, "NSET")[1])
+        elif first.upper() in deck.nsets:
+            members.extend(deck.nsets[first.upper()][1])
+        else:  # not a group bladecase can make (a set defined later, another kind of entry): left out
+            log.info("%s: *SURFACE, NAME=%s, TYPE=NODE names %r, no *NSET defined before it: the surface is no mesh "
+                     "group", at_line(where), name, first)
+            return
     deck.nsets[name.upper()] = (name, members)
 
 
