@@ -177,3 +177,9 @@ def test_an_empty_cyclic_section_needs_a_cyclic_deck(tmp_path, capsys):
     deck = re.sub(r"\*SELECT CYCLIC SYMMETRY MODES.*\n", "", deck)
     err = _fails(tmp_path, capsys, deck)
     assert "declares no *CYCLIC SYMMETRY MODEL: give [cyclic] sectors = N" in err, err
+
+
+def test_a_tie_surface_that_is_no_group_is_named(tmp_path, capsys):
+    deck = sector_deck().replace("*SURFACE, NAME=SRIGHT, TYPE=NODE\nRIGHT", "*SURFACE, NAME=SRIGHT, TYPE=NODE\nLATER")
+    err = _fails(tmp_path, capsys, deck)
+    assert "names the right cyclic face 'SRIGHT', but the mesh" in err and "no such node group" in err, err

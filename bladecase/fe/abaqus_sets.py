@@ -164,26 +164,25 @@ def node_surface(deck, place, params, data) -> None:
     them) become a node set of the surface's name — a group of the mesh, e.g. a cyclic face of a ``*TIE``. An
     element-based surface (the default ``TYPE=ELEMENT``), one naming a set not defined before it, and a name
     already taken by a ``*NSET`` (which keeps the set) are left out, with a log line for the last two."""
-    from .abaqus import _Members
-
     name = params.get("NAME")
     if (params.get("TYPE") or "ELEMENT").upper() != "NODE" or not name:
         return
     if name.upper() in deck.nsets:
         log.info("%s: *SURFACE, NAME=%s: a *NSET has that name: the group is the set", at_line(place), name)
         return
-    members = _Members()
-    for where, text in data:
-        first = text.split(",")[0].strip()
+    entries = [(where, text.split(",")[0].strip()) for where, text in data]
+    for where, first in entries:
+        if not first.lstrip("+-").isdigit() and first.upper() not in deck.nsets:
+            log.info("%s: *SURFACE, NAME=%s, TYPE=NODE names %r, no *NSET defined before it: the surface is no mesh "
+                     "group", at_line(where), name, first)  # (a set defined later, another kind of entry)
+            return
+    deck._add(deck.nsets, name, "node", [], place)  # the surface's set, then what each line names
+    members = deck.nsets[name.upper()][1]
+    for where, first in entries:
         if first.lstrip("+-").isdigit():
             members.add("node", [int(first)], where)
-        elif first.upper() in deck.nsets:
+        else:
             members.extend(deck.nsets[first.upper()][1])
-        else:  # not a group bladecase can make (a set defined later, another kind of entry): left out
-            log.info("%s: *SURFACE, NAME=%s, TYPE=NODE names %r, no *NSET defined before it: the surface is no mesh "
-                     "group", at_line(where), name, first)
-            return
-    deck.nsets[name.upper()] = (name, members)
 
 
 def _floats(where, text: str, count: int, what: str) -> list[float]:
