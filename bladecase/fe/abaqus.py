@@ -525,7 +525,23 @@ def read_abaqus(path: str | os.PathLike):
 
 def read_cyclic(path: str | os.PathLike) -> dict | None:
     """The deck's ``*CYCLIC SYMMETRY MODEL`` and its ``*TIE, CYCLIC SYMMETRY`` (:func:`~.abaqus_sets.cyclic_records`;
-    ``None``: the deck has none).  The tie's node-based surfaces are groups of :func:`read_abaqus`'s mesh."""
+    ``None``: the deck has none).  The tie's node-based surfaces are groups of :func:`read_abaqus`'s mesh.
+
+    >>> import tempfile, os
+    >>> folder = tempfile.TemporaryDirectory()
+    >>> path = os.path.join(folder.name, "sector.inp")
+    >>> _ = open(path, "w").write('''*NODE
+    ... 1, 0, 0, 1
+    ... *TIE, NAME=CYC, CYCLIC SYMMETRY, POSITION TOLERANCE=0.01
+    ... SRIGHT, SLEFT
+    ... *CYCLIC SYMMETRY MODEL, N=24, TIE=CYC
+    ... 0, 0, -250, 1, 0, -250
+    ... ''')
+    >>> c = read_cyclic(path)
+    >>> c["sectors"], c["left"], c["right"], c["tol"], c["axis"]
+    (24, 'SLEFT', 'SRIGHT', 0.01, ([0.0, 0.0, -250.0], [1.0, 0.0, -250.0]))
+    >>> folder.cleanup()
+    """
     return cyclic_records(_blocks(os.fspath(path)))
 
 

@@ -48,7 +48,12 @@ NEAR = 0.05
 
 def deck_cyclic(study: Study) -> dict | None:
     """The cyclic records of the study's mesh file when it is a CalculiX/Abaqus deck that has them
-    (:func:`~bladecase.fe.abaqus.read_cyclic`), else ``None``."""
+    (:func:`~bladecase.fe.abaqus.read_cyclic`), else ``None``.
+
+    >>> from bladecase.study.demo import demo_study
+    >>> deck_cyclic(demo_study()) is None       # a parametric blade
+    True
+    """
     if study.parametric:
         return None
     from ..fe.abaqus import looks_like_abaqus, read_cyclic

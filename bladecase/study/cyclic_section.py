@@ -117,14 +117,21 @@ def expand_spec(cy: dict, sectors: int) -> dict:
 def cyclic_checks(c: dict) -> None:
     """The ``[cyclic]`` keys against each other and the other sections (``StudyError`` naming the key): both faces
     or neither; a sector geometry's N; the diameters and the expanded mode within ``0 … N/2`` when N is known; no
-    contact yet (a cyclic study computes the linear modes of the disk)."""
+    contact yet (a cyclic study computes the linear modes of the disk).
+
+    >>> try:
+    ...     cyclic_checks({"cyclic": {"left": "L", "right": None, "sectors": None}})
+    ... except StudyError as exc:
+    ...     print(str(exc).split(";")[0])
+    [cyclic] left: give both cyclic faces (left and right groups) or neither (the deck's, or by angle)
+    """
     cy = c.get("cyclic")
     if not cy:
         return
     if (cy["left"] is None) != (cy["right"] is None):
         given = "left" if cy["left"] is not None else "right"
-        raise StudyError(f"[cyclic] {given}: give both cyclic faces, left and right (mesh groups), or neither (found "
-                         f"by the deck or by the sector angle); got only {given} = {cy[given]!r}")
+        raise StudyError(f"[cyclic] {given}: give both cyclic faces (left and right groups) or neither (the deck's, or "
+                         f"by angle); got only {given} = {cy[given]!r}")
     g = c.get("geometry") or {}
     n = cy["sectors"]
     if g.get("kind") == "sector":
