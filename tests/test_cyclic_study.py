@@ -152,3 +152,11 @@ def test_a_sector_mesh_file_with_faces_found_by_angle(tmp_path):
 def test_a_sector_mesh_file_errors(tmp_path, capsys, cyclic, words):
     assert main(["run", _vtu_study(tmp_path, cyclic), "--out", str(tmp_path / "out"), "--quiet"]) == 2
     assert words in capsys.readouterr().err
+
+
+def test_a_file_of_the_users_with_a_cyclic_result_name_stops_the_run(tmp_path, capsys):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "safe.png").write_text("my own figure")
+    assert main(["run", _write(tmp_path, "[cyclic]\nmodes = 1"), "--out", str(out), "--quiet"]) == 2
+    assert "safe.png" in capsys.readouterr().err and (out / "safe.png").read_text() == "my own figure"
