@@ -297,6 +297,10 @@ def compute_cyclic(study: Study, staging: Path, stage, progress: bool, executor:
     speed = _safe_speed(study)
     with stage("cyclic"):
         solved = sector
+        static = (study.config.get("rotation") or {}).get("static", "auto")
+        if (speed or (study.config.get("rotation") or {}).get("speeds")) and static in ("second-order", "nonlinear"):
+            log.warning("[rotation] static = %r: a disk's centrifugal state is its linear prestress (stress stiffening "
+                        "and spin softening about the linear static state, the sector's faces tied)", static)
         if speed:
             from ..fe.cyclic_spin import cyclic_spin
 
