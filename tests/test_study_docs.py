@@ -18,6 +18,7 @@ from pathlib import Path
 import pytest
 
 from bladecase.fe.geometry import BladeGeometry, PlateGeometry
+from bladecase.fe.sector import SectorGeometry
 from bladecase.study.demo import demo_text
 from bladecase.study.schema import GEOMETRY_FIELDS, REQUIRED, SCHEMA, loads
 
@@ -65,7 +66,7 @@ def _matches(cell: str, default) -> bool:
 
 def _geometry_defaults() -> dict[str, list]:
     out: dict[str, list] = {k: [spec.default] for k, spec in SCHEMA["geometry"].items()}
-    for cls in (BladeGeometry, PlateGeometry):
+    for cls in (BladeGeometry, PlateGeometry, SectorGeometry):
         for f in dataclasses.fields(cls):
             default = REQUIRED if f.default is dataclasses.MISSING else f.default
             out.setdefault(f.name, []).append(default)

@@ -85,7 +85,15 @@ import re
 import numpy as np
 
 from .. import log
-from .abaqus_sets import AbaqusError, Numbers, body_material, boundary_groups, log_boundary
+from .abaqus_sets import (
+    AbaqusError,
+    Numbers,
+    body_material,
+    boundary_groups,
+    cyclic_records,
+    log_boundary,
+    node_surface,
+)
 from .abaqus_sets import at_line as _where
 from .abaqus_write import ABAQUS_TYPES, abaqus_text, node_numbers  # noqa: F401  (public names of this module)
 from .groups import NODE_ID_KEY  # the point-data key of the file's node numbers (Mesh.node_ids)
@@ -448,6 +456,8 @@ def read_abaqus(path: str | os.PathLike):
             deck.sets(place, params, data, keyword)
         elif keyword == "BOUNDARY":
             deck.bc(place, params, data)
+        elif keyword == "SURFACE":
+            node_surface(deck, place, params, data)
         if keyword in _NOT_MATERIAL_OPTIONS:
             deck.material_now = None
         if keyword == "MATERIAL":
@@ -511,6 +521,28 @@ def read_abaqus(path: str | os.PathLike):
     material = body_material(deck, numbers, source)
     return meshio.Mesh(np.asarray(deck.xyz, dtype=float), cells, point_sets=point_sets,
                        point_data={NODE_ID_KEY: ids}, info={"material": material} if material else None)
+
+
+def read_cyclic(path: str | os.PathLike) -> dict | None:
+    """The deck's ``*CYCLIC SYMMETRY MODEL`` and its ``*TIE, CYCLIC SYMMETRY`` (:func:`~.abaqus_sets.cyclic_records`;
+    ``None``: the deck has none).  The tie's node-based surfaces are groups of :func:`read_abaqus`'s mesh.
+
+    >>> import tempfile, os
+    >>> folder = tempfile.TemporaryDirectory()
+    >>> path = os.path.join(folder.name, "sector.inp")
+    >>> _ = open(path, "w").write('''*NODE
+    ... 1, 0, 0, 1
+    ... *TIE, NAME=CYC, CYCLIC SYMMETRY, POSITION TOLERANCE=0.01
+    ... SRIGHT, SLEFT
+    ... *CYCLIC SYMMETRY MODEL, N=24, TIE=CYC
+    ... 0, 0, -250, 1, 0, -250
+    ... ''')
+    >>> c = read_cyclic(path)
+    >>> c["sectors"], c["left"], c["right"], c["tol"], c["axis"]
+    (24, 'SLEFT', 'SRIGHT', 0.01, ([0.0, 0.0, -250.0], [1.0, 0.0, -250.0]))
+    >>> folder.cleanup()
+    """
+    return cyclic_records(_blocks(os.fspath(path)))
 
 
 def register() -> None:

@@ -157,3 +157,101 @@ def log_boundary(source: str, fixed: dict[str, np.ndarray], full: np.ndarray, id
         log.info("Abaqus file %s: %d of the *BOUNDARY nodes have only some translations fixed (symmetry or "
                  "sliding conditions; first: node %d): a clamp fixes all three — clamp = \"boundary_fixed\" takes "
                  "only the nodes fixed in x, y and z", source, partial.size, int(ids[partial].min()))
+
+
+def node_surface(deck, place, params, data) -> None:
+    """``*SURFACE, NAME=…, TYPE=NODE``: its nodes (node numbers or node sets, one a line, an optional weight after
+    them) become a node set of the surface's name — a group of the mesh, e.g. a cyclic face of a ``*TIE``. An
+    element-based surface (the default ``TYPE=ELEMENT``), one naming a set not defined before it, and a name
+    already taken by a ``*NSET`` (which keeps the set) are left out, with a log line for the last two."""
+    name = params.get("NAME")
+    if (params.get("TYPE") or "ELEMENT").upper() != "NODE" or not name:
+        return
+    if name.upper() in deck.nsets:
+        log.info("%s: *SURFACE, NAME=%s: a *NSET has that name: the group is the set", at_line(place), name)
+        return
+    entries = [(where, text.split(",")[0].strip()) for where, text in data]
+    for where, first in entries:
+        if not first.lstrip("+-").isdigit() and first.upper() not in deck.nsets:
+            log.info("%s: *SURFACE, NAME=%s, TYPE=NODE names %r, no *NSET defined before it: the surface is no mesh "
+                     "group", at_line(where), name, first)  # (a set defined later, another kind of entry)
+            return
+    deck._add(deck.nsets, name, "node", [], place)  # the surface's set, then what each line names
+    members = deck.nsets[name.upper()][1]
+    for where, first in entries:
+        if first.lstrip("+-").isdigit():
+            members.add("node", [int(first)], where)
+        else:
+            members.extend(deck.nsets[first.upper()][1])
+
+
+def _floats(where, text: str, count: int, what: str) -> list[float]:
+    fields = [f.strip() for f in text.split(",") if f.strip()]
+    try:
+        values = [float(f) for f in fields[:count]]
+    except ValueError:
+        values = []
+    if len(values) != count:
+        raise AbaqusError(f"{at_line(where)}: {what}, got {text!r}")
+    return values
+
+
+def cyclic_records(blocks) -> dict | None:
+    """What a deck's ``*CYCLIC SYMMETRY MODEL`` and its ``*TIE, CYCLIC SYMMETRY`` say (``None``: no cyclic model):
+    ``{"sectors": N, "axis": (a, b)`` (the two points of the axis, in the deck's unit; angles right-handed about
+    ``a → b``), ``"left"`` (the ``*TIE``'s second, independent surface), ``"right"`` (its first, dependent one: the
+    left face turned by ``+360°/N``), ``"tol"`` (its ``POSITION TOLERANCE``, or ``None``), ``"where"`` (file and
+    line), ``"problem"`` (why the faces cannot be used as groups, or ``None``)}``."""
+    ties, surfaces, model = {}, {}, None
+    for place, keyword, params, data in blocks:
+        if keyword == "SURFACE" and params.get("NAME"):
+            surfaces[params["NAME"].upper()] = (params.get("TYPE") or "ELEMENT").upper()
+        elif keyword == "TIE" and "CYCLIC SYMMETRY" in params:
+            if not data:
+                raise AbaqusError(f"{at_line(place)}: *TIE, CYCLIC SYMMETRY needs a line 'dependent surface, "
+                                  "independent surface'")
+            names = [f.strip() for f in data[0][1].split(",") if f.strip()]
+            if len(names) != 2:
+                raise AbaqusError(f"{at_line(data[0][0])}: a *TIE line is 'dependent surface, independent surface', "
+                                  f"got {data[0][1]!r}")
+            tol = params.get("POSITION TOLERANCE")
+            ties[(params.get("NAME") or "").upper()] = (place, names, float(tol) if tol else None)
+        elif keyword == "CYCLIC SYMMETRY MODEL":
+            if model is not None:
+                raise AbaqusError(f"{at_line(place)}: a second *CYCLIC SYMMETRY MODEL (the first at line "
+                                  f"{model[0][1]}): bladecase reads a deck of one cyclic model")
+            model = (place, params, data)
+    if model is None:
+        return None
+    place, params, data = model
+    try:
+        n = int(params.get("N") or "")
+    except ValueError:
+        raise AbaqusError(f"{at_line(place)}: *CYCLIC SYMMETRY MODEL needs N=<number of sectors>, an integer >= 2, "
+                          f"got N={params.get('N')!r}") from None
+    if n < 2:
+        raise AbaqusError(f"{at_line(place)}: *CYCLIC SYMMETRY MODEL, N={n}: a disk has N >= 2 sectors")
+    if not data:
+        raise AbaqusError(f"{at_line(place)}: *CYCLIC SYMMETRY MODEL needs a line with the two points of the axis "
+                          "'xa, ya, za, xb, yb, zb'")
+    xyz = _floats(data[0][0], data[0][1], 6, "the axis of *CYCLIC SYMMETRY MODEL is two points 'xa, ya, za, xb, yb, "
+                  "zb'")
+    a, b = xyz[:3], xyz[3:]
+    if a == b:
+        raise AbaqusError(f"{at_line(data[0][0])}: the two points of the *CYCLIC SYMMETRY MODEL axis are the same "
+                          f"point {a}: give two distinct points of the axis")
+    tie = (params.get("TIE") or "").upper()
+    if tie not in ties:
+        if tie or len(ties) != 1:
+            have = ", ".join(sorted(ties)) or "none"
+            raise AbaqusError(f"{at_line(place)}: *CYCLIC SYMMETRY MODEL, TIE={params.get('TIE')}: no *TIE, CYCLIC "
+                              f"SYMMETRY of that name (cyclic ties: {have})")
+        tie = next(iter(ties))
+    _, (right, left), tol = ties[tie]
+    problem = None
+    bad = [s for s in (right, left) if surfaces.get(s.upper(), "NODE") != "NODE"]
+    if bad:
+        problem = (f"the *TIE's surface {bad[0]!r} is element-based: bladecase reads node-based cyclic faces "
+                   "(*SURFACE, TYPE=NODE), or give [cyclic] left and right node groups")
+    return {"sectors": n, "axis": (a, b), "left": left, "right": right, "tol": tol,
+            "where": f"{place[0]!r}, line {place[1]}", "problem": problem}

@@ -25,7 +25,7 @@ from matplotlib.figure import Figure
 from ..fe.cyclic import engine_order_diameter
 from .plots import new_figure
 
-__all__ = ["engine_order_zigzag", "safe_figure"]
+__all__ = ["campbell_nd_figure", "engine_order_zigzag", "safe_figure"]
 
 
 def engine_order_zigzag(sectors: int, speed: float, top: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -96,4 +96,40 @@ def safe_figure(spectrum, sectors: int, *, speed: float | None = None, title: st
     ax.set_title(title or f"SAFE diagram, {sectors} sectors")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="lower right")
+    return fig
+
+
+def campbell_nd_figure(speeds, table: dict, sectors: int, *, orders=(), title: str | None = None) -> Figure:
+    """The Campbell diagram of every nodal diameter: ``table`` ``{k: (len(speeds), families) frequencies (Hz)}``
+    (:func:`~bladecase.fe.cyclic_spin.cyclic_campbell`) against ``speeds`` (rad/s, drawn in rpm), one colour per
+    nodal diameter, and the engine-order lines ``eΩ/2π`` of ``orders`` labelled with the diameter each excites.
+
+    >>> import numpy as np
+    >>> fig = campbell_nd_figure(np.array([0.0, 1000.0]), {0: np.array([[100.0], [110.0]]),
+    ...                          1: np.array([[120.0], [125.0]])}, 4, orders=[1])
+    >>> [line.get_label() for line in fig.axes[0].lines]
+    ['ND 0', 'ND 1', 'EO 1 (ND 1)']
+    """
+    w = np.asarray(speeds, dtype=float)
+    if w.ndim != 1 or w.size < 1 or not np.all(np.isfinite(w)):
+        raise ValueError(f"speeds must be a list of finite speeds (rad/s), got {speeds!r}")
+    rpm = w * 60.0 / (2.0 * math.pi)
+    fig = new_figure(figsize=(7.0, 4.8), layout="constrained")
+    ax = fig.add_subplot()
+    colours = [f"C{i % 10}" for i in range(len(table))]
+    top = 0.0
+    for c, (k, f) in zip(colours, sorted(table.items())):
+        f = np.asarray(f, dtype=float).reshape(w.size, -1)
+        top = max(top, float(np.nanmax(f)))
+        for j in range(f.shape[1]):
+            ax.plot(rpm, f[:, j], "o-", color=c, ms=3, lw=1.1, label=f"ND {k}" if j == 0 else "_")
+    for e in orders:
+        ax.plot(rpm, e * w / (2.0 * math.pi), "--", color="0.4", lw=0.9,
+                label=f"EO {e} (ND {engine_order_diameter(e, sectors)})")
+    ax.set_ylim(0.0, 1.05 * top if top > 0 else 1.0)
+    ax.set_xlabel("speed (rpm)")
+    ax.set_ylabel("frequency (Hz)")
+    ax.set_title(title or f"Campbell diagram per nodal diameter, {sectors} sectors")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, loc="upper left", ncol=2)
     return fig

@@ -8,8 +8,8 @@ from __future__ import annotations
 import math
 
 from ..fe import Material, PlateGeometry
-from ..fe.geometry import estimate_cells
-from .geometry_section import geometry_of
+from .cyclic_section import cyclic_checks
+from .geometry_section import estimate_cells, geometry_of
 from .keys import StudyError, one_line
 from .sections import (
     casing_checks,
@@ -36,7 +36,7 @@ def _cell_checks(c: dict) -> None:
         raise StudyError(f"[geometry] {one_line(exc)}") from None
     if n <= cap:
         return
-    size = g["size"] if g["size"] is not None else geometry.default_size()
+    size = g["size"] if g["size"] is not None else getattr(geometry, "blade", geometry).default_size()
     uniform = estimate_cells(geometry, size=size, cells=g["cells"])
     dim = 2 if isinstance(geometry, PlateGeometry) else 3
     if g["tip_size"] is not None and uniform <= cap:
@@ -95,6 +95,7 @@ def cross_checks(c: dict, model: bool = True, contact: bool = True) -> None:
     casing_checks(c, model and contact)
     rub_checks(c)
     convergence_checks(c)
+    cyclic_checks(c)
     o, s = c["output"], c["search"]
     for i, item in enumerate(o["orbits"]):
         if item["ipp"] not in s["ipp"]:
@@ -186,16 +187,21 @@ def _contact_model_checks(c: dict) -> None:
 
 
 def campbell_only(raw: dict) -> bool:
-    """True for a study (as parsed, before its defaults) of the linear modes and the Campbell diagram alone:
-    ``[rotation] speeds`` given, no ``[contact]`` section and no casing of revolution.
+    """True for a study (as parsed, before its defaults) of the linear modes alone: no ``[contact]`` section and no
+    casing of revolution, and ``[rotation] speeds`` given (the Campbell diagram) or a bladed disk (``[cyclic]``, or
+    ``[geometry] kind = "sector"``: its modes by nodal diameter).
 
     >>> campbell_only({"rotation": {"speeds": [0, 1000]}}), campbell_only({"rotation": {"speeds": [0]}, "contact": {}})
     (True, False)
+    >>> campbell_only({"cyclic": {}}), campbell_only({"geometry": {"kind": "sector"}})
+    (True, True)
     """
     rotation, casing = raw.get("rotation"), raw.get("casing")
     speeds = rotation.get("speeds") if isinstance(rotation, dict) else None
     ring = isinstance(casing, dict) and (casing.get("radius") is not None or casing.get("radii") is not None)
-    return "contact" not in raw and not ring and isinstance(speeds, list) and len(speeds) > 0
+    geometry = raw.get("geometry")
+    disk = "cyclic" in raw or (isinstance(geometry, dict) and geometry.get("kind") == "sector")
+    return "contact" not in raw and not ring and (disk or (isinstance(speeds, list) and len(speeds) > 0))
 
 
 #: The sections (and the key that turns each on) that need a contact: refused in a study without one.

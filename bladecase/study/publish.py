@@ -44,7 +44,8 @@ from .manifest import MANIFEST, TOKEN, entry_hash, read_signed, stamp_folder, st
 #: Top-level result names a run owns in its output directory (older ones it did not write are removed).
 RUN_RESULTS = ("summary.json", "report.md", "run.log", "modes.json", "frequency_energy.png", "mesh.vtu", "animations",
                "vtk", "forced.csv", "forced_response.png", "campbell.png", "rub.csv", "rub_nodes.csv", "rub.png",
-               "rub.vtu", "casing.png", "nodal_modes.csv", "nodal_modes.png")
+               "rub.vtu", "casing.png", "nodal_modes.csv", "nodal_modes.png", "cyclic.csv", "safe.png",
+               "campbell_nd.png")
 
 LOCK = ".bladecase.lock"
 STAGING_PREFIX = ".bladecase-run-"

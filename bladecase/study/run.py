@@ -22,6 +22,7 @@ from .. import log
 from ..fe import save_mesh, stiffness_factor
 from ..io import write_json, write_text
 from ..post.compare import ModelResult, fe_reference
+from ..post.cyclic_report import cyclic_report, cyclic_verdict
 from ..post.modes_report import modes_verdict
 from ..post.outputs import FORMATS, PlotScene
 from ..post.prestress import add_to_mesh_file
@@ -29,10 +30,11 @@ from ..post.report import report
 from ..post.verdict import verdict
 from ..progress import progress_counter
 from .comparison import FE_MODES, compare_models, summary_section
+from .cyclic import compute_linear
 from .documents import contact_summary, families_document, family_summary, model_summary, reduced_summary
 from .executor import Executor, make_executor
 from .forcing import forced_response, forced_scene
-from .modes_run import campbell_with_figure, compute_modes
+from .modes_run import campbell_with_figure
 from .publish import RUN_RESULTS, check_inputs, output_folder, publish, release, staged_names, staging_dir
 from .reference import reference_model, study_basis
 from .render import orbit_engineering, render_all
@@ -161,16 +163,16 @@ def run(study: Study | str | os.PathLike, out: str | os.PathLike | None = None, 
     try:
         with log.transcript() as lines:
             log.info("study %s (%s) → %s", study.name, study.source, out)
-            compute = _compute if study.has_contact else compute_modes  # no contact: the modes and Campbell alone
+            compute = _compute if study.has_contact else compute_linear  # no contact: linear modes (a disk: cyclic)
             summary, families, models = compute(study, staging, stages, progress, executor or own)
             summary["timings_s"] = dict(stages.timings, total=round(time.perf_counter() - t_start, 3))
             log.info("results in %s (%.1f s)", out, summary["timings_s"]["total"])
         write_text(staging / "run.log", "\n".join(lines) + "\n")
         summary["outputs"] = sorted(set(staged_names(staging)) | {"summary.json", "report.md"})
         summary["verdict"] = (verdict(summary, staging / "modes.json") if study.has_contact
-                              else modes_verdict(summary))
+                              else cyclic_verdict(summary) if summary.get("cyclic") else modes_verdict(summary))
         write_json(staging / "summary.json", summary)
-        write_text(staging / "report.md", report(summary))
+        write_text(staging / "report.md", cyclic_report(summary) if summary.get("cyclic") else report(summary))
         publish(staging, out, RUN_RESULTS, whole=True)
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)

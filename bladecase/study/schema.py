@@ -31,6 +31,7 @@ from .cross_checks import (  # noqa: F401 (MASSLESS_METHODS lived here)
     cross_checks,
     modes_only_checks,
 )
+from .cyclic_section import CYCLIC_KEYS
 from .geometry_section import GEOMETRY_FIELDS, GEOMETRY_KEYS, geometry_of, geometry_section  # noqa: F401
 from .keys import _BOOL, _INT, _LIST, _NUM, _STR, REQUIRED, Key, StudyError, _check_field, _check_value, one_line  # noqa: F401
 from .sections import (
@@ -260,6 +261,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
     "casing": CASING_KEYS,
     "rub": RUB_KEYS,
     "convergence": CONVERGENCE_KEYS,
+    "cyclic": CYCLIC_KEYS,
     "execution": EXECUTION_KEYS,
     "limits": LIMIT_KEYS,
 }
