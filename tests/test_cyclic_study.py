@@ -160,3 +160,11 @@ def test_a_file_of_the_users_with_a_cyclic_result_name_stops_the_run(tmp_path, c
     (out / "safe.png").write_text("my own figure")
     assert main(["run", _write(tmp_path, "[cyclic]\nmodes = 1"), "--out", str(out), "--quiet"]) == 2
     assert "safe.png" in capsys.readouterr().err and (out / "safe.png").read_text() == "my own figure"
+
+
+def test_bladecase_mesh_meshes_a_sector(tmp_path):
+    """`bladecase mesh` on a sector study writes the sector's mesh with its cyclic faces and hub as groups."""
+    study = _write(tmp_path, "[cyclic]\nmodes = 3")
+    assert main(["mesh", study, "-o", str(tmp_path / "sector.vtu"), "--quiet"]) == 0
+    mesh = load_mesh(tmp_path / "sector.vtu")
+    assert {"hub", "left", "right", "tip"} <= set(mesh.groups)

@@ -32,7 +32,18 @@ def build_mesh(study: Study, path: str | os.PathLike | None = None) -> Mesh:
     group = contact_group(study)
     if group is not None:
         need.append(("[contact] group", group))
-    if study.parametric:
+    if study.parametric and study["geometry"]["kind"] == "sector":  # a bladed disk's sector (study/cyclic.py)
+        from ..fe import save_mesh, sector_mesh
+
+        g = study["geometry"]
+        try:
+            mesh = sector_mesh(study.geometry(), size=g["size"], order=g["mesh_order"])
+        except (ValueError, RuntimeError) as exc:
+            raise StudyError(f"[geometry] {exc}") from None
+        if path is not None:
+            save_mesh(mesh, path)
+        need = [(key, name) for key, name in need if (key, name) != ("[fem] clamp", "root")]  # clamped at its hub
+    elif study.parametric:
         g = study["geometry"]
         try:
             mesh = blade_mesh(study.geometry(), size=g["size"], tip_size=g["tip_size"], order=g["mesh_order"],
@@ -251,7 +262,9 @@ def read_node_list(path, key: str) -> list[tuple[int, int]]:
 
 
 def contact_group(study: Study) -> str | None:
-    """The mesh group ``[contact]`` selects from (``None``: a node index, or every free node)."""
+    """The mesh group ``[contact]`` selects from (``None``: a node index, every free node, or no contact)."""
+    if not study.has_contact:
+        return None
     c = study["contact"]
     if c["face"] is not None or c.get("nodes") is not None:
         return c["face"] if isinstance(c["face"], str) else SELECTED_FACE
