@@ -114,7 +114,7 @@ class FullModel:
     def phase(self, A):
         """The flight and the signals of the phase with closed set ``A`` (boolean, ``(m,)``)."""
         a = np.flatnonzero(A)
-        m, n = self.d.size, self.om2.size
+        n = self.om2.size
         if a.size == 0:
             w, U, qs = np.sqrt(self.om2), None, np.zeros(n)
             G, s0 = -self.B.T, self.d.copy()  # open signal −p_j = d_j − B_jᵀq (>= 0 valid)
