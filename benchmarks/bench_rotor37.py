@@ -83,8 +83,8 @@ def bladecase_frequencies(deck: Path, speeds, count: int):
         else:
             state = spin(model, w, AXIS, static="nonlinear")
             f = np.sqrt(lowest_modes(state.model.K, state.model.M, count, factor=state.factor)[0]) / (2 * math.pi)
-            out[w] = (f, time.perf_counter() - t, f"{state.iterations} Newton iterations, largest |u| "
-                      f"{np.abs(state.displacement).max() * 1e3:.3f} mm")
+            out[w] = (f, time.perf_counter() - t, f"{state.iterations} Newton iterations, largest |u_i| "
+                      f"{np.abs(state.displacement).max() * 1e3:.4f} mm")
         print(f"bladecase {w:7.1f} rad/s: " + " ".join(f"{x:10.4f}" for x in out[w][0])
               + f" Hz  ({out[w][1]:.1f} s) {out[w][2]}")
     return model, mesh, out
@@ -119,11 +119,11 @@ def dat_frequencies(dat: Path, count: int) -> np.ndarray:
 
 
 def ccx_displacement(dat: Path) -> float:
-    """The largest displacement magnitude printed by ``*NODE PRINT`` in the static step (mm)."""
+    """The largest displacement component printed by ``*NODE PRINT`` at the end of the static step (mm)."""
     text = dat.read_text().split("E I G E N V A L U E")[0]
     block = text.split("displacements (vx,vy,vz)")[-1]
     vals = [list(map(float, ln.split()[1:4])) for ln in block.splitlines() if len(ln.split()) == 4]
-    return float(np.linalg.norm(np.array(vals), axis=1).max()) if vals else float("nan")
+    return float(np.abs(np.array(vals)).max()) if vals else float("nan")
 
 
 def calculix_frequencies(deck: Path, speeds, count: int, threads: int):
@@ -139,7 +139,7 @@ def calculix_frequencies(deck: Path, speeds, count: int, threads: int):
             if run.returncode != 0 or not dat.exists() or "E I G E N" not in dat.read_text():
                 raise RuntimeError(f"ccx failed at {w} rad/s:\n{run.stdout[-2000:]}\n{run.stderr[-2000:]}")
             f = dat_frequencies(dat, count)
-            extra = f"largest |u| {ccx_displacement(dat):.3f} mm" if w else ""
+            extra = f"largest |u_i| {ccx_displacement(dat):.4f} mm" if w else ""
             out[w] = (f, time.perf_counter() - t, extra)
             print(f"CalculiX  {w:7.1f} rad/s: " + " ".join(f"{x:10.4f}" for x in f)
                   + f" Hz  ({out[w][1]:.1f} s) {extra}")
