@@ -93,7 +93,8 @@ clamp = "boundary"
 [contact]
 nodes = {TIP_NODES}
 model = "massless"
-casing_stiffness = 1e7
+weights = "equal"           # a line of nodes has no area (the default under [casing] is "area")
+# no casing_stiffness: a rigid casing (a stiffness is shared by tributary area, which a line of nodes lacks)
 
 [casing]
 radii = [[{z0}, {r(z0)!r}], [{z1}, {r(z1)!r}]]
@@ -110,6 +111,7 @@ ipp = [1]
 periods = [0.95, 1.0001]
 period_unit = "T1"
 scan = 6
+amplitude_limit = 0.2       # the 2 mm clearance needs a large orbit: do not cut it at 5 % of the span
 
 [output]
 animate = 1
