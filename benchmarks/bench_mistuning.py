@@ -1,5 +1,6 @@
 """Mistuning of a 24-blade lumped disk: 1000 random samples through Dask, their amplification factor against
-Whitehead's bound ½(1 + √N), and the worst mistuning pattern found by optimisation.
+Whitehead's bound ½(1 + √N), and the worst mistuning pattern found by optimisation (at the samples' damping and at
+a lighter one).
 
 The disk: a disk mass on a ground spring, a blade mass on it, neighbouring disk masses coupled (``lumped_disk``'s
 defaults), the blade family's subset-of-nominal-modes model (24 modes), engine order 3 on each blade's mass, modal
@@ -32,7 +33,8 @@ def main() -> None:
     parser.add_argument("--order", type=int, default=3, help="engine order")
     parser.add_argument("--zeta", type=float, default=0.001, help="modal damping ratio")
     parser.add_argument("--workers", type=int, default=2, help="Dask workers (1: serial)")
-    parser.add_argument("--limit", type=float, default=0.01, help="the worst pattern's largest |δ|")
+    parser.add_argument("--limit", type=float, default=0.02, help="the worst pattern's largest |δ|")
+    parser.add_argument("--worst-zeta", type=float, default=1e-4, help="a lighter damping for the worst pattern")
     parser.add_argument("--figure", default=None, help="write the histogram there (png)")
     args = parser.parse_args()
     forcing = {"zeta": args.zeta, "force": 1, "response": 1}
@@ -58,14 +60,17 @@ def main() -> None:
     over = int(np.sum(stats.factors > stats.bound))
     print(f"largest {s['largest']:.4f} (sample {s['largest_sample']}, blade {s['largest_blade']}); Whitehead's "
           f"bound ½(1 + √{args.sectors}) = {stats.bound:.4f}; samples above it: {over}")
-    start = time.perf_counter()
-    delta, factor = worst_mistuning(model, args.order, limit=args.limit, **forcing)
-    print(f"worst pattern within |δ| <= {args.limit:g}: amplification {factor:.4f} "
-          f"({factor / stats.bound:.1%} of the bound), {time.perf_counter() - start:.1f} s")
+    worst = 0.0
+    for zeta in (args.zeta, args.worst_zeta):
+        start = time.perf_counter()
+        delta, factor = worst_mistuning(model, args.order, limit=args.limit, starts=1, **{**forcing, "zeta": zeta})
+        worst = max(worst, factor)
+        print(f"worst pattern within |δ| <= {args.limit:g}, zeta {zeta:g}: amplification {factor:.4f} "
+              f"({factor / stats.bound:.1%} of the bound), {time.perf_counter() - start:.1f} s")
     if args.figure:
         amplification_figure(stats).savefig(args.figure, dpi=120)
         print(f"histogram: {args.figure}")
-    if over or factor > stats.bound:
+    if over or worst > stats.bound:
         raise SystemExit("an amplification factor exceeds Whitehead's bound")
 
 

@@ -33,5 +33,5 @@ def amplification_figure(stats: MistuningStatistics, bins: int = 40) -> Figure:
     ax.set_xlabel("amplification factor (largest blade amplitude ÷ tuned)")
     ax.set_ylabel("samples")
     ax.set_title(f"{stats.factors.size} mistuned samples, {stats.deltas.shape[1]} blades")
-    ax.legend(loc="upper left")
+    ax.legend(loc="center right")
     return fig
