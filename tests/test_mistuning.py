@@ -168,3 +168,20 @@ def test_bad_input_is_named(call, message):
     with pytest.raises(ValueError) as err:
         call(model)
     assert message in str(err.value)
+
+
+def test_worst_pattern_gradient_is_exact():
+    """The worst-pattern search's gradient (deviations and frequency) against central differences: 1e-6."""
+    from bladecase.reduction.mistuning import _load
+    from bladecase.reduction.mistuning_stats import _blade_amplitude
+
+    model = mistuning_model(*lumped_disk(N))
+    Fr, E = _load(model, ORDER, 1, 1)
+    k = model.diameters
+    waves = np.exp(2j * math.pi * np.multiply.outer(k[None, :] - k[:, None], np.arange(N)) / N) / N
+    args = (model.coupling, waves, model.lam, 2 * ZETA * np.sqrt(model.lam), Fr, E[0], 0.01, 0.1491, 0.004)
+    x = np.random.default_rng(1).uniform(-0.3, 0.3, N + 1)
+    _, grad = _blade_amplitude(x, *args)
+    h, eye = 1e-6, np.eye(N + 1)
+    fd = [(_blade_amplitude(x + h * e, *args)[0] - _blade_amplitude(x - h * e, *args)[0]) / (2 * h) for e in eye]
+    assert np.abs(grad - fd).max() <= 1e-6 * np.abs(grad).max()
