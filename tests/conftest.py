@@ -284,7 +284,7 @@ HEAVIEST_FIRST = [
 
 #: The files that use ``dask_executor`` (one work unit of :data:`SAME_WORKER`) and the session's executor while it
 #: exists.
-DASK_FILES = ("tests/test_executor.py", "tests/test_comparison_study.py")
+DASK_FILES = ("tests/test_executor.py", "tests/test_comparison_study.py", "tests/test_mistuning_stats.py")
 _DASK: list = []
 
 

@@ -20,6 +20,7 @@ from .lanczos import LanczosChain, chain_grounding, chain_jacobi, lanczos_chain
 from .loads import EngineOrderLoad, engine_order_load, nodal_load, pressure_load, project_load
 from .massless import MasslessReducedModel, massless_masses, massless_model
 from .methods import FULL_LIMIT
+from .mistuning import MistuningModel, amplification, forced_response, mistuning_model
 from .model import ReducedModel, node_operator
 from .registry import METHODS, Registry, reduce, register
 from .storage import load_reduced, save_reduced
@@ -33,5 +34,5 @@ __all__ = [
     "lanczos_chain", "load_reduced",
     "mass_factor", "massless_masses", "massless_model", "node_operator", "per_dof_defect", "per_dof_law",
     "radial_normal", "reduce", "register", "save_reduced", "engine_order_load", "nodal_load", "pressure_load",
-    "project_load",
+    "project_load", "MistuningModel", "amplification", "forced_response", "mistuning_model",
 ]
