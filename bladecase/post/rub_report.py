@@ -132,7 +132,35 @@ def rub_report(section: dict | None) -> list[str]:
         lines.append(f"- **No result at {f['speed']:.6g} {unit}**: the simulation was refused there ({f['reason']}); "
                      "the other speeds are unaffected.")
     lines += _settling(section, unit)
+    lines += _friction_lines(section.get("friction"), unit)
     return lines
+
+
+def _friction_lines(f: dict | None, unit: str) -> list[str]:
+    """The friction's words: its model and assumption, the energy of the hardest speed's last revolution, the
+    balance and the sliding check."""
+    if not f:
+        return []
+    out = [f"- Friction: {f['assumption']}."]
+    rows = [r for r in f["speeds"] if r["casing_input_j"] is not None]
+    if rows:
+        top = max(rows, key=lambda r: abs(r["casing_input_j"]))
+        out.append(f"- Energy over the last revolution at {top['speed']:.6g} {unit}: the casing puts in "
+                   f"{top['casing_input_j']:.4g} J, friction does {top['friction_work_j']:.4g} J on the vibration, "
+                   f"damping takes {top['damping_j']:.4g} J and the stored energy changes by "
+                   f"{top['stored_change_j']:.4g} J; the balance closes to {f['worst_residual']:.1e} (relative, worst "
+                   "revolution of every speed's window; `rub.csv` gives every speed).")
+    bad = f.get("not_rotation_dominated") or []
+    if bad:
+        out.append(f"- **The sliding is not dominated by the rotation** at {', '.join(f'{s:.6g}' for s in bad)} "
+                   f"{unit}: a node's tangential vibration velocity exceeds 0.1 × ΩR there, so the friction's "
+                   "direction is not the circumferential one and the results with friction are not to be trusted "
+                   "at those speeds (a stick–slip model is needed).")
+    elif rows:
+        worst = max(r["sliding_ratio"] or 0.0 for r in rows)
+        out.append(f"- The sliding is dominated by the rotation at every speed: the largest tangential vibration "
+                   f"velocity is {worst:.2g} × ΩR (the assumption holds below 0.1).")
+    return out
 
 
 #: Said of the crossing speed of mode 1 where the report names it.

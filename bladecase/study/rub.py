@@ -36,9 +36,11 @@ from ..io import csv_cell, save_figure, write_text
 from ..nsm.damping import Damping
 from ..nsm.massless.rub import RUN_ON_FACTOR, rub_response
 from ..reduction.contact import Contact
+from ..reduction.nodal_friction import nodal_friction
 from ..reduction.nodes import chord_positions, contact_pressure, nodal_model
 from .keys import StudyError
 from .rub_contact import check_rub_contact, contact_measure
+from .rub_friction import FRICTION_COLUMNS, friction_columns, friction_section, friction_words
 
 __all__ = ["check_rub_contact", "contact_measure", "crossing_speed", "node_angles", "rub_stage"]
 
@@ -135,7 +137,7 @@ def _running(model, contact: Contact, u: np.ndarray, speed: float) -> Contact:
 
 def _rub_point(speed: float, *, model, contact: Contact, interior: np.ndarray, size: int, casing: np.ndarray,
                angles: np.ndarray, axis: RotationAxis, static: str, lobes: int, amplitude: float, damping: Damping,
-               revolutions: int, window: int, max_revolutions: int) -> dict:
+               revolutions: int, window: int, max_revolutions: int, friction: dict | None = None) -> dict:
     """One speed (module level: an executor ships it to its workers)."""
     state = spin(model, speed, axis, static=static)
     hot = _running(model, contact, state.displacement, speed)
@@ -144,8 +146,10 @@ def _rub_point(speed: float, *, model, contact: Contact, interior: np.ndarray, s
     own = interior if state.static != "nonlinear" else None
     reduced = nodal_model(state.model, hot, size, factor=state.factor, casing=casing, interior=own, residual=True)
     try:
+        fr = None if friction is None else nodal_friction(reduced, friction["mu"], axis.origin, axis.direction,
+                                                          factor=state.factor if reduced.residual else None)
         response = rub_response(reduced.system, speed, lobes, amplitude, angles, damping, revolutions, window,
-                                areas=reduced.areas, max_revolutions=max_revolutions)
+                                areas=reduced.areas, max_revolutions=max_revolutions, friction=fr)
     except ValueError as exc:  # the simulation refused this speed (e.g. a grazing switch): the others go on
         out = {"error": str(exc), "nodes": list(reduced.system.nodes)}
     else:
@@ -254,13 +258,17 @@ def rub_stage(study, model, contact: Contact, *, families=None, executor=None, p
         raise StudyError(f"[rub] {exc}") from None
     damping = _damping(r)
     cap = max_revolutions(r)
+    friction = study["contact"].get("friction")
+    if friction is not None:
+        log.info("rub: %s", friction_words(friction))
     log.info("rub: %d speeds %.6g–%.6g %s, casing with %d lobes of %.4g mm, %d contact nodes (%s casing), %d "
              "revolutions each (the last %d read; on to at most %d until settled)", speeds.size, min(r["speeds"]),
              max(r["speeds"]), unit, k["lobes"], k["amplitude"] * 1e3, len(nodes),
              "rigid" if np.isinf(casing).all() else f"{casing.sum():.4g} N/m", r["revolutions"], r["window"], cap)
     shared = dict(model=model, contact=contact, interior=interior, size=r["size"], casing=casing, angles=angles,
                   axis=axis, static=static, lobes=k["lobes"], amplitude=k["amplitude"], damping=damping,
-                  revolutions=r["revolutions"], window=r["window"], max_revolutions=cap)
+                  revolutions=r["revolutions"], window=r["window"], max_revolutions=cap,
+                  **({"friction": friction} if friction is not None else {}))
     try:
         points = executor.map(_rub_point, [float(w) for w in speeds], shared=shared, desc="rub speeds",
                               progress=progress)
@@ -333,6 +341,8 @@ def _summary(study, speeds: np.ndarray, points: list[dict], families, contact: C
             failed.append({"speed": float(given), "reason": p["error"]})
             continue
         row = _row(float(given), float(w), p, crossing, k["lobes"], line=measure[0] == "length")
+        if study["contact"].get("friction") is not None:
+            row.update(friction_columns(p))
         rows.append(row)
         if row["response"] != "settled" or row["revolutions_run"] > r["revolutions"]:
             characterised.append({"speed": row["speed"], "response": p["response"], "settled": bool(p["settled"]),
@@ -349,7 +359,9 @@ def _summary(study, speeds: np.ndarray, points: list[dict], families, contact: C
     resonances = _resonances(speeds[ok], open_hz, k["lobes"]) if ok.sum() > 1 else []
     for res in resonances:
         res["speed"] = res["speed_rad_s"] / scale
+    friction = study["contact"].get("friction")
     return {
+        **({"friction": friction_section(friction, rows, good)} if friction is not None else {}),
         "speed_unit": unit, "lobes": k["lobes"], "amplitude_m": k["amplitude"], "revolutions": r["revolutions"],
         "window": r["window"], "max_revolutions": max_revolutions(r),
         "damping": {"ratio": r["ratio"]} if r["ratio"] is not None else {"rayleigh": r["rayleigh"]},
@@ -423,9 +435,10 @@ def _along_tip(model, contact: Contact, touching: list[int], areas: np.ndarray |
 
 def _write(folder: Path, section: dict, points: list[dict], figures: bool, title: str | None) -> dict:
     rows = section["rows"]
-    lines = [",".join(COLUMNS)]
+    columns = {**COLUMNS, **(FRICTION_COLUMNS if "friction" in section else {})}
+    lines = [",".join(columns)]
     for row in rows:
-        lines.append(",".join(csv_cell(row[c]) for c in COLUMNS))
+        lines.append(",".join(csv_cell(row[c]) for c in columns))
     write_text(folder / "rub.csv", "\n".join(lines) + "\n")
     node_lines = ["speed,speed_rad_s,node,peak_displacement_mm,peak_force_n,contact_pressure_mpa,contact_fraction,"
                   "penetration_mm,clearance_mm"]
