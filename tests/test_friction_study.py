@@ -112,3 +112,72 @@ def test_friction_key_defaults_its_model():
     study = loads(_study(rub=RUB, friction="{mu = 0.2}"), source="<friction>")
     assert study["contact"]["friction"] == {"mu": 0.2, "model": "rotation"}
     assert np.isclose(study["contact"]["friction"]["mu"], 0.2)
+
+
+WEAR_CASING = """
+[casing]
+radius = 0.4505
+axis = {origin = [-0.000167, 0.030778, -0.3], direction = [-0.350089, -0.936717, 0.0]}
+lobes = 8
+amplitude = 3e-4
+abradable = ABRADABLE
+"""
+
+COATING = "{thickness = 1e-3, yield = 2e5, stiffness = 2e11, cells = 24}"
+
+
+def _wear_study(coating: str = COATING, rub: str = RUB, **contact) -> str:
+    text = _study(casing=WEAR_CASING.replace("ABRADABLE", coating), rub=rub, **contact)
+    return text.replace("casing_stiffness = 1e6      # N/m: a thin casing's local radial stiffness; the modes "
+                        "converge (docs/massless.md)\n", "")
+
+
+@pytest.mark.parametrize("coating, rub, contact, match", [
+    ("{thickness = 1e-3, stiffness = 2e11}", RUB, {}, r"needs yield \(Pa: the contact pressure at which"),
+    ("{thickness = 1e-3, yield = 2e5, stiffness = 2e11, cells = 2}", RUB, {}, r"cells must be an integer in \[3"),
+    ("{thickness = -1e-3, yield = 2e5, stiffness = 2e11}", RUB, {}, r"thickness must be a finite number > 0"),
+    (COATING, "", {}, r"\[casing\] abradable: the coating is worn by the rub response: give \[rub\] speeds"),
+    (COATING, RUB, {"casing_stiffness": "1e6"}, r"\[contact\] casing_stiffness: with a \[casing\] abradable"),
+])
+def test_abradable_key_errors(coating, rub, contact, match):
+    with pytest.raises(StudyError, match=match):
+        loads(_wear_study(coating, rub, **contact), source="<wear>")
+
+
+def test_friction_and_wear_end_to_end_through_the_cli(tmp_path):
+    """``bladecase run`` on the demo blade at 1650 rpm with μ = 0.15 and a 24-cell abradable coating, two
+    revolutions: rub.csv with the friction's columns, wear.csv per revolution whose removed volume is the
+    profile's missing volume to 1e-6, wear_profile.csv, wear.png, the worn casing's ring in wear.vtu, the summary
+    and the report's words."""
+    import csv
+    import json
+
+    import meshio
+
+    from bladecase.cli import main
+
+    study = tmp_path / "wear.toml"
+    study.write_text(_wear_study(friction="{mu = 0.15}").replace("[rub]\n", "[rub]\nsize = 4\n"), encoding="utf-8")
+    out = tmp_path / "out"
+    assert main(["run", str(study), "--out", str(out), "--quiet"]) == 0
+    summary = json.loads((out / "summary.json").read_text())["rub"]
+    assert summary["friction"]["worst_residual"] < 1e-9
+    rows = list(csv.DictReader(open(out / "wear.csv")))
+    assert [int(r["revolution"]) for r in rows] == [1, 2]
+    for r in rows:
+        assert float(r["removed_volume_mm3"]) == pytest.approx(float(r["missing_volume_mm3"]), rel=1e-6)
+    assert float(rows[-1]["removed_volume_mm3"]) > 0
+    wear = summary["wear"]["speeds"][0]
+    assert wear["volume_mismatch"] < 1e-6 and wear["lobes"] == int(rows[-1]["lobes"])
+    ring = meshio.read(out / "wear.vtu")
+    assert ring.cells_dict["quad"].shape == (24, 4)
+    assert ring.point_data["worn_depth_mm"].max() == pytest.approx(float(rows[-1]["max_depth_um"]) * 1e-3, rel=1e-8)
+    radius = np.linalg.norm(np.cross(ring.points - [-0.000167, 0.030778, -0.3], [-0.350089, -0.936717, 0.0]),
+                            axis=1) / np.linalg.norm([-0.350089, -0.936717, 0.0])
+    np.testing.assert_allclose(radius, 0.4505 + ring.point_data["worn_depth_mm"] * 1e-3, rtol=1e-6)
+    profile = list(csv.DictReader(open(out / "wear_profile.csv")))
+    assert len(profile) == 24
+    assert (out / "wear.png").is_file() and (out / "rub.png").is_file()
+    report = (out / "report.md").read_text()
+    assert "Abradable coating: 1 mm thick" in report and "the sliding dominated by the rotation" in report
+    assert "round(f_vib / f_rot)" in report

@@ -133,7 +133,36 @@ def rub_report(section: dict | None) -> list[str]:
                      "the other speeds are unaffected.")
     lines += _settling(section, unit)
     lines += _friction_lines(section.get("friction"), unit)
+    lines += _wear_lines(section.get("wear"), unit)
     return lines
+
+
+def _wear_lines(w: dict | None, unit: str) -> list[str]:
+    """The abradable coating's words: the coating, the coupling, per speed the lobes and depth worn, the removed
+    volume against the profile's missing volume, the response's frequency over the rotation's."""
+    if not w:
+        return []
+    c = w["coating"]
+    out = [f"- Abradable coating: {c['thickness_m'] * 1e3:.4g} mm thick, removed above {c['yield_pa'] * 1e-6:.4g} MPa "
+           f"(stiffness {c['stiffness_pa_per_m']:.4g} Pa/m: it yields {c['yield_depth_m'] * 1e6:.3g} µm elastically), "
+           f"{c['cells']} cells round the casing over the {c['width_m'] * 1e3:.4g} mm band the tip rubs; "
+           f"{w['coupling']}. Files: `wear.csv` (per speed and revolution), `wear_profile.csv`, `wear.png` (the "
+           "profile unrolled over the angle after each revolution), `wear.vtu` (the worn casing).",
+           ]
+    for r in w["speeds"]:
+        if r["removed_mm3"] == 0:
+            out.append(f"- At {r['speed']:.6g} {unit} the tip removes no coating in {r['revolutions']} revolutions.")
+            continue
+        match = ("as many as" if r["lobes"] == r["expected_lobes"] else "against")
+        out.append(f"- At {r['speed']:.6g} {unit} after {r['revolutions']} revolutions the profile has {r['lobes']} "
+                   f"lobes, {r['lobe_depth_um']:.3g} µm deep (deepest {r['max_depth_um']:.3g} µm); "
+                   f"{r['removed_mm3']:.4g} mm³ removed (the profile's missing volume to {r['volume_mismatch']:.0e}); "
+                   f"the tip vibrates at {r['vibration_ratio']:.3g} × the rotation frequency: {match} "
+                   f"round(f_vib / f_rot) = {r['expected_lobes']} lobes"
+                   + ("; **the tip has worn through to the casing**." if r["worn_through"] else "."))
+    if len(w["speeds"]) > 1:
+        out.append(f"- The most coating is removed at {w['most_wear']:.6g} {unit}.")
+    return out
 
 
 def _friction_lines(f: dict | None, unit: str) -> list[str]:

@@ -34,6 +34,8 @@ from .. import log
 from ..fe.rotation import SPEED_UNITS, RotationAxis, spin, to_rad_s
 from ..io import csv_cell, save_figure, write_text
 from ..nsm.damping import Damping
+from ..nsm.massless.friction import friction_flight
+from ..nsm.massless.nodes import Rub
 from ..nsm.massless.rub import RUN_ON_FACTOR, rub_response
 from ..nsm.massless.wear_rub import wear_rub
 from ..reduction.contact import Contact
@@ -154,15 +156,16 @@ def _rub_point(speed: float, *, model, contact: Contact, interior: np.ndarray, s
     try:
         fr = None if friction is None else nodal_friction(reduced, friction["mu"], axis.origin, axis.direction,
                                                           factor=state.factor if reduced.residual else None)
+        flight = friction_flight(reduced.system, fr, damping, Rub(lobes, amplitude, speed, angles))
         response = rub_response(reduced.system, speed, lobes, amplitude, angles, damping, revolutions, window,
-                                areas=reduced.areas, max_revolutions=max_revolutions, friction=fr)
+                                areas=reduced.areas, max_revolutions=max_revolutions, friction=fr, flight=flight)
     except ValueError as exc:  # the simulation refused this speed (e.g. a grazing switch): the others go on
         out = {"error": str(exc), "nodes": list(reduced.system.nodes)}
     else:
         out = response.as_dict()
         if coating is not None:
             out["wear"] = wear_figures(wear_rub(reduced.system, coating, speed, lobes, amplitude, angles, damping,
-                                                revolutions, areas=reduced.areas, friction=fr))
+                                                revolutions, areas=reduced.areas, friction=fr, flight=flight))
         out["load"] = reduced.contact_load(response.force_at_peak)
         out["peak_pressure"] = np.nan_to_num(contact_pressure(response.peak_force, reduced.areas)).tolist()
     out["open_hz"] = (reduced.system.modes[0][:6] / (2 * np.pi)).tolist()

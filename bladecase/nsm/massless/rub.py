@@ -355,7 +355,8 @@ def _checked(revolutions, window, max_revolutions, speed) -> tuple[int, float]:
 
 def rub_response(system: NodalSystem, speed: float, lobes: int, amplitude: float, angles, damping=None,
                  revolutions: int = 40, window: int = 10, max_switches: int = 2_000_000,
-                 areas=None, max_revolutions: int | None = None, friction=None) -> RubResponse:
+                 areas=None, max_revolutions: int | None = None, friction=None,
+                 flight: NodalFlight | None = None) -> RubResponse:
     """The rub response at ``speed`` (rad/s) from rest, over ``revolutions`` turns and on, a ``window`` at a time,
     until it settles or ``max_revolutions`` (default ``10 × revolutions``) have run; read on the last ``window``
     (or a whole number of its periods) and characterised when it did not settle (module docstring). ``angles``: each
@@ -363,14 +364,18 @@ def rub_response(system: NodalSystem, speed: float, lobes: int, amplitude: float
     open-phase modes (``None``: undamped); ``areas``: each node's tributary area (m², ``(m,)``) for the largest
     loaded area (``loaded_area``; ``None`` without); ``max_switches``: over the whole run; ``friction``: a
     :class:`~bladecase.nsm.massless.friction.Friction` at the contact nodes (``None`` or ``μ = 0``: none, the
-    results bit for bit those without)."""
+    results bit for bit those without); ``flight``: the flight to fly (its phases reused: it must be of this
+    system, damping, casing and friction; default: a new one)."""
     cap, speed = _checked(revolutions, window, max_revolutions, speed)
     if areas is not None:
         areas = np.asarray(areas, dtype=float)
         if areas.shape != (system.m,):
             raise ValueError(f"areas must hold one value per contact node ({system.m}), got shape {areas.shape}")
     rub = Rub(lobes, amplitude, speed, angles)
-    fl = NodalFlight(system, damping, rub) if friction is None else friction_flight(system, friction, damping, rub)
+    if flight is not None:
+        fl = flight
+    else:
+        fl = NodalFlight(system, damping, rub) if friction is None else friction_flight(system, friction, damping, rub)
     turn = 2 * np.pi / speed
     passing = turn / lobes
     W = window * lobes  # lobe passings per window

@@ -89,11 +89,12 @@ def vibration_ratio(signal, samples_per_turn: int) -> float:
 
 def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, amplitude: float, angles,
              damping=None, revolutions: int = 10, areas=None, friction=None,
-             max_switches: int = 2_000_000) -> WearRub:
+             max_switches: int = 2_000_000, flight: NodalFlight | None = None) -> WearRub:
     """The coupled rub and wear of ``system`` at ``speed`` (rad/s) in a casing with ``lobes`` lobes of
     ``amplitude`` (m) lined with ``coating``, from rest over ``revolutions`` turns (module docstring). ``areas``:
     each node's tributary area (m²), for the pressure (``system.casing`` should be ``coating.stiffness × areas``);
-    ``friction``: a :class:`~bladecase.nsm.massless.friction.Friction`, or ``None``."""
+    ``friction``: a :class:`~bladecase.nsm.massless.friction.Friction`, or ``None``; ``flight``: the flight to fly
+    (its phases reused, e.g. the rub response's: of this system, damping, casing and friction)."""
     if not isinstance(coating, Abradable):
         raise ValueError(f"coating must be an Abradable, got {type(coating).__name__}")
     if isinstance(revolutions, bool) or int(revolutions) != revolutions or revolutions < 1:
@@ -103,7 +104,10 @@ def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, 
         raise ValueError(f"speed must be a finite number > 0 (rad/s), got {speed!r}")
     areas = np.ones(system.m) if areas is None else np.asarray(areas, dtype=float)
     rub = Rub(lobes, amplitude, speed, angles)
-    fl = NodalFlight(system, damping, rub) if friction is None else friction_flight(system, friction, damping, rub)
+    if flight is not None:
+        fl = flight
+    else:
+        fl = NodalFlight(system, damping, rub) if friction is None else friction_flight(system, friction, damping, rub)
     phi = np.asarray(rub.angles)
     turn = 2 * np.pi / speed
     per_turn = max(SAMPLES_PER_CELL * coating.cells, 48 * lobes,
