@@ -153,6 +153,11 @@ class _Phase:
         out.const = self.const + self.L @ dq + self.P @ delta
         return out
 
+    def signals_at(self, q: np.ndarray, gap: np.ndarray) -> np.ndarray:
+        """The ``m`` switching signals (``λ`` of the closed contacts, the clearance left of the open ones) of the
+        modal displacement ``q`` against the clearances ``gap``."""
+        return self.L @ q + self.P @ gap
+
     def particular(self, t: float) -> tuple[np.ndarray, np.ndarray]:
         if self.nu == 0:
             return self.q_eq, np.zeros_like(self.q_eq)
@@ -419,7 +424,9 @@ def simulate_nodes(system: NodalSystem, x0, v0, t_end: float, damping=None, rub:
         if hit is None and step < t_end:  # the profile steps: the closed contacts from the new clearances
             q, p = ph.advance(a, t, step - t)
             t = step
-            A = fl.active_set(q, p, t)
+            sig = fl.phase(A, t).signals_at(q, fl.gap(t))  # the same contacts, strictly, at the new clearances?
+            if not np.all(sig > SURFACE_RTOL * max(float(np.abs(sig).max()), np.finfo(float).tiny)):
+                A = fl.active_set(q, p, t)
             on = np.zeros(system.m, dtype=bool)
             starts.append(t)
             actives.append(A)
