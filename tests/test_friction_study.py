@@ -181,3 +181,6 @@ def test_friction_and_wear_end_to_end_through_the_cli(tmp_path):
     report = (out / "report.md").read_text()
     assert "Abradable coating: 1 mm thick" in report and "the sliding dominated by the rotation" in report
     assert "round(f_vib / f_rot)" in report
+    log = (out / "run.log").read_text()
+    assert "the sliding dominated by the rotation" in log and "the sliding is dominated by the rotation at every" in log
+    assert "the coating is worn to" in log

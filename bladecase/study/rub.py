@@ -43,8 +43,8 @@ from ..reduction.nodal_friction import nodal_friction
 from ..reduction.nodes import chord_positions, contact_pressure, nodal_model
 from .keys import StudyError
 from .rub_contact import check_rub_contact, contact_measure
-from .rub_friction import FRICTION_COLUMNS, friction_columns, friction_section, friction_words
-from .rub_wear import coating_of, wear_figures, wear_section, write_wear
+from .rub_friction import FRICTION_COLUMNS, friction_columns, friction_section, friction_words, log_friction
+from .rub_wear import coating_of, log_wear, wear_figures, wear_section, write_wear
 
 __all__ = ["check_rub_contact", "contact_measure", "crossing_speed", "node_angles", "rub_stage"]
 
@@ -300,6 +300,8 @@ def rub_stage(study, model, contact: Contact, *, families=None, executor=None, p
     points = [p for p in points if "error" not in p]  # aligned with the rows
     if coating is not None:
         section["wear"] = wear_section(study, coating, section["rows"], points)
+    log_friction(section, unit)
+    log_wear(section, unit)
     if folder is not None:
         section["files"] = _write(Path(folder), section, points, figures, title)
         if "vtu" in study["output"]["formats"]:

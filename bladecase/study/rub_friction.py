@@ -7,7 +7,9 @@
 
 from __future__ import annotations
 
-__all__ = ["FRICTION_COLUMNS", "friction_columns", "friction_section", "friction_words"]
+from .. import log
+
+__all__ = ["FRICTION_COLUMNS", "friction_columns", "friction_section", "friction_words", "log_friction"]
 
 #: Columns added to ``rub.csv`` with friction: name → what it holds (the last revolution's energy balance, J).
 FRICTION_COLUMNS = {
@@ -54,3 +56,13 @@ def friction_section(friction: dict, rows: list[dict], points: list[dict]) -> di
     return {"mu": friction["mu"], "model": friction["model"], "assumption": friction_words(friction),
             "speeds": per, "worst_residual": max(residuals) if residuals else None,
             "not_rotation_dominated": [r["speed"] for r in per if r["rotation_dominated"] is False]}
+
+
+def log_friction(section: dict, unit: str) -> None:
+    """Per speed, the friction's energy balance and the sliding check, in the log."""
+    for f in (section.get("friction") or {}).get("speeds", []):
+        if f["casing_input_j"] is not None:
+            log.info("rub: at %.6g %s friction does %.4g J over the last revolution (casing %.4g J, damping %.4g J, "
+                     "stored change %.4g J; balance to %.1e); %s", f["speed"], unit, f["friction_work_j"],
+                     f["casing_input_j"], f["damping_j"], f["stored_change_j"], f["balance_residual"],
+                     f["sliding"] or "no nodes' radii: the sliding not checked")

@@ -13,11 +13,12 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import log
 from ..io import csv_cell, save_figure, write_text
 from ..nsm.massless.wear import Abradable
 from .keys import StudyError
 
-__all__ = ["WEAR_COLUMNS", "coating_of", "wear_figures", "wear_section", "write_wear"]
+__all__ = ["WEAR_COLUMNS", "coating_of", "log_wear", "wear_figures", "wear_section", "write_wear"]
 
 #: Columns of ``wear.csv``: name → what it holds.
 WEAR_COLUMNS = {
@@ -99,6 +100,14 @@ def wear_section(study, coating: Abradable, rows: list[dict], points: list[dict]
             "speeds": per, "most_wear": None if top is None else per[top]["speed"],
             "coupling": "each revolution is flown with the profile worn by the revolutions before as its clearance; "
                         "within a revolution the coating is elastic, its removal taken at the revolution's end"}
+
+
+def log_wear(section: dict, unit: str) -> None:
+    """Per speed, the wear in the log."""
+    for w in (section.get("wear") or {}).get("speeds", []):
+        log.info("rub: at %.6g %s the coating is worn to %.4g µm in %d lobes after %d revolutions (%.4g mm³ removed; "
+                 "the tip vibrates at %.3g × the rotation frequency)", w["speed"], unit, w["max_depth_um"], w["lobes"],
+                 w["revolutions"], w["removed_mm3"], w["vibration_ratio"])
 
 
 def write_wear(folder: Path, study, model, contact, section: dict, points: list[dict], figures: bool,
