@@ -33,10 +33,10 @@ def wear_plot(section: dict, points: list[dict], title: str | None = None) -> Fi
     top = next(i for i, r in enumerate(per) if r["speed"] == wear["most_wear"])
     history = np.asarray(points[top]["wear"]["history_m"]) * 1e6
     cells = history.shape[1]
-    theta = (np.arange(cells) + 0.5) * 360.0 / cells
+    edges = np.arange(cells + 1) * 360.0 / cells
     cmap = colormaps["viridis"]
     for k, d in enumerate(history):
-        ax.step(theta, d, where="mid", color=cmap(0.15 + 0.8 * k / max(1, history.shape[0] - 1)), lw=1.0,
+        ax.stairs(d, edges, color=cmap(0.15 + 0.8 * k / max(1, history.shape[0] - 1)), lw=1.0,
                 label=f"revolution {k + 1}" if k in (0, history.shape[0] - 1) else None)
     ax.set_xlim(0.0, 360.0)
     ax.set_xlabel("angle round the casing (deg)")
