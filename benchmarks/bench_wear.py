@@ -85,7 +85,8 @@ def main() -> None:
         print(f"  {w['speed']:7.6g} rpm ({row['speed_ratio']:.3f} x crossing): profile {w['lobes']:2d} lobes, "
               f"{w['lobe_depth_um']:8.3f} um deep (deepest {w['max_depth_um']:.3f} um); response f_vib/f_rot = "
               f"{w['vibration_ratio']:.3f} -> round {w['expected_lobes']}: {'agree' if ok else 'DIFFER'}; removed "
-              f"{w['removed_mm3']:.6g} mm3 vs missing {w['missing_mm3']:.6g} mm3 (rel. {w['volume_mismatch']:.1e})")
+              f"{w['removed_mm3']:.6g} mm3 vs missing {w['missing_mm3']:.6g} mm3 (rel. {w['volume_mismatch']:.1e})"
+              + ("; worn through to the casing" if w["worn_through"] else ""))
     print(f"lobe count = round(f_vib / f_rot) at {agree} of {len(wear['speeds'])} speeds")
     n = len(section["rows"])
     print(f"cost: model {t1 - t0:.1f} s; rub stage {t2 - t1:.1f} s for {n} speeds ({(t2 - t1) / n:.1f} s a speed, the "
