@@ -184,3 +184,24 @@ def test_friction_and_wear_end_to_end_through_the_cli(tmp_path):
     log = (out / "run.log").read_text()
     assert "the sliding dominated by the rotation" in log and "the sliding is dominated by the rotation at every" in log
     assert "the coating is worn to" in log
+
+
+def test_a_coating_on_a_line_of_nodes_is_refused_before_any_factorisation():
+    """The coating's pressure needs each node's area: a line of tip nodes (no facet of the body) is refused."""
+    from test_rub_line import LINE
+
+    from bladecase.study.executor import SerialExecutor
+    from bladecase.study.rub import rub_stage
+    from bladecase.study.stages import build_contact
+
+    text = _wear_study().replace('face = "tip"                # the whole tip face rubs: its mean normal '
+                                 'displacement meets the casing\n', f"nodes = {LINE}\n")
+    text = text.replace('weights = "area"            # nodes weighted by their share of the face (converges under '
+                        'mesh refinement)\n', "")
+    study = loads(text, source="<wear>")
+    from bladecase.study.stages import build_mesh, build_model
+
+    blade = build_model(study, build_mesh(study))
+    with pytest.raises(StudyError, match=r"\[casing\] abradable: the coating's pressure needs each contact node's "
+                                         r"area: give a contact face"):
+        rub_stage(study, blade, build_contact(study, blade), executor=SerialExecutor())
