@@ -135,7 +135,7 @@ def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, 
         peak_u.append(float(y.max()))
         peak_p.append(float((lam / areas[:, None]).max()))
         count.append(profile.lobes())
-        tip = (tip + [(system.W.T @ tr.sample(grid)[0]).mean(axis=0)])[-TAIL:]
+        tip = (tip + [(system.W.T @ xs[:, np.searchsorted(t, grid)]).mean(axis=0)])[-TAIL:]
         x, v = tr.x_end, tr.v_end
     ratio = vibration_ratio(np.concatenate(tip), per_turn)
     return WearRub(profile, np.array(removed), np.array(peak_u), np.array(peak_p), np.array(count), ratio, phases)
