@@ -132,7 +132,64 @@ def rub_report(section: dict | None) -> list[str]:
         lines.append(f"- **No result at {f['speed']:.6g} {unit}**: the simulation was refused there ({f['reason']}); "
                      "the other speeds are unaffected.")
     lines += _settling(section, unit)
+    lines += _friction_lines(section.get("friction"), unit)
+    lines += _wear_lines(section.get("wear"), unit)
     return lines
+
+
+def _wear_lines(w: dict | None, unit: str) -> list[str]:
+    """The abradable coating's words: the coating, the coupling, per speed the lobes and depth worn, the removed
+    volume against the profile's missing volume, the response's frequency over the rotation's."""
+    if not w:
+        return []
+    c = w["coating"]
+    out = [f"- Abradable coating: {c['thickness_m'] * 1e3:.4g} mm thick, removed above {c['yield_pa'] * 1e-6:.4g} MPa "
+           f"(stiffness {c['stiffness_pa_per_m']:.4g} Pa/m: it yields {c['yield_depth_m'] * 1e6:.3g} µm elastically), "
+           f"{c['cells']} cells round the casing over the {c['width_m'] * 1e3:.4g} mm band the tip rubs; "
+           f"{w['coupling']}. Files: `wear.csv` (per speed and revolution), `wear_profile.csv`, `wear.png` (the "
+           "profile unrolled over the angle after each revolution), `wear.vtu` (the worn casing).",
+           ]
+    for r in w["speeds"]:
+        if r["removed_mm3"] == 0:
+            out.append(f"- At {r['speed']:.6g} {unit} the tip removes no coating in {r['revolutions']} revolutions.")
+            continue
+        match = ("as many as" if r["lobes"] == r["expected_lobes"] else "against")
+        out.append(f"- At {r['speed']:.6g} {unit} after {r['revolutions']} revolutions the profile has {r['lobes']} "
+                   f"lobes, {r['lobe_depth_um']:.3g} µm deep (deepest {r['max_depth_um']:.3g} µm); "
+                   f"{r['removed_mm3']:.4g} mm³ removed (the profile's missing volume to {r['volume_mismatch']:.0e}); "
+                   f"the tip vibrates at {r['vibration_ratio']:.3g} × the rotation frequency: {match} "
+                   f"round(f_vib / f_rot) = {r['expected_lobes']} lobes"
+                   + ("; **the tip has worn through to the casing**." if r["worn_through"] else "."))
+    if len(w["speeds"]) > 1:
+        out.append(f"- The most coating is removed at {w['most_wear']:.6g} {unit}.")
+    return out
+
+
+def _friction_lines(f: dict | None, unit: str) -> list[str]:
+    """The friction's words: its model and assumption, the energy of the hardest speed's last revolution, the
+    balance and the sliding check."""
+    if not f:
+        return []
+    out = [f"- Friction: {f['assumption']}."]
+    rows = [r for r in f["speeds"] if r["casing_input_j"] is not None]
+    if rows:
+        top = max(rows, key=lambda r: abs(r["casing_input_j"]))
+        out.append(f"- Energy over the last revolution at {top['speed']:.6g} {unit}: the casing puts in "
+                   f"{top['casing_input_j']:.4g} J, friction does {top['friction_work_j']:.4g} J on the vibration, "
+                   f"damping takes {top['damping_j']:.4g} J and the stored energy changes by "
+                   f"{top['stored_change_j']:.4g} J; the balance closes to {f['worst_residual']:.1e} (relative, worst "
+                   "revolution of every speed's window; `rub.csv` gives every speed).")
+    bad = f.get("not_rotation_dominated") or []
+    if bad:
+        out.append(f"- **The sliding is not dominated by the rotation** at {', '.join(f'{s:.6g}' for s in bad)} "
+                   f"{unit}: a node's tangential vibration velocity exceeds 0.1 × ΩR there, so the friction's "
+                   "direction is not the circumferential one and the results with friction are not to be trusted "
+                   "at those speeds (a stick–slip model is needed).")
+    elif rows:
+        worst = max(r["sliding_ratio"] or 0.0 for r in rows)
+        out.append(f"- The sliding is dominated by the rotation at every speed: the largest tangential vibration "
+                   f"velocity is {worst:.2g} × ΩR (the assumption holds below 0.1).")
+    return out
 
 
 #: Said of the crossing speed of mode 1 where the report names it.

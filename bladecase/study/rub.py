@@ -34,11 +34,17 @@ from .. import log
 from ..fe.rotation import SPEED_UNITS, RotationAxis, spin, to_rad_s
 from ..io import csv_cell, save_figure, write_text
 from ..nsm.damping import Damping
+from ..nsm.massless.friction import friction_flight
+from ..nsm.massless.nodes import Rub
 from ..nsm.massless.rub import RUN_ON_FACTOR, rub_response
+from ..nsm.massless.wear_rub import wear_rub
 from ..reduction.contact import Contact
+from ..reduction.nodal_friction import nodal_friction
 from ..reduction.nodes import chord_positions, contact_pressure, nodal_model
 from .keys import StudyError
 from .rub_contact import check_rub_contact, contact_measure
+from .rub_friction import FRICTION_COLUMNS, friction_columns, friction_section, friction_words, log_friction
+from .rub_wear import coating_of, log_wear, wear_figures, wear_section, write_wear
 
 __all__ = ["check_rub_contact", "contact_measure", "crossing_speed", "node_angles", "rub_stage"]
 
@@ -103,6 +109,9 @@ def _node_stiffness(study, model, contact: Contact, shares: np.ndarray | None = 
     if shares is None:
         shares = check_rub_contact(study, model, contact)[1]
     c = study["contact"]
+    coating = (study.config.get("casing") or {}).get("abradable")
+    if coating is not None:  # the coating's elastic layer is the casing's compliance at each node (per area)
+        return coating["stiffness"] * shares
     if c.get("casing_stiffness_per_area") is not None:
         return c["casing_stiffness_per_area"] * shares
     from .stages import casing_stiffness
@@ -135,7 +144,8 @@ def _running(model, contact: Contact, u: np.ndarray, speed: float) -> Contact:
 
 def _rub_point(speed: float, *, model, contact: Contact, interior: np.ndarray, size: int, casing: np.ndarray,
                angles: np.ndarray, axis: RotationAxis, static: str, lobes: int, amplitude: float, damping: Damping,
-               revolutions: int, window: int, max_revolutions: int) -> dict:
+               revolutions: int, window: int, max_revolutions: int, friction: dict | None = None,
+               coating=None) -> dict:
     """One speed (module level: an executor ships it to its workers)."""
     state = spin(model, speed, axis, static=static)
     hot = _running(model, contact, state.displacement, speed)
@@ -144,12 +154,18 @@ def _rub_point(speed: float, *, model, contact: Contact, interior: np.ndarray, s
     own = interior if state.static != "nonlinear" else None
     reduced = nodal_model(state.model, hot, size, factor=state.factor, casing=casing, interior=own, residual=True)
     try:
+        fr = None if friction is None else nodal_friction(reduced, friction["mu"], axis.origin, axis.direction,
+                                                          factor=state.factor if reduced.residual else None)
+        flight = friction_flight(reduced.system, fr, damping, Rub(lobes, amplitude, speed, angles))
         response = rub_response(reduced.system, speed, lobes, amplitude, angles, damping, revolutions, window,
-                                areas=reduced.areas, max_revolutions=max_revolutions)
+                                areas=reduced.areas, max_revolutions=max_revolutions, friction=fr, flight=flight)
     except ValueError as exc:  # the simulation refused this speed (e.g. a grazing switch): the others go on
         out = {"error": str(exc), "nodes": list(reduced.system.nodes)}
     else:
         out = response.as_dict()
+        if coating is not None:
+            out["wear"] = wear_figures(wear_rub(reduced.system, coating, speed, lobes, amplitude, angles, damping,
+                                                revolutions, areas=reduced.areas, friction=fr, flight=flight))
         out["load"] = reduced.contact_load(response.force_at_peak)
         out["peak_pressure"] = np.nan_to_num(contact_pressure(response.peak_force, reduced.areas)).tolist()
     out["open_hz"] = (reduced.system.modes[0][:6] / (2 * np.pi)).tolist()
@@ -232,6 +248,9 @@ def rub_stage(study, model, contact: Contact, *, families=None, executor=None, p
     face on the [casing]); writes ``rub.csv``, ``rub_nodes.csv`` and ``rub.png`` into ``folder``; returns the
     summary section."""
     kind, shares = check_rub_contact(study, model, contact)  # before any factorisation
+    if study["casing"].get("abradable") is not None and kind != "area":
+        raise StudyError("[casing] abradable: the coating's pressure needs each contact node's area: give a contact "
+                         "face ([contact] face), not a line of nodes")
     r, k = study["rub"], study["casing"]
     unit = r["speed_unit"]
     speeds = np.array([to_rad_s(v, unit) for v in r["speeds"]])
@@ -254,13 +273,24 @@ def rub_stage(study, model, contact: Contact, *, families=None, executor=None, p
         raise StudyError(f"[rub] {exc}") from None
     damping = _damping(r)
     cap = max_revolutions(r)
+    friction = study["contact"].get("friction")
+    if friction is not None:
+        log.info("rub: %s", friction_words(friction))
+    coating = coating_of(study, model, contact) if k.get("abradable") is not None else None
+    if coating is not None:
+        log.info("rub: an abradable coating of %.4g mm (yield %.4g MPa, %.4g Pa/m, %d cells over a band of %.4g mm "
+                 "at radius %.4g mm) worn over %d revolutions at each speed, each revolution flown with the profile "
+                 "the revolutions before left", coating.thickness * 1e3, coating.yield_pressure * 1e-6,
+                 coating.stiffness, coating.cells, coating.width * 1e3, coating.radius * 1e3, r["revolutions"])
     log.info("rub: %d speeds %.6g–%.6g %s, casing with %d lobes of %.4g mm, %d contact nodes (%s casing), %d "
              "revolutions each (the last %d read; on to at most %d until settled)", speeds.size, min(r["speeds"]),
              max(r["speeds"]), unit, k["lobes"], k["amplitude"] * 1e3, len(nodes),
              "rigid" if np.isinf(casing).all() else f"{casing.sum():.4g} N/m", r["revolutions"], r["window"], cap)
     shared = dict(model=model, contact=contact, interior=interior, size=r["size"], casing=casing, angles=angles,
                   axis=axis, static=static, lobes=k["lobes"], amplitude=k["amplitude"], damping=damping,
-                  revolutions=r["revolutions"], window=r["window"], max_revolutions=cap)
+                  revolutions=r["revolutions"], window=r["window"], max_revolutions=cap,
+                  **({"friction": friction} if friction is not None else {}),
+                  **({"coating": coating} if coating is not None else {}))
     try:
         points = executor.map(_rub_point, [float(w) for w in speeds], shared=shared, desc="rub speeds",
                               progress=progress)
@@ -268,10 +298,17 @@ def rub_stage(study, model, contact: Contact, *, families=None, executor=None, p
         raise StudyError(f"[rub] speeds: {exc}") from None
     section = _summary(study, speeds, points, families, contact, model, casing, (kind, shares))
     points = [p for p in points if "error" not in p]  # aligned with the rows
+    if coating is not None:
+        section["wear"] = wear_section(study, coating, section["rows"], points)
+    log_friction(section, unit)
+    log_wear(section, unit)
     if folder is not None:
         section["files"] = _write(Path(folder), section, points, figures, title)
         if "vtu" in study["output"]["formats"]:
             section["files"]["vtu"] = _write_vtu(Path(folder) / "rub.vtu", model, contact, section, points)
+        if coating is not None:
+            section["files"].update(write_wear(Path(folder), study, model, contact, section, points, figures,
+                                               "vtu" in study["output"]["formats"], title))
     return section
 
 
@@ -333,6 +370,8 @@ def _summary(study, speeds: np.ndarray, points: list[dict], families, contact: C
             failed.append({"speed": float(given), "reason": p["error"]})
             continue
         row = _row(float(given), float(w), p, crossing, k["lobes"], line=measure[0] == "length")
+        if study["contact"].get("friction") is not None:
+            row.update(friction_columns(p))
         rows.append(row)
         if row["response"] != "settled" or row["revolutions_run"] > r["revolutions"]:
             characterised.append({"speed": row["speed"], "response": p["response"], "settled": bool(p["settled"]),
@@ -349,7 +388,9 @@ def _summary(study, speeds: np.ndarray, points: list[dict], families, contact: C
     resonances = _resonances(speeds[ok], open_hz, k["lobes"]) if ok.sum() > 1 else []
     for res in resonances:
         res["speed"] = res["speed_rad_s"] / scale
+    friction = study["contact"].get("friction")
     return {
+        **({"friction": friction_section(friction, rows, good)} if friction is not None else {}),
         "speed_unit": unit, "lobes": k["lobes"], "amplitude_m": k["amplitude"], "revolutions": r["revolutions"],
         "window": r["window"], "max_revolutions": max_revolutions(r),
         "damping": {"ratio": r["ratio"]} if r["ratio"] is not None else {"rayleigh": r["rayleigh"]},
@@ -423,9 +464,10 @@ def _along_tip(model, contact: Contact, touching: list[int], areas: np.ndarray |
 
 def _write(folder: Path, section: dict, points: list[dict], figures: bool, title: str | None) -> dict:
     rows = section["rows"]
-    lines = [",".join(COLUMNS)]
+    columns = {**COLUMNS, **(FRICTION_COLUMNS if "friction" in section else {})}
+    lines = [",".join(columns)]
     for row in rows:
-        lines.append(",".join(csv_cell(row[c]) for c in COLUMNS))
+        lines.append(",".join(csv_cell(row[c]) for c in columns))
     write_text(folder / "rub.csv", "\n".join(lines) + "\n")
     node_lines = ["speed,speed_rad_s,node,peak_displacement_mm,peak_force_n,contact_pressure_mpa,contact_fraction,"
                   "penetration_mm,clearance_mm"]

@@ -39,6 +39,7 @@ from .sections import (
     CONVERGENCE_KEYS,
     EXECUTION_KEYS,
     FORCING_KEYS,
+    FRICTION_KEY,
     LIMIT_KEYS,
     ROTATION_KEYS,
     RUB_KEYS,
@@ -187,6 +188,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "clearance_at": Key(_STR, "cold", "A rotating blade's 'clearance' is the cold one ('cold': the "
                             "centrifugal growth of the blade along the normal closes it at speed) or the running "
                             "one at [rotation] speed ('speed').", _one_of("cold", "speed")),
+        "friction": FRICTION_KEY,
     },
     "reduction": {
         "method": Key(_STR, "lanczos-si", f"Reduced model: {', '.join(METHODS)}; not set with 'methods': the first "

@@ -14,6 +14,7 @@ import numpy as np
 from ..fe.geometry import MAX_CELLS
 from ..nsm.system import DENSE_LIMIT
 from .executor import make_executor
+from .friction_keys import ABRADABLE_KEY, FRICTION_KEY, friction_checks  # noqa: F401 (FRICTION_KEY: schema's)
 from .keys import _BOOL, _INT, _LIST, _NUM, _STR, Key, StudyError
 from .values import (
     LIMITS,
@@ -300,6 +301,7 @@ CASING_KEYS: dict[str, Key] = {
     "amplitude": Key(_NUM, None, "The out-of-round casing's amplitude (m): how far each lobe reaches inwards from the "
                      "round casing; with 'lobes'.",
                      lambda v: None if np.isfinite(v) and 0 < v <= 0.1 else "must be a finite number in (0, 0.1] (m)"),
+    "abradable": ABRADABLE_KEY,
 }
 
 
@@ -366,6 +368,7 @@ RUB_KEYS: dict[str, Key] = {
 def rub_checks(c: dict) -> None:
     """``[rub]`` (when its speeds are given): an out-of-round [casing], a face contact, the massless model, one
     damping, a window of at most half the revolutions, a cap of at least the revolutions."""
+    friction_checks(c)
     r = c.get("rub")
     if not r:
         return

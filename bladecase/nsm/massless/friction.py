@@ -218,9 +218,11 @@ class _FrictionPhase(_Phase):
             L[out] = -Wq[:, out].T + HG @ WA.T
             P[np.ix_(out, idx)] = -HG
             self.GWt, self.G = G @ WA.T, G
+            self.eq_map = np.linalg.solve(K, drive @ G)  # q_eq per unit gap_A
             self.q_eq = np.linalg.solve(K, drive @ (G @ s.gap[idx]))
         else:
             self.GWt, self.G, self.q_eq = np.zeros((0, n)), np.zeros((0, 0)), np.zeros(n)
+            self.eq_map = np.zeros((n, 0))
         self.L, self.P, self.K = L, P, K
         C = fl.Cq if fl.Cq is not None else np.zeros((n, n))
         nu = fl.nu
@@ -267,12 +269,8 @@ class FrictionFlight(NodalFlight):
         self.Tq = self.phi.T @ friction.T
         self.H_mu = friction.H(system)
 
-    def phase(self, A: np.ndarray) -> _Phase:
-        key = np.packbits(A).tobytes()
-        ph = self._phases.get(key)
-        if ph is None:
-            ph = self._phases[key] = _FrictionPhase(self, A.copy())
-        return ph
+    def _new_phase(self, A: np.ndarray) -> _Phase:
+        return _FrictionPhase(self, A)
 
     def active_set(self, q, p, t: float) -> np.ndarray:
         """The closed contacts from the state: the complementarity problem with ``H_μ``, at the rate level where a
@@ -317,7 +315,7 @@ def friction_flight(system: NodalSystem, friction: Friction | None, damping=None
 
 
 def simulate_friction(system: NodalSystem, friction: Friction | None, x0, v0, t_end: float, damping=None,
-                      rub: Rub | None = None, max_switches: int = 1_000_000) -> NodalTrajectory:
+                      rub: Rub | None = None, max_switches: int = 1_000_000, profile=None) -> NodalTrajectory:
     """Exact event-driven simulation with friction from ``(x0, v0)`` at ``t = 0``: :func:`simulate_nodes` flying
     :func:`friction_flight` (the trajectory's forces ``λ`` are the normal ones; the friction forces are ``μλ``).
 
@@ -327,7 +325,7 @@ def simulate_friction(system: NodalSystem, friction: Friction | None, x0, v0, t_
     ([True], True)
     """
     fl = friction_flight(system, friction, damping, rub)
-    return simulate_nodes(system, x0, v0, t_end, max_switches=max_switches, flight=fl)
+    return simulate_nodes(system, x0, v0, t_end, max_switches=max_switches, flight=fl, profile=profile)
 
 
 @dataclass(frozen=True)

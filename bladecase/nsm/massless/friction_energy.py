@@ -74,7 +74,7 @@ def _rates(tr: NodalTrajectory, t: np.ndarray):
     bounds = np.searchsorted(k[order], np.arange(tr.starts.size + 1))
     for i in np.flatnonzero(np.diff(bounds)):
         sel = order[bounds[i]:bounds[i + 1]]
-        ph = fl.phase(tr.active[i])
+        ph = fl.phase(tr.active[i], tr.starts[i])
         a = tr.amplitudes[i]
         Q[:, sel], P[:, sel] = ph.advance(a, tr.starts[i], t[sel] - tr.starts[i])
         if ph.idx.size:

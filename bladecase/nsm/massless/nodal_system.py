@@ -15,7 +15,7 @@ import numpy as np
 import scipy.linalg as sla
 from scipy.optimize import nnls
 
-__all__ = ["NODES_DENSE_LIMIT", "NodalSystem", "Rub", "lcp"]
+__all__ = ["NODES_DENSE_LIMIT", "NodalSystem", "Profile", "Rub", "lcp"]
 
 #: Largest interior size (dense phases).
 NODES_DENSE_LIMIT = 4000
@@ -193,3 +193,68 @@ class Rub:
     def D(self) -> np.ndarray:
         """Complex amplitudes: ``g(t) = d + Re(D e^{iνt})``."""
         return -self.amplitude * np.exp(1j * self.lobes * np.asarray(self.angles))
+
+
+# ----------------------------------------------------------------------------- a general clearance profile
+
+
+@dataclass(frozen=True, eq=False)
+class Profile:
+    """A clearance profile round the casing, piecewise constant over ``cells`` equal angular cells: the casing's
+    surface lies ``depth[c]`` (m) further out than its shape elsewhere says in cell ``c`` (a worn coating). A blade
+    turning at ``speed`` (rad/s) carries node ``j``, at the angle ``φ_j``, over the casing angle ``θ = Ωt + φ_j``:
+    its clearance steps by ``depth[c] − depth[c−1]`` when ``θ`` crosses a cell's edge — an event time known in
+    advance, where the exact flight is cut (:meth:`breaks`).
+
+    >>> p = Profile([0.0, 1e-5, 1e-5, 0.0], speed=2 * np.pi, angles=[0.0, np.pi])
+    >>> p.breaks(0.0, 1.0).tolist()          # node 0 enters cell 1 at t = 1/4, leaves cell 2 at 3/4; node 1 too
+    [0.25, 0.75]
+    >>> p.offset(np.array([0.3, 0.8])).round(9).tolist()   # (m, k): node 0, node 1 at t = 0.3 and 0.8
+    [[1e-05, 0.0], [0.0, 1e-05]]
+    """
+
+    depth: np.ndarray
+    speed: float
+    angles: tuple = (0.0,)
+
+    def __post_init__(self) -> None:
+        d = np.asarray(self.depth, dtype=float).reshape(-1)
+        if d.size < 1 or not np.all(np.isfinite(d)):
+            raise ValueError(f"the profile's depths must be finite numbers (m), one per cell, got {d.size} cells")
+        object.__setattr__(self, "depth", d)
+        if isinstance(self.speed, bool) or not (np.isfinite(float(self.speed)) and float(self.speed) > 0):
+            raise ValueError(f"speed must be a finite number > 0 (rad/s), got {self.speed!r}")
+        object.__setattr__(self, "speed", float(self.speed))
+        object.__setattr__(self, "angles", tuple(float(a) for a in np.atleast_1d(self.angles)))
+
+    @property
+    def step(self) -> float:
+        """A cell's angle (rad)."""
+        return 2 * np.pi / self.depth.size
+
+    def cell(self, theta) -> np.ndarray:
+        """The cell holding each casing angle ``theta`` (rad)."""
+        n = self.depth.size
+        return np.floor(np.mod(np.asarray(theta, dtype=float), 2 * np.pi) / self.step).astype(int) % n
+
+    def offset(self, t) -> np.ndarray:
+        """Each node's extra clearance at the times ``t``: ``(m,)`` or ``(m, k)`` (m)."""
+        theta = np.add.outer(np.asarray(self.angles), self.speed * np.asarray(t, dtype=float))
+        return self.depth[self.cell(theta)]
+
+    def breaks(self, t0: float, t1: float) -> np.ndarray:
+        """The times in ``(t0, t1)`` where some node's clearance steps (a cell edge with a different depth on each
+        side), sorted, without repeats."""
+        n, h = self.depth.size, self.step
+        jump = np.flatnonzero(self.depth != np.roll(self.depth, 1))  # edge k: between cells k − 1 and k
+        if jump.size == 0:
+            return np.zeros(0)
+        out = []
+        for phi in self.angles:
+            k0 = int(np.floor((self.speed * t0 + phi) / h)) + 1
+            k1 = int(np.ceil((self.speed * t1 + phi) / h))
+            k = np.arange(k0, k1)
+            k = k[np.isin(k % n, jump)]
+            out.append((k * h - phi) / self.speed)
+        t = np.unique(np.concatenate(out))
+        return t[(t > t0) & (t < t1)]

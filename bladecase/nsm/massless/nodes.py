@@ -45,15 +45,17 @@ True
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg as sla
 
 from .nodal_switches import _Signals, first_switch
-from .nodal_system import NODES_DENSE_LIMIT, NodalSystem, Rub, lcp
+from .nodal_system import NODES_DENSE_LIMIT, NodalSystem, Profile, Rub, lcp
 
-__all__ = ["NODES_DENSE_LIMIT", "NodalFlight", "NodalSystem", "NodalTrajectory", "Rub", "lcp", "simulate_nodes"]
+__all__ = ["NODES_DENSE_LIMIT", "NodalFlight", "NodalSystem", "NodalTrajectory", "Profile", "Rub", "lcp",
+           "simulate_nodes"]
 
 #: Largest condition number of a damped phase's state-space eigenvectors (near-defective: refused).
 EIGVEC_COND_LIMIT = 1e10
@@ -103,6 +105,7 @@ class _Phase:
         self.idx = idx
         self.GWt = G @ WA.T if idx.size else np.zeros((0, n))  # λ_A = G_A(W_Aᵀq − g_A(t))
         self.G = G if idx.size else np.zeros((0, 0))
+        self.eq_map = np.linalg.solve(K, WA @ G) if idx.size else np.zeros((n, 0))  # q_eq per unit gap_A
         f0 = WA @ (G @ s.gap[idx]) if idx.size else np.zeros(n)
         self.q_eq = np.linalg.solve(K, f0)
         nu = fl.nu
@@ -141,6 +144,20 @@ class _Phase:
         self.E0 = (L @ self.X + (P @ fl.D if fl.D is not None else 0)) if nu > 0 else np.zeros(m, complex)
         self.lam2 = np.abs(self.lam) ** 2
 
+    def shifted(self, delta: np.ndarray) -> _Phase:
+        """The same phase with every clearance ``delta`` (``(m,)``, m) wider: its equilibrium and switching
+        signals' constants moved, its modes shared (a worn casing's piece between two steps of its profile)."""
+        out = copy.copy(self)
+        dq = self.eq_map @ delta[self.idx]
+        out.q_eq = self.q_eq + dq
+        out.const = self.const + self.L @ dq + self.P @ delta
+        return out
+
+    def signals_at(self, q: np.ndarray, gap: np.ndarray) -> np.ndarray:
+        """The ``m`` switching signals (``λ`` of the closed contacts, the clearance left of the open ones) of the
+        modal displacement ``q`` against the clearances ``gap``."""
+        return self.L @ q + self.P @ gap
+
     def particular(self, t: float) -> tuple[np.ndarray, np.ndarray]:
         if self.nu == 0:
             return self.q_eq, np.zeros_like(self.q_eq)
@@ -178,9 +195,9 @@ class _Phase:
 class NodalFlight:
     """Exact flights of a :class:`NodalSystem`: its phases (cached per set of closed contacts), optional
     damping (:class:`~bladecase.nsm.damping.Damping` of the open-phase modes) and an out-of-round casing
-    (:class:`Rub`)."""
+    (:class:`Rub`), and a general clearance profile round the casing (:class:`Profile`: :meth:`set_profile`)."""
 
-    def __init__(self, system: NodalSystem, damping=None, rub: Rub | None = None):
+    def __init__(self, system: NodalSystem, damping=None, rub: Rub | None = None, profile: Profile | None = None):
         if not isinstance(system, NodalSystem):
             raise ValueError(f"system must be a NodalSystem, got {type(system).__name__}")
         self.system = system
@@ -198,16 +215,60 @@ class NodalFlight:
         else:
             self.nu, self.D = 0.0, None
         self._phases: dict[bytes, _Phase] = {}
+        self.profile = None
+        if profile is not None:
+            self.set_profile(profile, 0.0, 0.0)
 
-    def phase(self, A: np.ndarray) -> _Phase:
+    def set_profile(self, profile: Profile | None, t0: float, t1: float) -> None:
+        """Fly the clearances widened by ``profile`` over ``[t0, t1]``: its steps there are cut into the flights
+        (:meth:`next_break`); ``None``: no profile. The phases' modes are kept; a trajectory flown before with
+        another profile must not be sampled after."""
+        if profile is not None and len(profile.angles) != self.system.m:
+            raise ValueError(f"the profile needs one angle per contact node ({self.system.m}), got "
+                             f"{len(profile.angles)}")
+        self.profile = profile
+        self._shifted: dict = {}
+        if profile is None:
+            return
+        b = profile.breaks(t0, t1)
+        edges = np.r_[t0, b, max(t1, t0)]
+        self.breaks = b
+        self.pieces = profile.offset(0.5 * (edges[1:] + edges[:-1]))  # (m, len(b) + 1): each piece's offset
+
+    def _piece(self, t) -> np.ndarray:
+        return np.searchsorted(self.breaks, t, side="right")
+
+    def next_break(self, t: float) -> float:
+        """The first step of the profile after ``t`` (``inf``: none)."""
+        if self.profile is None:
+            return np.inf
+        i = int(self._piece(t))
+        return float(self.breaks[i]) if i < self.breaks.size else np.inf
+
+    def phase(self, A: np.ndarray, t: float | None = None) -> _Phase:
+        """The phase of the closed contacts ``A``; with a profile, as it is in the piece holding the time ``t``."""
         key = np.packbits(A).tobytes()
         ph = self._phases.get(key)
         if ph is None:
-            ph = self._phases[key] = _Phase(self, A.copy())
-        return ph
+            ph = self._phases[key] = self._new_phase(A.copy())
+        if self.profile is None or t is None:
+            return ph
+        i = int(self._piece(t))
+        out = self._shifted.get((key, i))
+        if out is None:
+            out = self._shifted[(key, i)] = ph.shifted(self.pieces[:, i])
+        return out
+
+    def _new_phase(self, A: np.ndarray) -> _Phase:
+        return _Phase(self, A)
 
     def gap(self, t) -> np.ndarray:
         """The clearances at the times ``t``: ``(m,)`` or ``(m, k)``."""
+        if self.profile is not None:
+            return self._base_gap(t) + self.pieces[:, self._piece(t)]
+        return self._base_gap(t)
+
+    def _base_gap(self, t) -> np.ndarray:
         d = self.system.gap
         if self.D is None:
             return d if np.ndim(t) == 0 else np.repeat(d[:, None], np.size(t), 1)
@@ -295,7 +356,7 @@ class NodalTrajectory:
         bounds = np.searchsorted(k[order], np.arange(self.starts.size + 1))
         for i in np.flatnonzero(np.diff(bounds)):
             sel = order[bounds[i]:bounds[i + 1]]
-            ph = fl.phase(self.active[i])
+            ph = fl.phase(self.active[i], self.starts[i])
             a = self.amplitudes[i] if self.amplitudes is not None else ph.amplitudes(self.q[:, i], self.p[:, i],
                                                                                       self.starts[i])
             Q[:, sel], P[:, sel] = ph.advance(a, self.starts[i], t[sel] - self.starts[i])
@@ -325,14 +386,17 @@ class NodalTrajectory:
 
 
 def simulate_nodes(system: NodalSystem, x0, v0, t_end: float, damping=None, rub: Rub | None = None,
-                   max_switches: int = MAX_SWITCHES, flight: NodalFlight | None = None) -> NodalTrajectory:
+                   max_switches: int = MAX_SWITCHES, flight: NodalFlight | None = None,
+                   profile: Profile | None = None) -> NodalTrajectory:
     """Exact event-driven simulation of the massless model with ``m`` contacts from ``(x0, v0)`` at ``t = 0``.
 
     Each phase is flown in closed form; each switch is the first root of any of the phase's ``m`` switching
     signals (certified); the set of closed contacts after a switch solves the complementarity problem (module
     docstring). ``damping``: :class:`~bladecase.nsm.damping.Damping` of the open-phase modes; ``rub``: the
-    clearances of an out-of-round casing seen at speed (:class:`Rub`). A run that hits ``max_switches`` stops
-    with ``complete = False``.
+    clearances of an out-of-round casing seen at speed (:class:`Rub`); ``profile``: a general clearance profile
+    round the casing (:class:`Profile`), whose steps cut the flights (the set of closed contacts after a step
+    solves the complementarity problem; each step is a phase start of the trajectory). A run that hits
+    ``max_switches`` stops with ``complete = False``.
     """
     fl = flight if flight is not None else NodalFlight(system, damping, rub)
     x, v = np.asarray(x0, float).reshape(-1), np.asarray(v0, float).reshape(-1)
@@ -343,17 +407,32 @@ def simulate_nodes(system: NodalSystem, x0, v0, t_end: float, damping=None, rub:
         raise ValueError(f"t_end must be finite and > 0, got {t_end!r}")
     if isinstance(max_switches, bool) or int(max_switches) < 1:
         raise ValueError(f"max_switches must be an integer >= 1, got {max_switches!r}")
+    if profile is not None:
+        fl.set_profile(profile, 0.0, t_end)
     q, p = fl.encode(x, v)
     t = 0.0
     A = fl.active_set(q, p, t)
     on = np.zeros(system.m, dtype=bool)
     starts, actives, qs, ps, amps = [0.0], [A], [q], [p], []
     while len(starts) <= max_switches:
-        ph = fl.phase(A)
+        ph = fl.phase(A, t)
         a = ph.amplitudes(q, p, t)
         amps.append(a)
         signals = ph.signals(a, t)
-        hit = first_switch(signals, t_end - t, on)
+        step = fl.next_break(t)
+        hit = first_switch(signals, (t_end if step >= t_end else step) - t, on)
+        if hit is None and step < t_end:  # the profile steps: the closed contacts from the new clearances
+            q, p = ph.advance(a, t, step - t)
+            t = step
+            sig = fl.phase(A, t).signals_at(q, fl.gap(t))  # the same contacts, strictly, at the new clearances?
+            if not np.all(sig > SURFACE_RTOL * max(float(np.abs(sig).max()), np.finfo(float).tiny)):
+                A = fl.active_set(q, p, t)
+            on = np.zeros(system.m, dtype=bool)
+            starts.append(t)
+            actives.append(A)
+            qs.append(q)
+            ps.append(p)
+            continue
         if hit is None:
             t = t_end
             break
@@ -376,6 +455,6 @@ def simulate_nodes(system: NodalSystem, x0, v0, t_end: float, damping=None, rub:
         qs.append(q)
         ps.append(p)
     if len(amps) < len(starts):
-        amps.append(fl.phase(A).amplitudes(q, p, starts[-1]))
+        amps.append(fl.phase(A, starts[-1]).amplitudes(q, p, starts[-1]))
     return NodalTrajectory(fl, np.array(starts), np.array(actives), np.array(qs).T, np.array(ps).T, t,
                            bool(t >= t_end), np.array(amps))

@@ -42,7 +42,8 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from .friction import friction_flight
+from .friction import friction_flight, sliding_check
+from .friction_energy import energy_balance
 from .nodes import NodalFlight, NodalSystem, NodalTrajectory, Rub, simulate_nodes
 
 __all__ = ["Character", "RubResponse", "characterise", "rub_response", "rub_sweep", "zero_one_test"]
@@ -271,6 +272,7 @@ class RubResponse:
     read_revolutions: float = 0.0
     max_revolutions: int = 0
     detail: dict = field(default_factory=dict)
+    friction: dict = field(default_factory=dict)
 
     @property
     def touching(self) -> tuple:
@@ -353,7 +355,8 @@ def _checked(revolutions, window, max_revolutions, speed) -> tuple[int, float]:
 
 def rub_response(system: NodalSystem, speed: float, lobes: int, amplitude: float, angles, damping=None,
                  revolutions: int = 40, window: int = 10, max_switches: int = 2_000_000,
-                 areas=None, max_revolutions: int | None = None, friction=None) -> RubResponse:
+                 areas=None, max_revolutions: int | None = None, friction=None,
+                 flight: NodalFlight | None = None) -> RubResponse:
     """The rub response at ``speed`` (rad/s) from rest, over ``revolutions`` turns and on, a ``window`` at a time,
     until it settles or ``max_revolutions`` (default ``10 × revolutions``) have run; read on the last ``window``
     (or a whole number of its periods) and characterised when it did not settle (module docstring). ``angles``: each
@@ -361,14 +364,18 @@ def rub_response(system: NodalSystem, speed: float, lobes: int, amplitude: float
     open-phase modes (``None``: undamped); ``areas``: each node's tributary area (m², ``(m,)``) for the largest
     loaded area (``loaded_area``; ``None`` without); ``max_switches``: over the whole run; ``friction``: a
     :class:`~bladecase.nsm.massless.friction.Friction` at the contact nodes (``None`` or ``μ = 0``: none, the
-    results bit for bit those without)."""
+    results bit for bit those without); ``flight``: the flight to fly (its phases reused: it must be of this
+    system, damping, casing and friction; default: a new one)."""
     cap, speed = _checked(revolutions, window, max_revolutions, speed)
     if areas is not None:
         areas = np.asarray(areas, dtype=float)
         if areas.shape != (system.m,):
             raise ValueError(f"areas must hold one value per contact node ({system.m}), got shape {areas.shape}")
     rub = Rub(lobes, amplitude, speed, angles)
-    fl = NodalFlight(system, damping, rub) if friction is None else friction_flight(system, friction, damping, rub)
+    if flight is not None:
+        fl = flight
+    else:
+        fl = NodalFlight(system, damping, rub) if friction is None else friction_flight(system, friction, damping, rub)
     turn = 2 * np.pi / speed
     passing = turn / lobes
     W = window * lobes  # lobe passings per window
@@ -424,9 +431,28 @@ def rub_response(system: NodalSystem, speed: float, lobes: int, amplitude: float
     loaded = None if areas is None else _loaded_area(tail, areas, t0, end)
     detail = {k: getattr(character, k) for k in ("k", "decay", "rotation", "samples")
               if getattr(character, k) is not None}
+    rubbed = _friction_figures(tail, speed, window) if getattr(fl, "friction", None) is not None else {}
     return RubResponse(speed, int(lobes), float(amplitude), int(revolutions), int(window), system.nodes, now[0],
                        now[1], fraction, now[2], switches, settled, change, float(now[3].sum()), now[3], loaded,
-                       character.label, period, int(done), span / lobes, cap, detail)
+                       character.label, period, int(done), span / lobes, cap, detail, rubbed)
+
+
+def _friction_figures(tail: NodalTrajectory, speed: float, window: int) -> dict:
+    """The friction's figures of a rub (``μ > 0``): the energy balance of the last revolution (J: casing input,
+    friction work on the vibration, damping, stored change, residual), the worst relative residual over the window's
+    revolutions, and the sliding check over the window (each node's ``max|z'| / ΩR``)."""
+    turn = 2 * np.pi / speed
+    end = tail.t_end
+    revs = [energy_balance(tail, end - (k + 1) * turn, end - k * turn) for k in range(window)]
+    last = revs[0]
+    out = {"mu": float(tail.flight.friction.mu), "casing_j": last.casing, "friction_j": last.friction,
+           "damping_j": last.damping, "stored_change_j": last.stored_change, "residual_j": last.residual,
+           "relative_residual": max(abs(e.relative) for e in revs), "quadrature_error_j": last.quadrature_error}
+    if tail.flight.friction.radius is not None:
+        check = sliding_check(tail, speed, end - window * turn, end)
+        out.update(sliding_ratio=float(check.ratio.max()), sliding_node_ratio=check.ratio.tolist(),
+                   rotation_dominated=bool(check.ok), sliding_limit=check.limit, sliding_message=check.message)
+    return out
 
 
 def _one(args) -> RubResponse:
