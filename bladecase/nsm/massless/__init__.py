@@ -84,6 +84,7 @@ from .nodal_modes import (
     transfer_state,
 )
 from .nodal_resonance import BACKBONE_SHARE, RESONANCE_SHARE, TONGUE_POINTS, backbone_trend, resonance_ratio
+from .nodal_system import Profile
 from .nodes import NodalFlight, NodalSystem, NodalTrajectory, Rub, lcp, simulate_nodes
 from .orbits import (
     ADMISSIBILITY_RTOL,
@@ -98,6 +99,7 @@ from .orbits import (
 from .phases import PHASES, PhasedOrbit, solve_half, split_at, violation
 from .rub import RubResponse, rub_response, rub_sweep
 from .wear import Abradable, WearProfile, pass_tip
+from .wear_rub import WearRub, vibration_ratio, wear_rub
 
 __all__ = [
     # nodes, nodal_modes, nodal_resonance, rub
@@ -110,7 +112,7 @@ __all__ = [
     "FRICTION_MODELS", "Friction", "FrictionFlight", "SlidingCheck", "friction_flight", "lemke", "simulate_friction",
     "sliding_check", "FrictionEnergy", "FrictionRub", "energy_balance", "friction_rub", "per_revolution",
     "FrictionMode", "decay_ratio", "friction_mode",
-    "Abradable", "WearProfile", "pass_tip",
+    "Abradable", "Profile", "WearProfile", "WearRub", "pass_tip", "vibration_ratio", "wear_rub",
     # bar
     "CONTACT_MODELS", "bar", "bar_continuum_band_energy", "bar_continuum_energy", "bar_continuum_field",
     # branches
