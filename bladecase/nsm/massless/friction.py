@@ -54,6 +54,7 @@ from .nodes import (
     NodalTrajectory,
     Rub,
     _Phase,
+    phase_signals,
     simulate_nodes,
 )
 
@@ -204,26 +205,20 @@ class _FrictionPhase(_Phase):
         idx = np.flatnonzero(A)
         self.idx = idx
         K = np.diag(fl.omega**2)
-        L, P = -Wq.T.copy(), np.eye(m)
+        G = None
         if idx.size:
             WA = Wq[:, idx]
             G = np.linalg.inv(H[np.ix_(idx, idx)])
             drive = WA - fr.mu * Tq[:, idx]
             K = K + drive @ G @ WA.T
-            L[idx] = G @ WA.T
-            P[idx] = 0.0
-            P[np.ix_(idx, idx)] = -G
-            out = np.flatnonzero(~A)
-            HG = H[np.ix_(out, idx)] @ G
-            L[out] = -Wq[:, out].T + HG @ WA.T
-            P[np.ix_(out, idx)] = -HG
             self.GWt, self.G = G @ WA.T, G
             self.eq_map = np.linalg.solve(K, drive @ G)  # q_eq per unit gap_A
             self.q_eq = np.linalg.solve(K, drive @ (G @ s.gap[idx]))
         else:
             self.GWt, self.G, self.q_eq = np.zeros((0, n)), np.zeros((0, 0)), np.zeros(n)
             self.eq_map = np.zeros((n, 0))
-        self.L, self.P, self.K = L, P, K
+        self.L, self.P = L, P = phase_signals(Wq, H, A, G)  # the switching signals, with H of the friction (H_mu)
+        self.K = K
         C = fl.Cq if fl.Cq is not None else np.zeros((n, n))
         nu = fl.nu
         self.X = np.zeros(n, complex)

@@ -70,6 +70,26 @@ SURFACE_RTOL = 1e-9
 # ----------------------------------------------------------------------------- phases
 
 
+def phase_signals(Wq: np.ndarray, H: np.ndarray, A: np.ndarray, G: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """The switching signals ``L q + P g(t)`` of the phase whose closed contacts are ``A`` (a boolean mask):
+    the closed contacts' forces ``G (W_Aᵀ q − g_A)`` and the open ones' gaps, with ``G`` the inverse of ``H`` on
+    ``A`` (``None`` when no contact is closed: the gaps ``g − Wᵀq`` alone). The same signals whether the phase is
+    symmetric or, with friction, not (its stiffness differs, not its signals)."""
+    m = Wq.shape[1]
+    L, P = -Wq.T.copy(), np.eye(m)
+    idx = np.flatnonzero(A)
+    if idx.size:
+        WA = Wq[:, idx]
+        L[idx] = G @ WA.T
+        P[idx] = 0.0
+        P[np.ix_(idx, idx)] = -G
+        out = np.flatnonzero(~A)
+        HG = H[np.ix_(out, idx)] @ G
+        L[out] = -Wq[:, out].T + HG @ WA.T
+        P[np.ix_(out, idx)] = -HG
+    return L, P
+
+
 class _Phase:
     """One set ``A`` of closed contacts, in the open-phase modal coordinates ``(q, p)`` (``M = I``).
 
@@ -89,19 +109,7 @@ class _Phase:
             G = np.linalg.inv(H[np.ix_(idx, idx)])
             G = 0.5 * (G + G.T)
             K = K + WA @ G @ WA.T
-        # switching signals: L q + P g(t)
-        L, P = np.zeros((m, n)), np.eye(m)
-        if idx.size:
-            L[idx] = G @ WA.T
-            P[idx] = 0.0
-            P[np.ix_(idx, idx)] = -G
-            out = np.flatnonzero(~A)
-            HG = H[np.ix_(out, idx)] @ G
-            L[out] = -Wq[:, out].T + HG @ WA.T
-            P[np.ix_(out, idx)] = -HG
-        else:
-            L = -Wq.T.copy()
-        self.L, self.P = L, P
+        self.L, self.P = L, P = phase_signals(Wq, H, A, G if idx.size else None)  # switching signals: L q + P g(t)
         self.idx = idx
         self.GWt = G @ WA.T if idx.size else np.zeros((0, n))  # λ_A = G_A(W_Aᵀq − g_A(t))
         self.G = G if idx.size else np.zeros((0, 0))
