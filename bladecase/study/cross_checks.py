@@ -11,6 +11,7 @@ from ..fe import Material, PlateGeometry
 from .cyclic_section import cyclic_checks
 from .geometry_section import estimate_cells, geometry_of
 from .keys import StudyError, one_line
+from .mistuning_section import mistuning_checks
 from .sections import (
     casing_checks,
     convergence_checks,
@@ -96,6 +97,7 @@ def cross_checks(c: dict, model: bool = True, contact: bool = True) -> None:
     rub_checks(c)
     convergence_checks(c)
     cyclic_checks(c)
+    mistuning_checks(c)
     o, s = c["output"], c["search"]
     for i, item in enumerate(o["orbits"]):
         if item["ipp"] not in s["ipp"]:
@@ -200,7 +202,7 @@ def campbell_only(raw: dict) -> bool:
     speeds = rotation.get("speeds") if isinstance(rotation, dict) else None
     ring = isinstance(casing, dict) and (casing.get("radius") is not None or casing.get("radii") is not None)
     geometry = raw.get("geometry")
-    disk = "cyclic" in raw or (isinstance(geometry, dict) and geometry.get("kind") == "sector")
+    disk = "cyclic" in raw or "mistuning" in raw or (isinstance(geometry, dict) and geometry.get("kind") == "sector")
     return "contact" not in raw and not ring and (disk or (isinstance(speeds, list) and len(speeds) > 0))
 
 

@@ -36,6 +36,7 @@ from ..io import save_figure, write_text
 from .cyclic_section import check_diameters, cyclic_requested, expand_spec
 from .documents import model_summary
 from .executor import Executor
+from .mistuning_section import mistuning_requested
 from .modes_run import compute_modes
 from .schema import Study, StudyError
 from .stages import build_model, selected_nodes
@@ -72,6 +73,9 @@ def compute_linear(study: Study, staging: Path, stage, progress: bool, executor:
     deck = deck_cyclic(study)
     if cyclic_requested(study.config) or deck is not None:
         return compute_cyclic(study, staging, stage, progress, executor, deck)
+    if mistuning_requested(study.config):
+        raise StudyError(f"[mistuning]: mistuning is that of a bladed disk, but the mesh {study.mesh_path()} is not a "
+                         "sector (no *CYCLIC SYMMETRY MODEL): give [cyclic] sectors = N (and [rotation] axis)")
     if not (study.config.get("rotation") or {}).get("speeds"):
         raise StudyError(f"[cyclic]: the mesh {study.mesh_path()} declares no *CYCLIC SYMMETRY MODEL: give [cyclic] "
                          "sectors = N (and [rotation] axis, the engine axis) for a sector mesh")
@@ -325,6 +329,13 @@ def compute_cyclic(study: Study, staging: Path, stage, progress: bool, executor:
         if "vtu" in o["formats"]:
             expanded = _expand(study, staging, mesh, model, solved, spectrum, expand_spec(cy, n))
             files["annulus"] = expanded["file"]
+    mistuning = None
+    if mistuning_requested(study.config):
+        from .mistuning import compute_mistuning
+
+        with stage("mistuning"):
+            mistuning = compute_mistuning(study, staging, files, fe_model=model, mesh=mesh, sector=solved,
+                                          axis=setup["axis"], geometry=geometry, executor=executor, progress=progress)
     campbell = None
     r = study.config.get("rotation") or {}
     if r.get("speeds"):
@@ -351,7 +362,7 @@ def compute_cyclic(study: Study, staging: Path, stage, progress: bool, executor:
         "contact": None, "rotation": None, "campbell": None, "reduction": None, "reference": None,
         "compare": [], "search": None, "families": [], "forcing": None, "rub": None, "casing_sweep": None,
         "nodal_modes": None, "comparison": None, "convergence": None, "validity": None, "cyclic": section,
-        "files": files,
+        "mistuning": mistuning, "files": files,
     }
     return summary, [], {}
 

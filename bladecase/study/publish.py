@@ -45,7 +45,7 @@ from .manifest import MANIFEST, TOKEN, entry_hash, read_signed, stamp_folder, st
 RUN_RESULTS = ("summary.json", "report.md", "run.log", "modes.json", "frequency_energy.png", "mesh.vtu", "animations",
                "vtk", "forced.csv", "forced_response.png", "campbell.png", "rub.csv", "rub_nodes.csv", "rub.png",
                "rub.vtu", "casing.png", "nodal_modes.csv", "nodal_modes.png", "cyclic.csv", "safe.png",
-               "campbell_nd.png")
+               "campbell_nd.png", "mistuning.csv", "mistuning.png")
 
 LOCK = ".bladecase.lock"
 STAGING_PREFIX = ".bladecase-run-"

@@ -34,6 +34,7 @@ from .cross_checks import (  # noqa: F401 (MASSLESS_METHODS lived here)
 from .cyclic_section import CYCLIC_KEYS
 from .geometry_section import GEOMETRY_FIELDS, GEOMETRY_KEYS, geometry_of, geometry_section  # noqa: F401
 from .keys import _BOOL, _INT, _LIST, _NUM, _STR, REQUIRED, Key, StudyError, _check_field, _check_value, one_line  # noqa: F401
+from .mistuning_section import MISTUNING_KEYS
 from .sections import (
     CASING_KEYS,
     CONVERGENCE_KEYS,
@@ -264,6 +265,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
     "rub": RUB_KEYS,
     "convergence": CONVERGENCE_KEYS,
     "cyclic": CYCLIC_KEYS,
+    "mistuning": MISTUNING_KEYS,
     "execution": EXECUTION_KEYS,
     "limits": LIMIT_KEYS,
 }
