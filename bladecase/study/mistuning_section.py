@@ -8,9 +8,16 @@ deck's ``*CYCLIC SYMMETRY MODEL``) whose blade is the node group ``[mistuning] b
 
 >>> from bladecase.study.schema import loads
 >>> s = loads('''
-... geometry = {kind = "sector", sectors = 6, hub_radius = 0.1, rim_radius = 0.2, disk_thickness = 0.03,
-...             span = 0.1, root_chord = 0.03, thickness = 0.005}
 ... mistuning = {std = 0.02, samples = 50, engine_order = 2}
+... [geometry]
+... kind = "sector"
+... sectors = 6
+... hub_radius = 0.1
+... rim_radius = 0.2
+... disk_thickness = 0.03
+... span = 0.1
+... root_chord = 0.03
+... thickness = 0.005
 ... ''')
 >>> mistuning_requested(s.config), s["mistuning"]["model"], s["mistuning"]["damping"]
 (True, 'snm', 0.002)
