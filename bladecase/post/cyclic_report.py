@@ -21,6 +21,8 @@ True
 
 from __future__ import annotations
 
+from .mistuning_report import mistuning_lines, mistuning_sentence
+
 __all__ = ["cyclic_report", "cyclic_verdict", "engine_order_words"]
 
 
@@ -45,6 +47,8 @@ def cyclic_verdict(summary: dict) -> dict:
                   f"{c['speed_rpm']:.0f} rpm" + (": " + ", ".join(near) if near else "") + ".")
     else:
         found += "; at rest (no speed: no engine-order line)."
+    if summary.get("mistuning"):
+        found += " " + mistuning_sentence(summary["mistuning"])
     trust = ("The tuned disk's modes from one sector under the cyclic constraint (every sector identical, the faces "
              f"matched node by node: {c['faces']['pairs']} pairs); the mesh error is not measured.")
     figures = " and campbell_nd.png" if c.get("campbell") else ""
@@ -96,6 +100,7 @@ def cyclic_report(summary: dict) -> str:
         lines += ["", "## Campbell diagram per nodal diameter", "",
                   f"- {len(c['campbell']['speeds_rad_s'])} speeds, every nodal diameter's modes about the disk's "
                   "centrifugal state (the sector's faces tied): `campbell_nd.png`."]
+    lines += mistuning_lines(summary.get("mistuning"))
     files = summary.get("files") or {}
     lines += ["", "## Files", ""] + [f"- `{x}`" for k, x in files.items() if isinstance(x, str)]
     return "\n".join(lines) + "\n"
