@@ -16,7 +16,7 @@ from bladecase.cli import main
 from bladecase.fe import assemble, fe_sector, load_mesh
 from bladecase.fe.cyclic import sector_angles
 from bladecase.fe.rotation import RotationAxis
-from bladecase.reduction.mistuning import amplification, family_band, mistuning_model
+from bladecase.reduction.mistuning import amplification, family_band, fmm_model, mistuning_model
 from bladecase.reduction.mistuning_fe import blade_stiffness
 from bladecase.reduction.mistuning_stats import mistuning_statistics
 
@@ -77,6 +77,16 @@ def test_a_given_pattern_equals_the_library(given):
 def test_the_tuned_pattern_amplifies_one(tmp_path):
     _, m = _run(tmp_path, f"deviations = {[0.0] * N}\nengine_order = 5")
     assert abs(m["largest"] - 1.0) <= 1e-9 and m["diameter"] == 1
+
+
+def test_the_fundamental_mistuning_model(tmp_path, given):
+    _, m = _run(tmp_path, f'deviations = {PATTERN}\nengine_order = 2\ndamping = 0.005\nmodel = "fmm"')
+    sector = fe_sector(assemble(load_mesh(given[0] / "mesh.vtu"), "Ti-6Al-4V", order=1, mass="consistent",
+                                clamp="hub"), N, AXIS, left="left", right="right")
+    model, dof = fmm_model(sector), m["tip"]["dof"]
+    ref = amplification(model, PATTERN, 2, family_band(model), zeta=0.005, force=dof, response=dof)
+    assert m["model"] == "fmm" and abs(m["largest"] - ref) <= 1e-12 * ref
+    assert m["largest"] == pytest.approx(given[1]["largest"], rel=0.01)   # FMM ≈ SNM (0.27 % here)
 
 
 def test_random_samples_equal_the_library_statistics(tmp_path, given):
