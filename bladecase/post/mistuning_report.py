@@ -58,10 +58,10 @@ def mistuning_lines(m: dict | None) -> list[str]:
              f"- Forcing: engine order {m['engine_order']} (nodal diameter {m['diameter']}) at each blade's tip "
              f"(node {tip['node']} of the sector, direction {tip['direction']}), response read there; modal damping "
              f"ratio {m['damping']:g}; the blade is {m['blade_cells']} of the sector's {m['cells']} cells.",
-             f"- Amplification factor (each sample's largest blade amplitude ÷ the tuned disk's): mean "
-             f"{m['mean']:.4f}; 5th/50th/95th/99th percentiles {p['p5']:.4f}, {p['p50']:.4f}, {p['p95']:.4f}, "
-             f"{p['p99']:.4f}; largest {m['largest']:.4f} on blade {m['largest_blade']} at "
-             f"{m['largest_frequency_hz']:.2f} Hz.",
+             "- Amplification factor (each sample's largest blade amplitude ÷ the tuned disk's): "
+             + ("" if m["samples"] == 1 else f"mean {m['mean']:.4f}; 5th/50th/95th/99th percentiles {p['p5']:.4f}, "
+                f"{p['p50']:.4f}, {p['p95']:.4f}, {p['p99']:.4f}; largest ")
+             + f"{m['largest']:.4f} on blade {m['largest_blade']} at {m['largest_frequency_hz']:.2f} Hz.",
              f"- Whitehead's bound ½(1 + √N) = {m['whitehead_bound']:.4f} for N = {m['sectors']}: "
              f"{m['above_bound']} sample(s) above it" + (" (none expected: check the family is isolated)."
                                                          if m["above_bound"] else ".")]
