@@ -115,8 +115,10 @@ def test_worker_logs_and_environment(parallel, monkeypatch):
     ex = ProcessExecutor(1) if isinstance(parallel, ProcessExecutor) else parallel
     with log.transcript() as lines:
         out = ex.map(_hello, ["first task says hello", "second task says hello"])
-    assert sorted(line.split(" ", 3)[3] for line in lines) == ["first task says hello", "second task says hello"]
+    said = [line for line in lines if " done (item " not in line]  # the tasks' own lines, relayed
+    assert sorted(line.split(" ", 3)[3] for line in said) == ["first task says hello", "second task says hello"]
     assert all(line.split(" ", 3)[2] == "INFO" for line in lines)
+    assert sum(" done (item " in line for line in lines) == 2  # and one line per finished task, with its time
     assert out == [("1", "1"), ("1", "1")]
     assert "OPENBLAS_NUM_THREADS" not in os.environ  # the caller's environment is left as it was
 

@@ -12,7 +12,7 @@ from collections.abc import Callable, Iterable
 from typing import Any
 
 from ..progress import progress_counter
-from .tasks import WORKER_ENV, A, Logged, R, check_workers, environ_kept, label, named, relay
+from .tasks import WORKER_ENV, A, ItemLog, Logged, R, check_workers, environ_kept, label, named, relay
 
 __all__ = ["HOST_PORT_SCHEMES", "DaskExecutor"]
 
@@ -148,18 +148,20 @@ class DaskExecutor:
             except (OSError, TimeoutError) as exc:  # the connection lost (CommClosedError is an OSError)
                 raise self._lost(exc) from None
             index = {f.key: i for i, f in enumerate(futures)}
+            done = ItemLog(desc, len(items))
             with progress_counter(len(items), desc, enabled=progress and len(items) > 1, unit="task") as bar:
                 bar.set_postfix_str(f"{workers} workers")
                 for fut in as_completed(futures):
                     i = index[fut.key]
                     try:
-                        results[i], lines = fut.result()
+                        results[i], lines, seconds = fut.result()
                     except (KilledWorker, FutureCancelledError) as exc:  # not the task's own error: Dask's
                         raise RuntimeError(f"{desc or 'task'} {i} (item {label(items[i])}) did not run on the Dask "
                                            f"cluster {_where(self.scheduler)}: {_dask_failure(exc)}") from None
                     except Exception as exc:
                         raise named(exc, desc, i, items[i]) from None
                     relay(lines)
+                    done(items[i], seconds)
                     bar.update()
         finally:
             try:

@@ -29,13 +29,14 @@ into a run's ``run.log``) when the task returns.  Workers run single-threaded BL
 from __future__ import annotations
 
 import os
+import time
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any, Protocol
 
 from ..progress import progress_bar, progress_counter
-from .tasks import WORKER_ENV, A, R  # noqa: F401  (WORKER_ENV: public name of this module)
+from .tasks import WORKER_ENV, A, ItemLog, R  # noqa: F401  (WORKER_ENV: public name of this module)
 from .tasks import Logged as _Logged
 from .tasks import check_workers as _check_workers
 from .tasks import environ_kept as _environ_kept  # noqa: F401  (the former home of these names)
@@ -99,11 +100,14 @@ class SerialExecutor:
         items = list(items)
         kwargs = dict(shared or {})
         out = []
+        done = ItemLog(desc, len(items))
         for i, x in enumerate(progress_bar(items, desc, enabled=progress and len(items) > 1, unit="task")):
+            start = time.perf_counter()
             try:
                 out.append(fn(x, **kwargs))
             except Exception as exc:
                 raise _named(exc, desc, i, x) from None
+            done(x, time.perf_counter() - start)
         return out
 
     def close(self) -> None:
@@ -140,7 +144,7 @@ def _install_shared(shared: dict[str, Any]) -> None:
     _SHARED.update(shared)
 
 
-def _run_with_shared(task: _Logged, item: Any) -> tuple[Any, list[str]]:
+def _run_with_shared(task: _Logged, item: Any) -> tuple[Any, list[str], float]:
     return task(item, _SHARED)
 
 
@@ -173,6 +177,7 @@ class ProcessExecutor:
         pool = ProcessPoolExecutor(n, mp_context=multiprocessing.get_context("spawn"),
                                    initializer=_install_shared, initargs=(dict(shared or {}),))
         results: list[Any] = [None] * len(items)
+        done = ItemLog(desc, len(items))
         try:
             with _worker_env():  # the workers are spawned as tasks are submitted
                 index = {pool.submit(_run_with_shared, task, x): i for i, x in enumerate(items)}
@@ -181,11 +186,12 @@ class ProcessExecutor:
                 for fut in as_completed(index):
                     i = index[fut]
                     try:
-                        results[i], lines = fut.result()
+                        results[i], lines, seconds = fut.result()
                     except Exception as exc:
                         pool.shutdown(wait=False, cancel_futures=True)
                         raise _named(exc, desc, i, items[i]) from None
                     _relay(lines)
+                    done(items[i], seconds)
                     bar.update()
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
