@@ -93,13 +93,16 @@ class MistuningModel:
         return f
 
 
-def _family_modes(sector: CyclicSector, families) -> tuple[list, list, list, list]:
-    """The sector modes of each family for every travelling-wave index ``k = 0 … N−1``."""
+def _family_modes(sector: CyclicSector, families, spectrum=None) -> tuple[list, list, list, list]:
+    """The sector modes of each family for every travelling-wave index ``k = 0 … N−1``; a nodal diameter whose
+    modes ``spectrum`` (``{k: CyclicModes}`` of this sector) holds, enough of them, is not solved again."""
     fam = sorted({integer("family", f, 0) for f in np.atleast_1d(families).tolist()})
     if not fam:
         raise ValueError("families must list at least one family (0: the lowest mode of every nodal diameter)")
     n = sector.sectors
-    per_nd = {k: cyclic_modes(sector, k, fam[-1] + 1) for k in range(n // 2 + 1)}
+    known = spectrum or {}
+    per_nd = {k: known[k] if k in known and known[k].lam.size > fam[-1] else cyclic_modes(sector, k, fam[-1] + 1)
+              for k in range(n // 2 + 1)}
     lam, ks, fs, shapes = [], [], [], []
     for f in fam:
         for k in range(n):
@@ -115,7 +118,7 @@ def _family_modes(sector: CyclicSector, families) -> tuple[list, list, list, lis
     return lam, ks, fs, shapes
 
 
-def mistuning_model(sector: CyclicSector, blade_stiffness, families=(0,)) -> MistuningModel:
+def mistuning_model(sector: CyclicSector, blade_stiffness, families=(0,), spectrum=None) -> MistuningModel:
     """The subset-of-nominal-modes model (module docstring) of a tuned cyclic ``sector``.
 
     Parameters
@@ -127,6 +130,9 @@ def mistuning_model(sector: CyclicSector, blade_stiffness, families=(0,)) -> Mis
         deviation ``δ_j`` scales it.
     families : sequence of int
         The mode families of the basis (0: the lowest mode of every nodal diameter); each gives ``N`` modes.
+    spectrum : dict or None
+        ``{k: CyclicModes}`` already solved for this sector (:func:`~bladecase.fe.cyclic.cyclic_spectrum`): those
+        nodal diameters are not solved again.
 
     >>> sector, kb = lumped_disk(4)
     >>> m = mistuning_model(sector, kb, families=[0, 1])
@@ -140,14 +146,14 @@ def mistuning_model(sector: CyclicSector, blade_stiffness, families=(0,)) -> Mis
         raise ValueError(f"blade_stiffness must be {sector.n_dofs} × {sector.n_dofs} (the sector's dofs), "
                          f"got {Kb.shape}")
     symmetric("blade_stiffness", Kb)
-    lam, ks, fs, shapes = _family_modes(sector, families)
+    lam, ks, fs, shapes = _family_modes(sector, families, spectrum)
     Phi = np.column_stack(shapes)
     B = Phi.conj().T @ (Kb @ Phi)
     return MistuningModel(sector.sectors, np.asarray(lam), np.asarray(ks), np.asarray(fs), Phi,
                           0.5 * (B + B.conj().T), "snm")
 
 
-def fmm_model(sector: CyclicSector, family: int = 0) -> MistuningModel:
+def fmm_model(sector: CyclicSector, family: int = 0, spectrum=None) -> MistuningModel:
     """The fundamental mistuning model (Feiner & Griffin) of one isolated ``family``: ``B_pq = ω̄²``.
 
     Its assumptions: the family is isolated in frequency (no other family near), its strain energy is in the blades,
@@ -160,7 +166,7 @@ def fmm_model(sector: CyclicSector, family: int = 0) -> MistuningModel:
     """
     if not isinstance(sector, CyclicSector):
         raise ValueError(f"sector must be a CyclicSector (bladecase.fe.fe_sector), got {type(sector).__name__}")
-    lam, ks, fs, shapes = _family_modes(sector, [family])
+    lam, ks, fs, shapes = _family_modes(sector, [family], spectrum)
     lam = np.asarray(lam)
     B = np.full((lam.size, lam.size), lam.mean(), dtype=complex)
     return MistuningModel(sector.sectors, lam, np.asarray(ks), np.asarray(fs), np.column_stack(shapes), B, "fmm")

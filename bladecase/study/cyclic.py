@@ -335,7 +335,8 @@ def compute_cyclic(study: Study, staging: Path, stage, progress: bool, executor:
 
         with stage("mistuning"):
             mistuning = compute_mistuning(study, staging, files, fe_model=model, mesh=mesh, sector=solved,
-                                          axis=setup["axis"], geometry=geometry, executor=executor, progress=progress)
+                                          axis=setup["axis"], geometry=geometry, executor=executor, progress=progress,
+                                          spectrum=spectrum)
     campbell = None
     r = study.config.get("rotation") or {}
     if r.get("speeds"):

@@ -111,12 +111,12 @@ def mistuning_csv(stats: MistuningStatistics) -> str:
     return buf.getvalue()
 
 
-def _model(study: Study, fe_model, sector, cells: np.ndarray) -> MistuningModel:
+def _model(study: Study, fe_model, sector, cells: np.ndarray, spectrum=None) -> MistuningModel:
     m = study["mistuning"]
     try:
         if m["model"] == "fmm":
-            return fmm_model(sector, m["family"])
-        return mistuning_model(sector, blade_stiffness(fe_model, cells), families=[m["family"]])
+            return fmm_model(sector, m["family"], spectrum=spectrum)
+        return mistuning_model(sector, blade_stiffness(fe_model, cells), families=[m["family"]], spectrum=spectrum)
     except ValueError as exc:
         if "family" in str(exc):
             raise StudyError(f"[mistuning] family: {exc}") from None
@@ -132,13 +132,13 @@ def _samples(m: dict, sectors: int) -> np.ndarray:
 
 
 def compute_mistuning(study: Study, staging: Path, files: dict, *, fe_model, mesh, sector, axis, geometry,
-                      executor: Executor, progress: bool) -> dict:
+                      executor: Executor, progress: bool, spectrum=None) -> dict:
     """The mistuning stage (module docstring), writing into ``staging`` and naming its files in ``files``; returns
-    ``summary["mistuning"]``."""
+    ``summary["mistuning"]``. ``spectrum``: the cyclic stage's modes of ``sector`` (not solved again)."""
     m = study["mistuning"]
     n = sector.sectors
     cells = blade_cells(mesh, axis, geometry, m["blade"])
-    model = _model(study, fe_model, sector, cells)
+    model = _model(study, fe_model, sector, cells, spectrum)
     order = m["engine_order"]
     tip = excitation_dof(fe_model, mesh, axis, cells, model, order)
     hz = family_band(model)
