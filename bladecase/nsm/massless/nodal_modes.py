@@ -330,10 +330,11 @@ class NodalFamily:
         family ends in it) or ``"open"`` (the family stopped inside it for another reason).
     end : dict or None
         Why the family ends, structured: ``kind`` (``"internal_resonance"``, ``"frequency_ratio"``, ``"energy_max"``,
-        ``"max_points"``, ``"step"``), ``frequency_hz`` and ``energy_j`` where it ends, ``trend`` (the backbone's
-        last stretch: :func:`backbone_trend`); for an internal resonance also ``mode``, ``mode_frequency_hz``,
-        ``ratio``, ``ratio_value``, ``share`` (the family's mode's share there), ``crossing`` (why it was not crossed)
-        and ``mesh_dependent`` (True: where a resonance with a high mode falls moves with the mesh).
+        ``"limit"`` (``stop_when``), ``"max_points"``, ``"step"``), ``frequency_hz`` and ``energy_j`` where it
+        ends, ``trend`` (the backbone's last stretch: :func:`backbone_trend`); for an internal resonance also
+        ``mode``, ``mode_frequency_hz``, ``ratio``, ``ratio_value``, ``share`` (the family's mode's share there),
+        ``crossing`` (why it was not crossed) and ``mesh_dependent`` (True: where a resonance with a high mode
+        falls moves with the mesh).
     backbone_share : float
         The share of the modal energy that puts an orbit on the backbone (:attr:`on_backbone`).
     """
@@ -438,7 +439,8 @@ def nodal_family(system: NodalSystem, mode: int = 0, *, method: str = "energy", 
                  energy_max: float | None = None, max_points: int = 200, ds: float | None = None,
                  ds_max: float | None = None, ds_min: float | None = None,
                  resonance_share: float = RESONANCE_SHARE, max_phases: int = MAX_PHASES,
-                 through_resonances: bool = False, backbone_share: float = BACKBONE_SHARE) -> NodalFamily:
+                 through_resonances: bool = False, backbone_share: float = BACKBONE_SHARE,
+                 stop_when=None) -> NodalFamily:
     """The nonsmooth mode grown from open-phase mode ``mode`` (0 = the first) at grazing (:func:`grazing_orbit`),
     continued through changes of the phase sequence (module docstring).
 
@@ -495,6 +497,10 @@ def nodal_family(system: NodalSystem, mode: int = 0, *, method: str = "energy", 
         Cross the internal-resonance tongues instead of stopping at the first.
     backbone_share : float
         See above; in ``[resonance_share, 1)``.
+    stop_when : callable or None
+        ``orbit -> reason or None``: the family stops at the first orbit for which it returns a reason (a string;
+        ``end["kind"] == "limit"``), that orbit kept — e.g. a small-displacement limit, so that nothing beyond it
+        is computed.
 
     Returns
     -------
@@ -531,7 +537,7 @@ def nodal_family(system: NodalSystem, mode: int = 0, *, method: str = "energy", 
     g = _grazing(sh, mode)
     run = _Run(_Problem(sh, mode, np.sqrt(2 * g.energy), g.T), g, method, steps,
                {"freq_ratio": freq_ratio, "energy_max": energy_max, "resonance": resonance_share,
-                "backbone": backbone_share, "through": bool(through_resonances)})
+                "backbone": backbone_share, "through": bool(through_resonances), "stop_when": stop_when})
     run.follow(max_points)
     if len(run.orbits) < 2:
         raise ValueError(f"no orbit beyond grazing on the family of mode {mode} (T = {run.orbits[0].T:.12g} s): "

@@ -178,6 +178,12 @@ class _Run:
         if o["freq_ratio"] is not None and (ratio >= o["freq_ratio"] or ratio <= 1 / o["freq_ratio"]):
             self._finish("frequency_ratio", f"frequency ratio {ratio:.6g} reached (freq_ratio = {o['freq_ratio']:g})")
             return True
+        limit = o.get("stop_when")
+        if limit is not None:
+            why = limit(orbit)
+            if why:  # the caller's own limit (e.g. the small-displacement limit): nothing beyond it is computed
+                self._finish("limit", str(why))
+                return True
         over = o["energy_max"] is not None and orbit.energy >= o["energy_max"]
         if over and (on or not o["through"] or o["resonance"] == 0):
             self._finish("energy_max", f"energy {orbit.energy:.6g} J reached (energy_max = {o['energy_max']:g})")
