@@ -63,7 +63,9 @@ def test_the_family_stops_at_the_limit(strip):
     assert section["energy_range_j"][1] == pytest.approx(family.orbits[k - 1].energy, rel=1e-9)
     assert section["energy_range_j"][1] < v["cut"]["energy_beyond_j"] <= v["cut"]["continuation_top_energy_j"]
     assert section["end"]["kind"] == "amplitude_limit" and "small-displacement limit" in section["stop"]
-    assert "frequency ratio" in v["cut"]["continuation_stop"]
+    # the continuation stops at the first orbit beyond the limit: nothing past it is computed
+    assert v["cut"]["continuation_stop"] == "beyond the small-displacement limit" and v["cut"]["orbits_beyond"] == 1
+    assert v["cut"]["continuation_top_energy_j"] == v["cut"]["energy_beyond_j"]
     rows = list(csv.DictReader(open(out / "nodal_modes.csv")))
     assert len(rows) == k
 
@@ -74,7 +76,7 @@ def test_the_report_says_where_and_why(strip):
     text = "\n".join(nodal_report(section))
     assert "**The family is cut at the small-displacement limit**" in text
     assert f"at {c['frequency_beyond_hz']:.5g} Hz" in text and "`[search] amplitude_limit`" in text
-    assert f"{c['orbits_beyond']} more orbits, to {c['continuation_top_energy_j']:.3g} J" in text
+    assert "The continuation stops at that orbit: nothing beyond the limit is computed." in text
 
 
 def test_the_amplitude_and_the_default_limit(strip):

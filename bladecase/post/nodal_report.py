@@ -116,9 +116,12 @@ mm: not figures of the blade.
             f"({end['energy_beyond_j']:.3g} J) a contact node moves {end['tip_amplitude_beyond_mm']:.3g} mm, more "
             f"than {end['limit_mm']:.3g} mm ({100 * end['amplitude_limit']:g} % of the blade's {end['span_mm']:.3g} mm "
             "span, `[search] amplitude_limit`), where a linear-elastic, small-displacement model of the blade no "
-            f"longer holds; {last}. The continuation went on for {end['orbits_beyond']} more orbits, to "
-            f"{end['continuation_top_energy_j']:.3g} J and a casing yield of "
-            f"{end['continuation_top_yield_mm']:.3g} mm: not figures of the blade.")
+            f"longer holds; {last}. " + (
+                "The continuation stops at that orbit: nothing beyond the limit is computed."
+                if end["orbits_beyond"] <= 1 else
+                f"The continuation went on for {end['orbits_beyond']} more orbits, to "
+                f"{end['continuation_top_energy_j']:.3g} J and a casing yield of "
+                f"{end['continuation_top_yield_mm']:.3g} mm: not figures of the blade."))
 
 
 def tongue_words(section: dict) -> str | None:

@@ -106,10 +106,11 @@ def _small_displacements(study, model, nodal, fam):
             "mm span, [search] amplitude_limit)")
     end = {"kind": "amplitude_limit", "frequency_hz": cut["frequency_cut_hz"], "energy_j": cut["energy_cut_j"],
            "limit_mm": limit * 1e3, "span_mm": span * 1e3, "amplitude_limit": share, **cut}
-    log.warning("every face node a contact: the family is %s; its figures stop at %s (the continuation went on to "
-                "%.3g J, a casing yield of %.3g mm: not reported)", stop,
-                "its first orbit" if last is None else f"{last.frequency:.6g} Hz ({last.energy:.4g} J)",
-                top.energy, cut["continuation_top_yield_mm"])
+    went = ("the continuation stopped there: nothing beyond the limit is computed" if cut["orbits_beyond"] <= 1 else
+            f"the continuation went on to {top.energy:.3g} J, a casing yield of "
+            f"{cut['continuation_top_yield_mm']:.3g} mm: not reported")
+    log.warning("every face node a contact: the family is %s; its figures stop at %s (%s)", stop,
+                "its first orbit" if last is None else f"{last.frequency:.6g} Hz ({last.energy:.4g} J)", went)
     return cut_family(fam, k, stop, end), record
 
 
@@ -203,7 +204,14 @@ def nodal_stage(study, model, contact, families, reduced, *, factor=None, folder
     _log_casing(nodal)
     top = _face_top_energy(families)
     cap = {"energy_max": top} if top is not None else {"freq_ratio": 1.0 / study["search"]["periods"][0]}
-    fam = nodal_family(nodal.system, 0, through_resonances=True, **cap)  # up to the face mean's energy
+    from .validity import blade_span
+
+    limit = study["search"]["amplitude_limit"] * blade_span(model)  # the small-displacement limit: nothing beyond
+
+    def beyond(orbit):
+        return "beyond the small-displacement limit" if node_amplitude(nodal, orbit) > limit else None
+
+    fam = nodal_family(nodal.system, 0, through_resonances=True, stop_when=beyond, **cap)  # to the face mean's energy
     fam, validity = _small_displacements(study, model, nodal, fam)
     orbits = fam.orbits
     reference = (nodal_extension(nodal, REFERENCE_FACTOR * nodal.n, factor) if study["output"]["reference"]
