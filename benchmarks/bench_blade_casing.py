@@ -31,7 +31,7 @@ import bladecase as bc
 from bladecase.fe import stiffness_factor
 from bladecase.nsm import series_stiffness
 from bladecase.nsm.massless.orbits import orbits_at_period, smoothest
-from bladecase.post.compare_plots import observed_order as observed_order_of
+from bladecase.post.comparison.plots import observed_order as observed_order_of
 from bladecase.study import demo_study, stages
 
 GOAL = 0.01

@@ -36,8 +36,8 @@ from scipy.optimize import brentq
 import bladecase as bc
 from bladecase.nsm import MASSLESS_DENSE_LIMIT
 from bladecase.nsm.massless.orbits import SymmetricOrbit, closing_residual, orbit_at_period
-from bladecase.post.compare import ModelResult, contact_spectrum
-from bladecase.post.compare_table import convergence_verdict
+from bladecase.post.comparison.compare import ModelResult, contact_spectrum
+from bladecase.post.comparison.table import convergence_verdict
 from bladecase.study import demo_study, stages
 from bladecase.study.run import run
 from bladecase.study.schema import validate

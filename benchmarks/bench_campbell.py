@@ -23,7 +23,7 @@ from bladecase.fe.rotation import RotationAxis, coriolis_matrix, second_order_st
 from bladecase.linalg import lowest_modes
 from bladecase.study.demo import demo_text
 from bladecase.study.executor import make_executor
-from bladecase.study.rotation import campbell_stage, operating_point
+from bladecase.study.rotation.stage import campbell_stage, operating_point
 from bladecase.study.schema import loads
 from bladecase.study.stages import build_contact, build_mesh, build_model
 

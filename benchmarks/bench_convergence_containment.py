@@ -4,7 +4,7 @@ The demo study (``bladecase/study/studies/demo.toml``, its outputs reduced to ``
 the same search and the same animated orbits) is run with ``[convergence] meshes = [1, 0.7, 0.5]``; from its
 ``summary.json`` each headline figure's reported value (the study's own mesh, ×1) and its error estimate (1.25 ×
 the distance from the Richardson extrapolation of ×1, ×0.7, ×0.5, relative) are read. Then the same study is run
-alone on the ×0.25 mesh (:func:`bladecase.study.convergence.mesh_row`: mesh, model, contact, reduced model and
+alone on the ×0.25 mesh (:func:`bladecase.study.convergence.stage.mesh_row`: mesh, model, contact, reduced model and
 search of the study on element sizes × 0.25) and its figures are read at the same ``T/T₁`` on the same family.
 Printed per figure: the ×1 value, the estimated error (relative and absolute), the ×0.25 value, whether the ×0.25
 value lies inside ``value ± error`` (the estimate's claim, held out), and whether the Richardson extrapolation is
@@ -25,7 +25,7 @@ import time
 from pathlib import Path
 
 from bladecase.study import run
-from bladecase.study.convergence import mesh_row
+from bladecase.study.convergence.stage import mesh_row
 from bladecase.study.demo import demo_text
 from bladecase.study.schema import loads
 

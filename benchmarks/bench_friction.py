@@ -37,7 +37,7 @@ from bladecase.nsm.massless.friction_rub import friction_rub  # noqa: E402
 from bladecase.nsm.massless.nodes import Rub, simulate_nodes  # noqa: E402
 from bladecase.nsm.massless.wear import Abradable, WearProfile, pass_tip  # noqa: E402
 from bladecase.reduction.nodal_friction import nodal_friction  # noqa: E402
-from bladecase.study import rub as stage  # noqa: E402
+from bladecase.study.rub import stage  # noqa: E402
 
 LOBES, AMPLITUDE, DAMPING, MU = 8, 3e-4, Damping(zeta=0.005), 0.15
 

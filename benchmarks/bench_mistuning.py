@@ -18,7 +18,7 @@ import time
 
 import numpy as np
 
-from bladecase.post.mistuning_plot import amplification_figure
+from bladecase.post.disk.mistuning_plot import amplification_figure
 from bladecase.reduction.mistuning import lumped_disk, mistuning_model
 from bladecase.reduction.mistuning_stats import mistuning_statistics, worst_mistuning
 from bladecase.study.executor import make_executor

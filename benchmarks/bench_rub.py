@@ -39,8 +39,8 @@ from bladecase.nsm.massless.nodes import NodalSystem, Rub, simulate_nodes  # noq
 from bladecase.nsm.massless.rub import rub_response  # noqa: E402
 from bladecase.reduction.massless import massless_model  # noqa: E402
 from bladecase.reduction.nodes import contact_pressure, nodal_model  # noqa: E402
-from bladecase.study import rub as stage  # noqa: E402
 from bladecase.study.executor import make_executor  # noqa: E402
+from bladecase.study.rub import stage  # noqa: E402
 from bladecase.study.schema import loads  # noqa: E402
 from bladecase.study.stages import build_contact, build_mesh, build_model  # noqa: E402
 

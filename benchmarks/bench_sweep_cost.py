@@ -4,7 +4,7 @@ The model: the twisted, tapered NACA 0012 blade of ``bench_fem.py`` (``blade(siz
 clamped), mesh sizes 5.5 / 2.5 / 1.75 mm (about 5.5k / 26k / 62k dofs; ``--large`` adds 1.4 mm, about 110k),
 spun about an axis along the root chord through a 0.25 m hub radius (the docs' example axis).
 
-One speed is the task of the Campbell stage, ``bladecase.study.rotation._speed_point`` with ``bands = false``:
+One speed is the task of the Campbell stage, ``bladecase.study.rotation.stage._speed_point`` with ``bands = false``:
 ``spin`` (the rotating stiffness ``K + K_σ − Ω² M⊥``, the static centrifugal state — ``static = "auto"``, the
 study default, so one extra second-order step is tried — and the factorisation of ``K(Ω)``), then the lowest
 ``modes + EXTRA_MODES`` = 6 + 4 = 10 modes with that factorisation (``modes_at_speed``).  The operating point
@@ -135,7 +135,7 @@ def blade_model(size: float):
 def shared_for(study, model, contact) -> dict:
     """The ``shared`` dict ``campbell_stage`` maps ``_speed_point`` with."""
     from bladecase.fe.campbell import mac_sample
-    from bladecase.study.rotation import rotation_axis
+    from bladecase.study.rotation.stage import rotation_axis
 
     r = study["rotation"]
     return {"study": study, "model": model, "contact": contact, "axis": rotation_axis(study, model),
@@ -153,7 +153,7 @@ def run_client(size: float, path: str) -> dict:
 
     from bladecase.fe.rotation import to_rad_s
     from bladecase.study.executor import _Logged
-    from bladecase.study.rotation import _speed_point
+    from bladecase.study.rotation.stage import _speed_point
 
     base = peak_mib()
     t_mesh, t_asm, model, contact = blade_model(size)
@@ -206,7 +206,7 @@ def run_worker(path: str, repeat: int) -> dict:
     from bladecase.fe.campbell import EXTRA_MODES, from_modes, modes_at_speed
     from bladecase.fe.rotation import to_rad_s
     from bladecase.linalg import factor_backend
-    from bladecase.study.rotation import _speed_point
+    from bladecase.study.rotation.stage import _speed_point
 
     base = peak_mib()
     acc: dict = {}
@@ -277,7 +277,7 @@ def measure(size: float, repeat: int) -> dict:
 def dask_check(repeat_maps: int = 2) -> dict:
     """``campbell_stage`` at 8 speeds on the 5.5k blade: serial vs a 2-worker LocalCluster."""
     from bladecase.study.executor import DaskExecutor, SerialExecutor
-    from bladecase.study.rotation import campbell_stage
+    from bladecase.study.rotation.stage import campbell_stage
 
     warnings.filterwarnings("ignore", message="Port .* is already in use")  # another job's dashboard
     _, _, model, contact = blade_model(SIZES[0])

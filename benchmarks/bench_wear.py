@@ -23,7 +23,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from test_rub_study import _study  # noqa: E402
 
 from bladecase.study.executor import SerialExecutor  # noqa: E402
-from bladecase.study.rub import rub_stage  # noqa: E402
+from bladecase.study.rub.stage import rub_stage  # noqa: E402
 from bladecase.study.schema import loads  # noqa: E402
 from bladecase.study.stages import build_contact, build_mesh, build_model  # noqa: E402
 

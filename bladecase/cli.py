@@ -337,7 +337,7 @@ def _cmd_assemble(args) -> int:
     deck, speed = None, None
     if args.calculix is not None:  # before anything is written: a model the deck cannot hold is refused first
         from .fe.calculix import calculix_deck
-        from .study.rotation import operating_speed, rotation_axis
+        from .study.rotation.stage import operating_speed, rotation_axis
 
         speed = operating_speed(study)
         spin = {} if not speed else {"speed": speed, "axis": rotation_axis(study, model)}
@@ -365,14 +365,14 @@ def _cmd_assemble(args) -> int:
 def _frequencies_at_speed(study, model, count: int) -> str | None:
     """With ``[rotation]``: the printed line of the model's frequencies at the operating speed (``K(Ω)``: stress
     stiffening, spin softening), and the note that the model file holds the structure at rest."""
-    from .study.rotation import operating_speed, rotation_axis
+    from .study.rotation.stage import operating_speed, rotation_axis
 
     speed = operating_speed(study)
     if speed is None:
         return None
     from .fe import natural_frequencies
     from .fe.rotation import spin
-    from .post.rotation_report import speed_words
+    from .post.rotation.report import speed_words
     from .study import StudyError
 
     try:
@@ -388,7 +388,7 @@ def _frequencies_at_speed(study, model, count: int) -> str | None:
 def _cmd_reduce(args) -> int:
     from .fe import load_model
     from .reduction import save_reduced
-    from .study.rotation import operating_point
+    from .study.rotation.stage import operating_point
     from .study.stages import build_contact, build_reduced
 
     _setup(args)

@@ -4,7 +4,7 @@ The committed 2-D plate (``meshes/plate.vtu``, P1, lumped mass, clamped at its r
 a casing 0.1 mm away. Three reduction methods at two sizes each get the same 1-ipp search; each is compared with
 the FE model: its modes matched to FE modes by shape (MAC), the contact's impact mass ``1/Σb²`` and static
 compliance against the FE values, its admissible arcs, and what it all means in words
-(:mod:`bladecase.post.compare`). The same study from a TOML file: ``[reduction] methods = [...]``,
+(:mod:`bladecase.post.comparison.compare`). The same study from a TOML file: ``[reduction] methods = [...]``,
 ``sizes = [...]`` (docs/study.md); ``bladecase.run`` then returns it all in ``RunResult.models``.
 
 Run: ``python examples/compare_models.py [--out DIR] [--low]``.
@@ -23,10 +23,10 @@ import _paper as paper  # noqa: E402  (the examples' shared command line)
 
 import bladecase as bc  # noqa: E402
 from bladecase.io import save_figure  # noqa: E402
-from bladecase.post.compare import ModelResult, fe_reference  # noqa: E402
-from bladecase.post.compare_diagnose import diagnose  # noqa: E402
-from bladecase.post.compare_plots import convergence_plot, overlay_plot, spectral_plot  # noqa: E402
-from bladecase.post.compare_table import comparison_rows, write_comparison_csv  # noqa: E402
+from bladecase.post.comparison.compare import ModelResult, fe_reference  # noqa: E402
+from bladecase.post.comparison.diagnose import diagnose  # noqa: E402
+from bladecase.post.comparison.plots import convergence_plot, overlay_plot, spectral_plot  # noqa: E402
+from bladecase.post.comparison.table import comparison_rows, write_comparison_csv  # noqa: E402
 
 PLATE = pathlib.Path(__file__).resolve().parent.parent / "meshes" / "plate.vtu"
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from bladecase.fe.campbell import Campbell, crossings
-from bladecase.post.campbell_plot import MIN_BAND, campbell_figure
+from bladecase.post.rotation.campbell import MIN_BAND, campbell_figure
 
 
 def _campbell():

@@ -8,10 +8,10 @@ from __future__ import annotations
 import pytest
 from _studies import PLATE, ROOT
 
-from bladecase.post.rotation_report import rotation_report
-from bladecase.study import rotation
+from bladecase.post.rotation.report import rotation_report
 from bladecase.study.executor import SerialExecutor
-from bladecase.study.rotation import campbell_stage
+from bladecase.study.rotation import stage as rotation
+from bladecase.study.rotation.stage import campbell_stage
 from bladecase.study.schema import loads
 from bladecase.study.stages import build_contact, build_mesh, build_model
 

@@ -1,4 +1,4 @@
-"""The comparison study's analysis and figures (bladecase.post.compare, compare_table, compare_plots).
+"""The comparison study's analysis and figures (bladecase.post.comparison.compare, comparison.table, comparison.plots).
 
 Reference model: the committed plane-stress plate ``meshes/plate.msh`` (P1, 1084 free dofs, Ti-6Al-4V, 2 mm,
 root clamped at y = 0), contact at its ``contact`` node on the tip (x = 5 mm, y = 100 mm) with the casing normal
@@ -29,7 +29,7 @@ import scipy.sparse.linalg as spla
 
 import bladecase as bc
 from bladecase.fe import stiffness_factor
-from bladecase.post.compare import (
+from bladecase.post.comparison.compare import (
     ModelResult,
     arc_energies,
     contact_spectrum,
@@ -39,9 +39,9 @@ from bladecase.post.compare import (
     match_modes,
     model_matches,
 )
-from bladecase.post.compare_diagnose import diagnose
-from bladecase.post.compare_plots import MARKERS, convergence_plot, observed_order, overlay_plot, spectral_plot
-from bladecase.post.compare_table import (
+from bladecase.post.comparison.diagnose import diagnose
+from bladecase.post.comparison.plots import MARKERS, convergence_plot, observed_order, overlay_plot, spectral_plot
+from bladecase.post.comparison.table import (
     comparison_rows,
     convergence_verdict,
     energy_column,

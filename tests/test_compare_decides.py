@@ -1,4 +1,4 @@
-"""Comparisons that decide (bladecase/study/comparison.py, bladecase/post/compare*.py): periods chosen inside the
+"""Comparisons that decide (bladecase/study/comparison/stage.py, bladecase/post/comparison/): periods chosen inside the
 models' admissible arcs, a verdict that names the model to use or says why none can be trusted, one readable
 overlay figure, no convergence figure without data, observed orders only where sizes converge monotonically, units
 in the headers of comparison.csv.
@@ -27,13 +27,13 @@ from _studies import PLATE, ROOT
 
 import bladecase as bc
 from bladecase.fe import stiffness_factor
-from bladecase.post import compare_table as table
-from bladecase.post.compare import ModelResult, fe_reference
-from bladecase.post.compare_plots import observed_order, overlay_plot
-from bladecase.post.compare_table import read_comparison_csv
+from bladecase.post.comparison import table
+from bladecase.post.comparison.compare import ModelResult, fe_reference
+from bladecase.post.comparison.plots import observed_order, overlay_plot
+from bladecase.post.comparison.table import read_comparison_csv
 from bladecase.reduction import Contact, reduce
 from bladecase.study import run
-from bladecase.study.comparison import compare_models
+from bladecase.study.comparison.stage import compare_models
 from bladecase.study.schema import loads
 
 

@@ -1,5 +1,5 @@
 """A comparison study: [reduction] methods × sizes through the same search, compared against the FE model
-(bladecase/study/comparison.py, bladecase/post/compare*.py)."""
+(bladecase/study/comparison/stage.py, bladecase/post/comparison/)."""
 
 import json
 
@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from _studies import PLATE, ROOT
 
-from bladecase.post.compare_table import read_comparison_csv
+from bladecase.post.comparison.table import read_comparison_csv
 from bladecase.study import run
 from bladecase.study.schema import StudyError, loads
 

@@ -13,7 +13,7 @@ import pytest
 
 from bladecase.fe import natural_frequencies
 from bladecase.study import run
-from bladecase.study.convergence import FLAG, SAFETY, richardson, scaled_study
+from bladecase.study.convergence.stage import FLAG, SAFETY, richardson, scaled_study
 from bladecase.study.schema import StudyError, loads
 from bladecase.study.stages import build_mesh, build_model
 

@@ -16,7 +16,7 @@ from _studies import ROOT
 
 from bladecase.fe import natural_frequencies, refine_mesh
 from bladecase.study import run
-from bladecase.study.convergence import refined_mesh
+from bladecase.study.convergence.stage import refined_mesh
 from bladecase.study.schema import loads
 from bladecase.study.stages import build_contact, build_mesh, build_model
 
@@ -76,7 +76,7 @@ def test_the_contact_face_is_carried(converged):
 def test_the_extrapolation_agrees_with_finer_splits(converged):
     """f1 (linear triangles) over splits 1, 2, 3 extrapolates to within 3e-5 of the extrapolation over splits 3, 4, 5
     (measured 1591.738 and 1591.73 Hz; the ×1/4 mesh itself is still 1593.05), and the study's error covers it."""
-    from bladecase.study.convergence import richardson
+    from bladecase.study.convergence.stage import richardson
 
     study, result = converged
     f = result.summary["convergence"]["figures"]["f1_hz"]

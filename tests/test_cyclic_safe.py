@@ -1,4 +1,4 @@
-"""``bladecase.post.safe_plot``: the SAFE (ZZENF) diagram draws each mode family and the engine-order zig-zag
+"""``bladecase.post.disk.safe_plot``: the SAFE (ZZENF) diagram draws each mode family and the engine-order zig-zag
 (engine order e at e·Ω/2π on the nodal diameter k ≡ ±e mod N)."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import scipy.sparse as sp
 from matplotlib.figure import Figure
 
 from bladecase.fe.cyclic import CyclicSector, cyclic_spectrum, engine_order_diameter
-from bladecase.post.safe_plot import engine_order_zigzag, safe_figure
+from bladecase.post.disk.safe_plot import engine_order_zigzag, safe_figure
 
 
 def test_zigzag_folds_engine_orders_onto_nodal_diameters():

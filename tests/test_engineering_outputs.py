@@ -180,7 +180,7 @@ def test_newton_run_keeps_its_words(newton):
 
 
 def test_figures_follow_the_contact_model(demo):
-    from bladecase.post.forced_plots import forced_response_plot
+    from bladecase.post.forcing.plots import forced_response_plot
     from bladecase.post.plots import frequency_energy
 
     labels = frequency_energy(demo.families).axes[0].get_legend_handles_labels()[1]
@@ -233,7 +233,7 @@ def plate():
 
 def test_massless_forcing_speaks_of_contact_phases(plate, tmp_path):
     from bladecase.post.report import forcing_report
-    from bladecase.study.forcing import forced_response
+    from bladecase.study.forcing.stage import forced_response
 
     _, massless = plate
     out = forced_response(massless, [], {"ratio": 0.03, "amplitude": 900.0, "frequencies": [0.96, 1.04],
@@ -250,7 +250,7 @@ def test_massless_forcing_speaks_of_contact_phases(plate, tmp_path):
 
 
 def test_forced_csv_header_carries_each_unit_once(plate, tmp_path):
-    from bladecase.study.forcing import COLUMNS, forced_response
+    from bladecase.study.forcing.stage import COLUMNS, forced_response
 
     newton, _ = plate
     out = forced_response(newton, [], {"ratio": 0.05, "amplitude": 5.0, "frequencies": [0.9, 1.1], "points": 2,

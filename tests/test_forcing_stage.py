@@ -1,4 +1,4 @@
-"""The forcing stage (bladecase.study.forcing): linear steady state against the closed form, a sweep with
+"""The forcing stage (bladecase.study.forcing.stage): linear steady state against the closed form, a sweep with
 impacts on the plate study's reduced model (CSV, figure, classes confirmed by re-simulation), refusals."""
 
 from __future__ import annotations
@@ -12,11 +12,11 @@ from _studies import PLATE, ROOT, absolute
 from bladecase.nsm import chain
 from bladecase.nsm.damping import Damping
 from bladecase.nsm.sweep import forced_point
-from bladecase.post.forced_plots import forced_response_plot
+from bladecase.post.forcing.plots import forced_response_plot
 from bladecase.post.outputs import FORMATS
 from bladecase.reduction import reduce
 from bladecase.reduction.loads import project_load
-from bladecase.study.forcing import build_load, forced_response, forced_scene, forcing_frequencies, steady_orbit
+from bladecase.study.forcing.stage import build_load, forced_response, forced_scene, forcing_frequencies, steady_orbit
 from bladecase.study.schema import loads
 from bladecase.study.stages import build_contact, build_mesh, build_model, build_reduced, search
 
@@ -149,7 +149,7 @@ def test_massless_stage_runs_and_loads_the_contact_dofs(plate, tmp_path):
     """The massless contact model (4 modes + attachment): the default load sits on the massless contact node, so
     it enters as the condensed load plus its static contact displacement g = w_cᵀK_cc⁻¹f_c; the state with contact
     phases is confirmed by re-simulation and touches the casing exactly."""
-    from bladecase.study.forcing import contact_load
+    from bladecase.study.forcing.stage import contact_load
 
     _, reduced, _ = plate
     massless = reduce(reduced.model, reduced.contact, "massless", 4)

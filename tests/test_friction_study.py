@@ -35,7 +35,7 @@ def blade():
 
 def _stage(blade, **contact):
     from bladecase.study.executor import SerialExecutor
-    from bladecase.study.rub import rub_stage
+    from bladecase.study.rub.stage import rub_stage
     from bladecase.study.stages import build_contact
 
     study = loads(_study(rub=RUB, **contact), source="<friction>")
@@ -45,7 +45,7 @@ def _stage(blade, **contact):
 @pytest.fixture(scope="module")
 def with_friction(blade, tmp_path_factory):
     from bladecase.study.executor import SerialExecutor
-    from bladecase.study.rub import rub_stage
+    from bladecase.study.rub.stage import rub_stage
     from bladecase.study.stages import build_contact
 
     out = tmp_path_factory.mktemp("friction")
@@ -72,7 +72,7 @@ def test_friction_energy_balance_closes_and_is_written(with_friction):
     cells = dict(zip(header.split(","), line.split(",")))
     assert float(cells["friction_work_j"]) == pytest.approx(row["friction_work_j"], rel=1e-8)
     assert cells["rotation_dominated"] == "true"
-    from bladecase.post.rub_report import rub_report
+    from bladecase.post.rub.report import rub_report
 
     text = "\n".join(rub_report(section))
     assert "the sliding dominated by the rotation" in text and "the balance closes to" in text
@@ -193,7 +193,7 @@ def test_a_coating_on_a_line_of_nodes_is_refused_before_any_factorisation():
     from test_rub_line import LINE
 
     from bladecase.study.executor import SerialExecutor
-    from bladecase.study.rub import rub_stage
+    from bladecase.study.rub.stage import rub_stage
     from bladecase.study.stages import build_contact
 
     text = _wear_study().replace('face = "tip"                # the whole tip face rubs: its mean normal '

@@ -302,7 +302,7 @@ def test_forcing_amplitude_has_a_physical_range(amplitude):
 
 def test_forcing_amplitude_that_buries_the_contact_refused_before_the_sweep(plate_model):
     from bladecase.reduction import reduce
-    from bladecase.study.forcing import forced_response
+    from bladecase.study.forcing.stage import forced_response
 
     model, contact = plate_model
     reduced = reduce(model, contact, "modal", 10)
@@ -339,7 +339,7 @@ def test_forcing_low_frequencies_count_in_first_mode_periods():
 
 def test_forcing_work_in_hz_checked_at_the_stage(plate_model):
     from bladecase.reduction import reduce
-    from bladecase.study.forcing import forced_response
+    from bladecase.study.forcing.stage import forced_response
 
     model, contact = plate_model
     reduced = reduce(model, contact, "modal", 10)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from bladecase.post.mistuning_plot import amplification_figure
+from bladecase.post.disk.mistuning_plot import amplification_figure
 from bladecase.reduction.mistuning import amplification, family_band, lumped_disk, mistuning_model
 from bladecase.reduction.mistuning_stats import (
     mistuning_statistics,

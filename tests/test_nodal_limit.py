@@ -20,9 +20,9 @@ import pytest
 from test_convergence import STRIP
 
 from bladecase.nsm.massless.nodal_modes import nodal_family
-from bladecase.post.nodal_report import nodal_report
+from bladecase.post.nodal.report import nodal_report
 from bladecase.reduction.nodes import nodal_model
-from bladecase.study.nodal import nodal_stage, node_amplitude
+from bladecase.study.nodal.stage import nodal_stage, node_amplitude
 from bladecase.study.schema import loads
 from bladecase.study.stages import build_contact, build_mesh, build_model
 from bladecase.study.validity import blade_span, cut_family, first_beyond

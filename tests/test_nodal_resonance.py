@@ -22,7 +22,7 @@ import pytest
 
 from bladecase.nsm.massless.nodal_modes import BACKBONE_SHARE, backbone_trend, nodal_family, resonance_ratio
 from bladecase.nsm.massless.nodes import NodalSystem, simulate_nodes
-from bladecase.post.nodal_report import backbone_rows, nodal_report
+from bladecase.post.nodal.report import backbone_rows, nodal_report
 
 
 def chain(masses=(1.0, 1.5, 0.7)) -> NodalSystem:

@@ -140,8 +140,8 @@ def test_a_large_model_tracks_its_modes_on_a_sample_of_dofs(monkeypatch, tmp_pat
     results stay small): on the plate (1084 dofs) with a 150-dof sample, the same modes are followed, the links'
     MACs within 0.02 of the exact ones, and each speed's shapes have 150 rows."""
     from bladecase.fe import campbell as fc
-    from bladecase.study import rotation as rs
     from bladecase.study.executor import make_executor
+    from bladecase.study.rotation import stage as rs
     from bladecase.study.stages import build_contact, build_mesh, build_model
 
     study = _study(ROTATION.replace("modes = 3", "modes = 4\nbands = false"))
@@ -168,7 +168,7 @@ def test_a_clearance_closed_at_speed_names_both_ways_out():
     """The blade's centrifugal growth closes a 1 µm cold clearance at 8000 rpm: the message gives the touch speed,
     and says how to give a clearance measured at speed."""
     from bladecase.fe import stiffness_factor
-    from bladecase.study.rotation import operating_point
+    from bladecase.study.rotation.stage import operating_point
     from bladecase.study.schema import StudyError
     from bladecase.study.stages import build_contact, build_mesh, build_model
 

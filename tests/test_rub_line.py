@@ -66,7 +66,7 @@ def test_a_line_of_tip_nodes_rubs(result):
     text = (out / "report.md").read_text()
     assert "on the line of contact nodes" in text and "no contact pressure" in text
     assert "contact_pressure" not in __import__("meshio").read(out / "rub.vtu").point_data
-    from bladecase.post.rub_plot import interaction_plot
+    from bladecase.post.rub.plot import interaction_plot
 
     labels = [ax.get_ylabel() for ax in interaction_plot(s).axes]   # no pressure to draw: its panel left out
     assert "peak total contact force (N)" in labels and "peak contact pressure (MPa)" not in labels
@@ -77,7 +77,7 @@ def test_a_line_of_tip_nodes_rubs(result):
 def test_the_casing_is_shared_by_tributary_length():
     """Each node of the line takes the casing's stiffness in proportion to half its distances to its neighbours
     along the line (computed here by sorting the nodes along the chord)."""
-    from bladecase.study.rub import _node_stiffness, check_rub_contact
+    from bladecase.study.rub.stage import _node_stiffness, check_rub_contact
     from bladecase.study.stages import build_contact, build_mesh, build_model
 
     study = loads(_line_study(), source="<line>")
@@ -112,8 +112,8 @@ def _tip_and_one_more(node: int = 28) -> list[int]:
                  r"node, or a node off the face\)"),
 ])
 def test_an_invalid_selection_is_refused_before_any_factorisation(nodes, stiffness, match, monkeypatch):
-    from bladecase.study import rub as stage
     from bladecase.study.executor import SerialExecutor
+    from bladecase.study.rub import stage
     from bladecase.study.stages import build_contact, build_mesh, build_model
 
     nodes = nodes or _tip_and_one_more()

@@ -11,7 +11,7 @@ from scipy.optimize import brentq
 from bladecase.nsm import Damping
 from bladecase.nsm.massless.nodes import NodalFlight, NodalSystem, Rub, simulate_nodes
 from bladecase.nsm.massless.rub import _peaks, rub_response
-from bladecase.post.rub_report import rub_report
+from bladecase.post.rub.report import rub_report
 from bladecase.study.keys import StudyError
 from bladecase.study.schema import loads
 
@@ -23,7 +23,7 @@ def characterise(*args, **kwargs):
 
 
 def crossing_speed(*args, **kwargs):
-    from bladecase.study.rub import crossing_speed
+    from bladecase.study.rub.stage import crossing_speed
 
     return crossing_speed(*args, **kwargs)
 
@@ -101,7 +101,7 @@ def test_the_cap_is_checked(rub, match):
 def test_the_cap_defaults_to_ten_times_the_revolutions():
     from test_rub_study import CASING, RUB, _study
 
-    from bladecase.study.rub import max_revolutions
+    from bladecase.study.rub.stage import max_revolutions
 
     study = loads(_study(CASING, RUB.replace("max_revolutions = 8\n", "")), source="<rub>")
     assert study["rub"]["max_revolutions"] is None and max_revolutions(study["rub"]) == 80
@@ -168,7 +168,7 @@ def test_a_sub_harmonic_rub_is_periodic_over_three_revolutions():
     assert r.peak_force.max() == pytest.approx(lam.max(), rel=0.02)
     assert r.tip_displacement == pytest.approx((x - s.flexibility @ lam).max(), rel=0.02)
     section = {"lobes": 1, "window": 5}
-    from bladecase.post.rub_report import _verdict
+    from bladecase.post.rub.report import _verdict
 
     words = _verdict({"speed": 48.7, "response": r.response, "read_revolutions": r.read_revolutions,
                       "change": r.change}, section, "rpm")

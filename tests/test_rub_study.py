@@ -146,7 +146,7 @@ def test_rub_input_errors(casing, rub, contact, match):
 
 def test_a_speed_whose_growth_closes_a_clearance_is_named(blade):
     from bladecase.study.executor import SerialExecutor
-    from bladecase.study.rub import rub_stage
+    from bladecase.study.rub.stage import rub_stage
     from bladecase.study.stages import build_contact
 
     study = loads(_study(rub=RUB.replace("speeds = [1450, 1650]", "speeds = [1450, 3000]")), source="<rub>")
@@ -157,7 +157,7 @@ def test_a_speed_whose_growth_closes_a_clearance_is_named(blade):
 
 
 def test_stiffness_per_area_gives_each_node_its_share(blade):
-    from bladecase.study.rub import _node_stiffness
+    from bladecase.study.rub.stage import _node_stiffness
     from bladecase.study.stages import build_contact
 
     text = _study().replace("casing_stiffness = 1e6      # N/m: a thin casing's local radial stiffness; the modes "
@@ -178,8 +178,8 @@ def test_stiffness_per_area_gives_each_node_its_share(blade):
 def test_a_speed_the_simulation_refuses_is_reported_and_the_others_go_on(blade, monkeypatch):
     """A ValueError of the simulation at one speed (e.g. a grazing switch) is that speed's result, not the end of
     the sweep: the other speeds are computed, the failed one is listed with its reason."""
-    from bladecase.study import rub as stage
     from bladecase.study.executor import SerialExecutor
+    from bladecase.study.rub import stage
     from bladecase.study.stages import build_contact
 
     real = stage.rub_response
@@ -196,6 +196,6 @@ def test_a_speed_the_simulation_refuses_is_reported_and_the_others_go_on(blade, 
     assert [r["speed"] for r in s["rows"]] == [1650.0, 1660.0]
     assert s["failed_speeds"] == [{"speed": 1450.0, "reason": "grazing switch: a contact signal does not leave its "
                                                               "switching surface"}]
-    from bladecase.post.rub_report import rub_report
+    from bladecase.post.rub.report import rub_report
 
     assert any("No result at 1450 rpm" in line for line in rub_report(s))

@@ -12,7 +12,7 @@ import pytest
 from _studies import PLATE, ROOT
 from scipy.sparse.linalg import spsolve
 
-from bladecase.post.casing_words import weak_casing_words
+from bladecase.post.casing.words import weak_casing_words
 from bladecase.post.report import report
 from bladecase.reduction.casing import WEAK_CASING, frequency_rise_bound, ring_stiffness
 from bladecase.study import run

@@ -11,8 +11,8 @@ from _studies import PLATE, absolute
 
 from bladecase.cli import main
 from bladecase.fe.campbell import Campbell, crossings
-from bladecase.post.campbell_plot import campbell_figure
-from bladecase.post.rotation_report import rotation_report, speed_words, to_unit
+from bladecase.post.rotation.campbell import campbell_figure
+from bladecase.post.rotation.report import rotation_report, speed_words, to_unit
 
 RPM = 2 * math.pi / 60
 

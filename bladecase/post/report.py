@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from .casing import casing_report
-from .casing_words import weak_casing_words
-from .convergence_report import convergence_report
-from .modes_report import modes_report
-from .nodal_report import nodal_report
-from .rotation_report import rotation_report
-from .rub_report import rub_report
+from .casing.report import casing_report
+from .casing.words import weak_casing_words
+from .convergence.report import convergence_report
+from .nodal.report import nodal_report
+from .rotation.modes_report import modes_report
+from .rotation.report import rotation_report
+from .rub.report import rub_report
 from .verdict import (  # noqa: F401 (re-exported)
     NARROW_RTOL,
     massless_summary,
@@ -57,7 +57,7 @@ def verdict_lines(summary: dict) -> list[str]:
 
 def report(summary: dict) -> str:
     """A human-readable Markdown report of a run's :data:`summary` (a run without a contact: the linear modes and
-    the Campbell diagram, :func:`~bladecase.post.modes_report.modes_report`)."""
+    the Campbell diagram, :func:`~bladecase.post.rotation.modes_report.modes_report`)."""
     if summary.get("contact") is None and summary.get("reduction") is None:
         return modes_report(summary)
     m, c, r = summary["model"], summary["contact"], summary["reduction"]
@@ -443,7 +443,7 @@ def comparison_report(section: dict) -> list[str]:
     """The comparison section of ``report.md``: the verdict first (which model to use, or why none can be trusted:
     the section's ``verdict``, else computed from its rows), then the table, the sentences in words and the
     figures."""
-    from .compare_table import comparison_verdict, energy_columns, period_labels
+    from .comparison.table import comparison_verdict, energy_columns, period_labels
 
     rows = section["rows"]
     energy_cols = energy_columns(rows[0])

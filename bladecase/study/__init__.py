@@ -8,7 +8,11 @@
 - :mod:`~bladecase.study.documents` — the modes file and the summary's parts (JSON);
 - :mod:`~bladecase.study.publish` — staging and all-or-nothing publishing;
 - :mod:`~bladecase.study.executor` — where independent tasks run (serial, local processes, Dask);
-- :mod:`~bladecase.study.run` — :func:`run`, the whole chain.
+- :mod:`~bladecase.study.run` — :func:`run`, the whole chain;
+- one subpackage per study kind, its stage and keys (its report and figures in the :mod:`bladecase.post`
+  subpackage of the same name): :mod:`~bladecase.study.rotation`, :mod:`~bladecase.study.rub`,
+  :mod:`~bladecase.study.nodal`, :mod:`~bladecase.study.disk`, :mod:`~bladecase.study.comparison`,
+  :mod:`~bladecase.study.forcing`, :mod:`~bladecase.study.convergence`, :mod:`~bladecase.study.casing`.
 
 The command line (:mod:`bladecase.cli`) is a thin layer over this package.
 """

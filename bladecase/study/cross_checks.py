@@ -8,10 +8,10 @@ from __future__ import annotations
 import math
 
 from ..fe import Material, PlateGeometry
-from .cyclic_section import cyclic_checks
+from .disk.cyclic_keys import cyclic_checks
+from .disk.mistuning_keys import mistuning_checks
 from .geometry_section import estimate_cells, geometry_of
 from .keys import StudyError, one_line
-from .mistuning_section import mistuning_checks
 from .sections import (
     casing_checks,
     convergence_checks,

@@ -424,8 +424,8 @@ def _stable_fraction(records: list[dict | None]) -> float | None:
 
 def reduced_summary(reduced: ReducedModel, reference_hz: np.ndarray, fe=None) -> dict:
     """A reduced model's frequencies and contact weights, with the nearest-frequency error vs ``reference_hz``;
-    with ``fe`` (:func:`~bladecase.post.compare.fe_reference`) each mode's FE counterpart by mode shape (MAC):
-    ``fe_match`` per listed mode, ``None`` when it has none (an artefact) or lies above the FE modes computed."""
+    with ``fe`` (:func:`~bladecase.post.comparison.compare.fe_reference`) each mode's FE counterpart by mode shape
+    (MAC): ``fe_match`` per listed mode, ``None`` when it has none (an artefact) or lies above the FE modes computed."""
     sp = reduced.system.spectrum
     f = sp.frequencies[sp.active]
     nearest = [float(np.min(np.abs(f - fr)) / fr) if f.size else None for fr in reference_hz]
@@ -433,7 +433,7 @@ def reduced_summary(reduced: ReducedModel, reference_hz: np.ndarray, fe=None) ->
            "frequencies_hz": f.tolist(), "contact_weights_b2": (sp.b[sp.active] ** 2).tolist(),
            "relative_error_vs_fe": nearest}
     if fe is not None:
-        from ..post.compare import model_matches
+        from ..post.comparison.compare import model_matches
 
         found = {m.index: m for m in model_matches(reduced, fe, modes=12)}
         out["fe_match"] = [_match(found.get(int(j))) for j in np.flatnonzero(sp.active)]
@@ -469,9 +469,9 @@ def contact_summary(contact: Contact, model: FEModel, reduced: ReducedModel | No
 
     With ``reduced``: the contact model (``"newton"`` or ``"massless"``) and, for the massless one, the contact's
     own stiffness ``k_c = 1/(w_cᵀK_cc⁻¹w_c)`` (the contact dofs with the interior held) and its value in series with
-    the casing (:func:`~bladecase.nsm.series_stiffness`); with ``fe`` (:func:`~bladecase.post.compare.fe_reference`)
-    the blade's static stiffness at the contact ``1/(wᵀK⁻¹w)`` (the whole blade); ``face``: the name of a face
-    contact's node group.
+    the casing (:func:`~bladecase.nsm.series_stiffness`); with ``fe``
+    (:func:`~bladecase.post.comparison.compare.fe_reference`) the blade's static stiffness at the contact
+    ``1/(wᵀK⁻¹w)`` (the whole blade); ``face``: the name of a face contact's node group.
     """
     ids = model.mesh.node_ids
     out = {"node": contact.node, "node_id": int(ids[contact.node]), "face_nodes": list(contact.nodes),

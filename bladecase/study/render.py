@@ -14,12 +14,12 @@ from ..nsm import Branch
 from ..nsm.energy import describe_split, modal_energy_split
 from ..nsm.verify import verify
 from ..post.grid import fe_grid, grid_index, nodal_field
+from ..post.nodal.tip_excursion import tip_excursion
+from ..post.nodal.tip_excursion import words as tip_words
 from ..post.outputs import FORMATS, OrbitScene
 from ..post.plots import is_massless
 from ..post.prestress import centrifugal_fields
 from ..post.report import engineering_words, orbit_words
-from ..post.tip_excursion import tip_excursion
-from ..post.tip_excursion import words as tip_words
 from ..progress import progress_bar
 from ..reduction import MasslessReducedModel, ReducedModel
 from .choose import Choice, choose_orbits, frame_times

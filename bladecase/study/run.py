@@ -21,24 +21,24 @@ import numpy as np
 from .. import log
 from ..fe import save_mesh, stiffness_factor
 from ..io import write_json, write_text
-from ..post.compare import ModelResult, fe_reference
-from ..post.cyclic_report import cyclic_report, cyclic_verdict
-from ..post.modes_report import modes_verdict
+from ..post.comparison.compare import ModelResult, fe_reference
+from ..post.disk.cyclic_report import cyclic_report, cyclic_verdict
 from ..post.outputs import FORMATS, PlotScene
 from ..post.prestress import add_to_mesh_file
 from ..post.report import report
+from ..post.rotation.modes_report import modes_verdict
 from ..post.verdict import verdict
 from ..progress import progress_counter
-from .comparison import FE_MODES, compare_models, summary_section
-from .cyclic import compute_linear
+from .comparison.stage import FE_MODES, compare_models, summary_section
+from .disk.cyclic import compute_linear
 from .documents import contact_summary, families_document, family_summary, model_summary, reduced_summary
 from .executor import Executor, make_executor
-from .forcing import forced_response, forced_scene
-from .modes_run import campbell_with_figure
+from .forcing.stage import forced_response, forced_scene
 from .publish import RUN_RESULTS, check_inputs, output_folder, publish, release, staged_names, staging_dir
 from .reference import reference_model, study_basis
 from .render import orbit_engineering, render_all
-from .rotation import operating_point
+from .rotation.modes_run import campbell_with_figure
+from .rotation.stage import operating_point
 from .schema import Study, load_study
 from .stages import (
     build_contact,
@@ -61,7 +61,7 @@ class RunResult:
     summary: dict = field(repr=False)
     families: list = field(repr=False, default_factory=list)
     #: Every model of the run by name (the main one first, then ``compare`` and the methods × sizes grid):
-    #: :class:`~bladecase.post.compare.ModelResult` with the reduced model, its families and timings.
+    #: :class:`~bladecase.post.comparison.compare.ModelResult` with the reduced model, its families and timings.
     models: dict = field(repr=False, default_factory=dict)
 
     @property
@@ -201,7 +201,7 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
         factor = stiffness_factor(model)
         contact = build_contact(study, model)
         if (study.config.get("rub") or {}).get("speeds"):  # the rub's contact selection, before minutes of work
-            from .rub import check_rub_contact
+            from .rub.stage import check_rub_contact
 
             check_rub_contact(study, model, contact)
         rest_model, cold_contact = model, contact
@@ -297,7 +297,7 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
     nodal = None
     if study["contact"].get("points") == "nodes":
         with stage("nodes"):
-            from .nodal import nodal_stage
+            from .nodal.stage import nodal_stage
 
             anims = files["animations"]
             nodal = nodal_stage(study, model, contact, families, reduced, factor=factor, folder=staging,
@@ -314,7 +314,7 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
     rub = None
     if (study.config.get("rub") or {}).get("speeds"):
         with stage("rub"):
-            from .rub import rub_stage
+            from .rub.stage import rub_stage
 
             rub = rub_stage(study, rest_model, cold_contact, families=families, executor=executor, progress=progress,
                             folder=staging, figures="png" in o["formats"], title=study.name)
@@ -380,8 +380,8 @@ def _small_displacements(study: Study, model, searched: list, found: list) -> tu
 def _convergence(study: Study, model, reduced, families, f1: float, animations: list, executor, progress: bool
                  ) -> dict:
     """The mesh-convergence stage: the orbit's figures read at ``[convergence] ratio``, else at the first animated
-    orbit's ``T/T₁``, else at the middle of the widest admissible arc (:mod:`~bladecase.study.convergence`)."""
-    from .convergence import convergence_stage, mesh_figures
+    orbit's ``T/T₁``, else at the middle of the widest admissible arc (:mod:`~bladecase.study.convergence.stage`)."""
+    from .convergence.stage import convergence_stage, mesh_figures
 
     T1 = 2 * np.pi / float(reduced.system.spectrum.contact_modes[0][0])
     ratio, ipp = study["convergence"]["ratio"], study["search"]["ipp"][0]
@@ -400,10 +400,10 @@ def _convergence(study: Study, model, reduced, families, f1: float, animations: 
 def _casing_sweep(study: Study, model, contact, factor, unit: float, staging: Path, figures: bool,
                   progress: bool, main: tuple) -> dict:
     """The nonsmooth modes searched with each casing stiffness of ``[contact] casing_stiffness = [...]`` (the first
-    is the run's own; :mod:`bladecase.study.casing_sweep`): the rows and their spread, ``casing.png``."""
+    is the run's own; :mod:`bladecase.study.casing.stage`): the rows and their spread, ``casing.png``."""
     from ..io import save_figure
-    from ..post.casing import casing_figure
-    from .casing_sweep import casing_sweep
+    from ..post.casing.report import casing_figure
+    from .casing.stage import casing_sweep
 
     values = casing_sweep_values(study)
     out = casing_sweep(study, model, contact, values, factor=factor, unit=unit, progress=progress, first=main)
@@ -441,8 +441,8 @@ def _stiffness_words(reduced, fe) -> str:
 
 def _soft_casing(reduced, fe) -> str | None:
     """The sentence of a compliant casing far softer than the blade's static stiffness at the contact
-    (:func:`~bladecase.post.casing_words.weak_casing_words`), else ``None``."""
-    from ..post.casing_words import weak_casing_words
+    (:func:`~bladecase.post.casing.words.weak_casing_words`), else ``None``."""
+    from ..post.casing.words import weak_casing_words
 
     s = reduced.system
     if getattr(s, "contact_model", "newton") != "massless" or np.isinf(s.casing) or not fe.static_compliance > 0:

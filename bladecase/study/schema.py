@@ -31,10 +31,10 @@ from .cross_checks import (  # noqa: F401 (MASSLESS_METHODS lived here)
     cross_checks,
     modes_only_checks,
 )
-from .cyclic_section import CYCLIC_KEYS
+from .disk.cyclic_keys import CYCLIC_KEYS
+from .disk.mistuning_keys import MISTUNING_KEYS
 from .geometry_section import GEOMETRY_FIELDS, GEOMETRY_KEYS, geometry_of, geometry_section  # noqa: F401
 from .keys import _BOOL, _INT, _LIST, _NUM, _STR, REQUIRED, Key, StudyError, _check_field, _check_value, one_line  # noqa: F401
-from .mistuning_section import MISTUNING_KEYS
 from .sections import (
     CASING_KEYS,
     CONVERGENCE_KEYS,

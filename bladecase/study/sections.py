@@ -1,8 +1,8 @@
 """The sections of a study beyond the pipeline's own: ``[forcing]`` (the forced–damped response of the blade:
-damping, load, forcing frequencies, the sweep; run by :func:`bladecase.study.forcing.forced_response`),
+damping, load, forcing frequencies, the sweep; run by :func:`bladecase.study.forcing.stage.forced_response`),
 ``[execution]`` (where independent tasks run: :func:`bladecase.study.executor.make_executor`) and ``[limits]``
 (the caps on the work a study may ask for, which a big machine may raise), ``[rotation]`` (the blade's rotation:
-the speed every stage works at and the Campbell diagram, :mod:`bladecase.study.rotation`), with their
+the speed every stage works at and the Campbell diagram, :mod:`bladecase.study.rotation.stage`), with their
 cross-checks."""
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ import numpy as np
 from ..fe.geometry import MAX_CELLS
 from ..nsm.system import DENSE_LIMIT
 from .executor import make_executor
-from .friction_keys import ABRADABLE_KEY, FRICTION_KEY, friction_checks  # noqa: F401 (FRICTION_KEY: schema's)
 from .keys import _BOOL, _INT, _LIST, _NUM, _STR, Key, StudyError
+from .rub.keys import ABRADABLE_KEY, FRICTION_KEY, friction_checks  # noqa: F401 (FRICTION_KEY: schema's)
 from .values import (
     LIMITS,
     _amplitude,
@@ -183,7 +183,7 @@ DOFS_FULL = 3000
 SWEEP_PERIODS = 100_000
 
 #: Most forcing periods ``[limits] sweep_periods`` may allow, and the cap of a forced response run without a
-#: study (:func:`bladecase.study.forcing.forced_response` without ``max_periods``).
+#: study (:func:`bladecase.study.forcing.stage.forced_response` without ``max_periods``).
 SWEEP_CEILING = 10**9
 
 #: ``[limits]``: key → :class:`~bladecase.study.keys.Key`.  Each caps work that would otherwise run for hours or

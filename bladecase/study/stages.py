@@ -32,7 +32,7 @@ def build_mesh(study: Study, path: str | os.PathLike | None = None) -> Mesh:
     group = contact_group(study)
     if group is not None:
         need.append(("[contact] group", group))
-    if study.parametric and study["geometry"]["kind"] == "sector":  # a bladed disk's sector (study/cyclic.py)
+    if study.parametric and study["geometry"]["kind"] == "sector":  # a bladed disk's sector (study/disk/cyclic.py)
         from ..fe import save_mesh, sector_mesh
 
         g = study["geometry"]
@@ -392,9 +392,9 @@ def build_reduced(study: Study, model: FEModel, contact: Contact, method: str | 
 def check_forcing(study: Study, reduced: ReducedModel) -> None:
     """The forced response's work on ``reduced``, checked as soon as the reduced model is known (before the
     search): the amplitude against the clearance, the sweep within ``[limits] sweep_periods`` counted in periods
-    ``T1`` (:func:`bladecase.study.forcing.check_sweep_work`); and the load itself (its group, its node)."""
+    ``T1`` (:func:`bladecase.study.forcing.stage.check_sweep_work`); and the load itself (its group, its node)."""
     from ..reduction.loads import project_load
-    from .forcing import build_load, check_sweep_work, contact_load
+    from .forcing.stage import build_load, check_sweep_work, contact_load
 
     forcing = study["forcing"]
     try:

@@ -9,9 +9,9 @@ blades): an orbit whose tip amplitude (the largest ``|u|`` of a contact node
 over the period, :func:`~bladecase.study.render.orbit_engineering`) exceeds it is not part of an arc, and the report
 says where each arc was cut and why. The span is the distance from the clamp's centroid to the farthest node.
 
-The every-node family (``[contact] points = "nodes"``, :mod:`~bladecase.study.nodal`) is one followed curve, not a set
-of arcs: it is cut at its first orbit beyond the limit (:func:`first_beyond`, :func:`cut_family`), and its figures
-— energy, pressure, total force, casing yield — stop at the last orbit within it.
+The every-node family (``[contact] points = "nodes"``, :mod:`~bladecase.study.nodal.stage`) is one followed curve,
+not a set of arcs: it is cut at its first orbit beyond the limit (:func:`first_beyond`, :func:`cut_family`), and its
+figures — energy, pressure, total force, casing yield — stop at the last orbit within it.
 
 >>> from bladecase.nsm import backbone, chain
 >>> branch = backbone(chain(2, k=1.0, m=0.5, gap=1.0), [4.0, 4.5, 5.0, 5.5, 6.0, 6.5, 7.0])

@@ -1,0 +1,9 @@
+"""A bladed disk's report and figures.
+
+- :mod:`~bladecase.post.disk.cyclic_report` — the modes in words: the nodal diameter each engine order excites,
+  crossings;
+- :mod:`~bladecase.post.disk.safe_plot` — the SAFE (ZZENF) diagram: frequency against nodal diameter, engine-order
+  zig-zag;
+- :mod:`~bladecase.post.disk.mistuning_report` — the mistuned samples in words;
+- :mod:`~bladecase.post.disk.mistuning_plot` — the amplification factors' histogram against Whitehead's bound.
+"""

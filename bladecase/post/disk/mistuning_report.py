@@ -1,0 +1,67 @@
+"""The report's words on a mistuned disk (``summary["mistuning"]``, :mod:`bladecase.study.disk.mistuning`): the
+model and its assumptions in one sentence, the amplification factor's distribution against Whitehead's bound, the worst
+blade of the worst sample.
+
+>>> m = {"model": "snm", "family": 0, "modes": 6, "engine_order": 2, "diameter": 2, "damping": 0.005, "sectors": 6,
+...      "std": 0.02, "seed": 3, "deviations": None, "samples": 20, "mean": 1.12, "largest": 1.21,
+...      "largest_sample": 9, "largest_blade": 4, "whitehead_bound": 1.7247, "above_bound": 0,
+...      "percentiles": {"p5": 1.07, "p50": 1.11, "p95": 1.2, "p99": 1.21}, "largest_frequency_hz": 1648.2,
+...      "tip": {"node": 9, "direction": "y"}, "blade_cells": 58, "cells": 283}
+>>> print(mistuning_sentence(m))
+Mistuning (20 random samples, std 2 %): amplification 1.110 (median) to 1.210 (largest: blade 4 of sample 9), \
+below Whitehead's bound 1.725 for 6 blades.
+>>> lines = mistuning_lines(m)
+>>> lines[1]
+'## Mistuning'
+"""
+
+from __future__ import annotations
+
+__all__ = ["ASSUMPTIONS", "mistuning_lines", "mistuning_sentence"]
+
+#: Each model's assumptions in one sentence.
+ASSUMPTIONS = {
+    "snm": "subset of nominal modes: the mistuned disk's modes are combinations of the tuned modes of the forced "
+           "family for every nodal diameter, only each blade's own stiffness is scaled (no mass or disk mistuning), "
+           "the deviations are small and the family is isolated in frequency",
+    "fmm": "fundamental mistuning model: one isolated mode family whose strain energy is all in the blades, each "
+           "deviation scaling a blade's frequency squared as the family sees it, the deviations small",
+}
+
+
+def _samples(m: dict) -> str:
+    if m.get("deviations") is not None:
+        return "the given pattern"
+    return f"{m['samples']} random sample{'s' if m['samples'] != 1 else ''}, std {100 * m['std']:g} %"
+
+
+def mistuning_sentence(m: dict) -> str:
+    """One sentence: the amplification's median and largest, where, against Whitehead's bound."""
+    p50 = m["percentiles"]["p50"]
+    spread = (f"amplification {m['largest']:.3f}" if m["samples"] == 1
+              else f"amplification {p50:.3f} (median) to {m['largest']:.3f}")
+    where = f"blade {m['largest_blade']}" + ("" if m["samples"] == 1 else f" of sample {m['largest_sample']}")
+    side = (f"{m['above_bound']} sample(s) above" if m["above_bound"] else "below")
+    return (f"Mistuning ({_samples(m)}): {spread} (largest: {where}), {side} Whitehead's bound "
+            f"{m['whitehead_bound']:.3f} for {m['sectors']} blades.")
+
+
+def mistuning_lines(m: dict | None) -> list[str]:
+    """The report's Markdown section on mistuning (``[]`` without it)."""
+    if not m:
+        return []
+    tip, p = m["tip"], m["percentiles"]
+    return ["", "## Mistuning", "",
+             f"- {mistuning_sentence(m)}",
+             f"- Model ({m['model'].upper()}, {m['modes']} modes: family {m['family']} of every nodal diameter): "
+             f"{ASSUMPTIONS[m['model']]}.",
+             f"- Forcing: engine order {m['engine_order']} (nodal diameter {m['diameter']}) at each blade's tip "
+             f"(node {tip['node']} of the sector, direction {tip['direction']}), response read there; modal damping "
+             f"ratio {m['damping']:g}; the blade is {m['blade_cells']} of the sector's {m['cells']} cells.",
+             "- Amplification factor (each sample's largest blade amplitude ÷ the tuned disk's): "
+             + ("" if m["samples"] == 1 else f"mean {m['mean']:.4f}; 5th/50th/95th/99th percentiles {p['p5']:.4f}, "
+                f"{p['p50']:.4f}, {p['p95']:.4f}, {p['p99']:.4f}; largest ")
+             + f"{m['largest']:.4f} on blade {m['largest_blade']} at {m['largest_frequency_hz']:.2f} Hz.",
+             f"- Whitehead's bound ½(1 + √N) = {m['whitehead_bound']:.4f} for N = {m['sectors']}: "
+             f"{m['above_bound']} sample(s) above it" + (" (none expected: check the family is isolated)."
+                                                         if m["above_bound"] else ".")]

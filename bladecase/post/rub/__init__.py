@@ -1,0 +1,6 @@
+"""The rub study's report and figures.
+
+- :mod:`~bladecase.post.rub.report` — the rub response in words;
+- :mod:`~bladecase.post.rub.plot` — the interaction diagram;
+- :mod:`~bladecase.post.rub.wear_plot` — the worn coating unrolled over the angle, per revolution.
+"""

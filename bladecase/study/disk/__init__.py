@@ -1,0 +1,13 @@
+"""A bladed-disk study: ``[geometry] kind = "sector"``, ``[cyclic]`` or a deck's cyclic symmetry, and
+``[mistuning]``.
+
+Import from the modules (``from bladecase.study.disk.cyclic import compute_linear``): the schema reads
+the key modules, so this package's ``__init__`` imports nothing.
+
+- :mod:`~bladecase.study.disk.cyclic` — modes per nodal diameter, ``cyclic.csv``, ``safe.png``, the whole disk's
+  wave as a VTK series, Campbell per nodal diameter;
+- :mod:`~bladecase.study.disk.cyclic_keys` — the ``[cyclic]`` section;
+- :mod:`~bladecase.study.disk.mistuning` — the reduced mistuning model from the study's own sector, samples through
+  the executor, ``mistuning.csv``, ``mistuning.png``, Whitehead's bound;
+- :mod:`~bladecase.study.disk.mistuning_keys` — the ``[mistuning]`` section.
+"""
