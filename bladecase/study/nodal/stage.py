@@ -204,7 +204,7 @@ def nodal_stage(study, model, contact, families, reduced, *, factor=None, folder
     _log_casing(nodal)
     top = _face_top_energy(families)
     cap = {"energy_max": top} if top is not None else {"freq_ratio": 1.0 / study["search"]["periods"][0]}
-    from .validity import blade_span
+    from ..validity import blade_span
 
     limit = study["search"]["amplitude_limit"] * blade_span(model)  # the small-displacement limit: nothing beyond
 
