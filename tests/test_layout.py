@@ -105,3 +105,19 @@ def test_imports_flow_downstream():
                    if (m == pkg or m.startswith(pkg + ".")) and any(t == b or t.startswith(b + ".") for b in bad))
     # the one exception: Branch.plot(), a convenience that draws with bladecase.post.plots when it is called
     assert wrong == [("bladecase.nsm.branches", "bladecase.post.plots")]
+
+
+def test_relative_imports_name_modules_that_exist():
+    """Every ``from .x import …`` inside the package names a module or package of the package (an import inside a
+    function is only run when that function is: a module moved without it would fail only there)."""
+    mods = _modules()
+    wrong = []
+    for name, path in mods.items():
+        package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and node.level and node.module:
+                base = package.split(".")[: len(package.split(".")) - node.level + 1]
+                target = ".".join(base + [node.module])
+                if target not in mods:
+                    wrong.append((name, node.lineno, target))
+    assert wrong == []
