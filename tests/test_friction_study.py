@@ -207,3 +207,28 @@ def test_a_coating_on_a_line_of_nodes_is_refused_before_any_factorisation():
     with pytest.raises(StudyError, match=r"\[casing\] abradable: the coating's pressure needs each contact node's "
                                          r"area: give a contact face"):
         rub_stage(study, blade, build_contact(study, blade), executor=SerialExecutor())
+
+
+def test_a_speed_whose_worn_casing_flutters_is_reported_and_the_others_go_on(blade, monkeypatch, tmp_path):
+    """The coupled wear run refused at one speed (friction-induced flutter once the coating is worn) is that speed's
+    result, named with its reason, not the end of the sweep."""
+    from bladecase.study.executor import SerialExecutor
+    from bladecase.study.rub import stage
+    from bladecase.study.stages import build_contact
+
+    real = stage.wear_rub
+
+    def flutters(system, coating, speed, *args, **kwargs):
+        if abs(speed * 60 / (2 * np.pi) - 1650) < 1e-6:
+            raise ValueError("a contact phase with friction (nodes [4] closed, mu = 0.15) is unstable: it grows at "
+                             "531 1/s (friction-induced flutter)")
+        return real(system, coating, speed, *args, **kwargs)
+
+    monkeypatch.setattr(stage, "wear_rub", flutters)
+    study = loads(_wear_study(rub=RUB.replace("speeds = [1650]", "speeds = [1640, 1650]"), friction="{mu = 0.15}"),
+                  source="<wear>")
+    s = stage.rub_stage(study, blade, build_contact(study, blade), executor=SerialExecutor(), folder=tmp_path,
+                        figures=False)
+    assert [r["speed"] for r in s["rows"]] == [1640.0]
+    assert (tmp_path / "wear.csv").exists() and "1650" not in (tmp_path / "wear.csv").read_text().split("\n", 1)[1]
+    assert s["failed_speeds"][0]["speed"] == 1650.0 and "friction-induced flutter" in s["failed_speeds"][0]["reason"]

@@ -159,13 +159,16 @@ def _rub_point(speed: float, *, model, contact: Contact, interior: np.ndarray, s
         flight = friction_flight(reduced.system, fr, damping, Rub(lobes, amplitude, speed, angles))
         response = rub_response(reduced.system, speed, lobes, amplitude, angles, damping, revolutions, window,
                                 areas=reduced.areas, max_revolutions=max_revolutions, friction=fr, flight=flight)
-    except ValueError as exc:  # the simulation refused this speed (e.g. a grazing switch): the others go on
+        worn = None if coating is None else wear_rub(reduced.system, coating, speed, lobes, amplitude, angles,
+                                                     damping, revolutions, areas=reduced.areas, friction=fr,
+                                                     flight=flight)
+    except ValueError as exc:  # the simulation refused this speed (a grazing switch, friction-induced flutter on the
+        # worn casing, …): it is that speed's result, the others go on
         out = {"error": str(exc), "nodes": list(reduced.system.nodes)}
     else:
         out = response.as_dict()
-        if coating is not None:
-            out["wear"] = wear_figures(wear_rub(reduced.system, coating, speed, lobes, amplitude, angles, damping,
-                                                revolutions, areas=reduced.areas, friction=fr, flight=flight))
+        if worn is not None:
+            out["wear"] = wear_figures(worn)
         out["load"] = reduced.contact_load(response.force_at_peak)
         out["peak_pressure"] = np.nan_to_num(contact_pressure(response.peak_force, reduced.areas)).tolist()
     out["open_hz"] = (reduced.system.modes[0][:6] / (2 * np.pi)).tolist()
