@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import log
-from ..fe import save_mesh, stiffness_factor
+from ..fe import stiffness_factor
 from ..io import write_json, write_text
 from ..post.comparison.compare import ModelResult, fe_reference
 from ..post.disk.cyclic_report import cyclic_report, cyclic_verdict
@@ -31,7 +31,7 @@ from ..post.verdict import verdict
 from ..progress import progress_counter
 from .comparison.stage import FE_MODES, compare_models, summary_section
 from .disk.cyclic import compute_linear
-from .documents import contact_summary, families_document, family_summary, model_summary, reduced_summary
+from .documents import contact_summary, families_document, family_summary, model_summary, reduced_summary, write_mesh
 from .executor import Executor, make_executor
 from .forcing.stage import forced_response, forced_scene
 from .publish import RUN_RESULTS, check_inputs, output_folder, publish, release, staged_names, staging_dir
@@ -192,10 +192,7 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
     files: dict[str, object] = {}
     with stage("mesh"):
         mesh = build_mesh(study)
-        save_mesh(mesh, staging / "mesh.vtu")
-        files["mesh"] = "mesh.vtu"
-        log.info("mesh: %d nodes, %d %s cells (%s)", len(mesh.points), len(mesh.cells[mesh.body_type]),
-                 mesh.body_type, "gmsh" if study.parametric else mesh.source)
+        write_mesh(mesh, staging, files, "gmsh" if study.parametric else mesh.source)
     with stage("assemble"):
         model = build_model(study, mesh)
         factor = stiffness_factor(model)

@@ -27,13 +27,13 @@ from pathlib import Path
 import numpy as np
 
 from ... import log
-from ...fe import fe_sector, save_mesh, sector_mesh
+from ...fe import fe_sector, sector_mesh
 from ...fe.centrifugal import to_rad_s
 from ...fe.cyclic import cyclic_spectrum, engine_order_diameter, nodal_diameters, rotation_matrix, sector_angles
 from ...fe.mesh_checks import LENGTH_UNITS
 from ...fe.rotation import RotationAxis
 from ...io import save_figure, write_text
-from ..documents import model_summary
+from ..documents import model_summary, write_mesh
 from ..executor import Executor
 from ..rotation.modes_run import compute_modes
 from ..schema import Study, StudyError
@@ -285,11 +285,8 @@ def compute_cyclic(study: Study, staging: Path, stage, progress: bool, executor:
             mesh = _file_mesh(study)
         setup = _setup(study, mesh, deck, geometry)
         study, mesh = _clamp_images(study, mesh, setup)
-        save_mesh(mesh, staging / "mesh.vtu")
-        files["mesh"] = "mesh.vtu"
-        log.info("sector mesh: %d nodes, %d %s cells (%s); a disk of %d sectors", len(mesh.points),
-                 len(mesh.cells[mesh.body_type]), mesh.body_type, "gmsh" if study.parametric else mesh.source,
-                 setup["sectors"])
+        write_mesh(mesh, staging, files, "gmsh" if study.parametric else mesh.source, "sector mesh",
+                   f"; a disk of {setup['sectors']} sectors")
     with stage("assemble"):
         model = build_model(study, mesh)
         sector = fe_sector(model, setup["sectors"], setup["axis"], left=setup["left"], right=setup["right"],

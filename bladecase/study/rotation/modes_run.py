@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 
 from ... import log
-from ...fe import natural_frequencies, save_mesh, stiffness_factor
-from ..documents import model_summary
+from ...fe import natural_frequencies, stiffness_factor
+from ..documents import model_summary, write_mesh
 from ..executor import Executor
 from ..schema import Study
 from ..stages import build_mesh, build_model, check_plausibility
@@ -47,10 +47,7 @@ def compute_modes(study: Study, staging: Path, stage, progress: bool, executor: 
     files: dict[str, object] = {}
     with stage("mesh"):
         mesh = build_mesh(study)
-        save_mesh(mesh, staging / "mesh.vtu")
-        files["mesh"] = "mesh.vtu"
-        log.info("mesh: %d nodes, %d %s cells (%s)", len(mesh.points), len(mesh.cells[mesh.body_type]),
-                 mesh.body_type, "gmsh" if study.parametric else mesh.source)
+        write_mesh(mesh, staging, files, "gmsh" if study.parametric else mesh.source)
     with stage("assemble"):
         rest = build_model(study, mesh)
         model, _, factor, rotation = operating_point(study, rest, None, stiffness_factor(rest))
