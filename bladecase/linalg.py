@@ -63,6 +63,7 @@ from .linalg_backends import (  # noqa: F401  (INDEFINITE_PIVOT_THRESHOLD: a pub
     superlu_factor,
 )
 from .linalg_block import BLOCK_SIZE, block_lanczos
+from .threads import blas_threads
 
 __all__ = [
     "BACKEND_ENV", "BLOCK_MIN_DOFS", "DENSE_LIMIT", "EIGEN_METHODS", "Factor", "SPDFactor", "available_backends",
@@ -383,7 +384,15 @@ def _eigen_method(method: str, factor: Factor, n: int) -> str:
 
 def _sparse_modes(K, M, count: int, factor: Factor, method: str,
                   space: list | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Shift-invert eigenpairs about 0 with ``factor``: block Lanczos (falls back to ARPACK) or ARPACK."""
+    """Shift-invert eigenpairs about 0 with ``factor``: block Lanczos (falls back to ARPACK) or ARPACK, on one
+    BLAS thread when the machine is busy (:func:`bladecase.threads.blas_threads`)."""
+    with blas_threads("eigen"):
+        return _shift_invert_modes(K, M, count, factor, method, space)
+
+
+def _shift_invert_modes(K, M, count: int, factor: Factor, method: str,
+                        space: list | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_sparse_modes` on the threads it was given."""
     if _eigen_method(method, factor, K.shape[0]) == "block" and count + 2 <= K.shape[0]:
         block = min(_BLOCK_SOLVES.get(factor.backend, BLOCK_SIZE), K.shape[0] - count)
         found = block_lanczos(K, M, factor.solve, count, block=block, space=space)
