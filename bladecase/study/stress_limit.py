@@ -1,0 +1,143 @@
+"""Where the model stops being the blade: the elastic limit of the nonsmooth modes' arcs (``[material]
+yield_strength``).
+
+The FE model is linear elastic. An orbit whose stress somewhere in the blade exceeds the material's yield strength is
+beyond the model: the blade would yield, and the figures of that orbit describe no real blade. With ``[material]
+yield_strength`` given (Pa), a study cuts every admissible arc where an orbit's **peak von Mises stress** — the
+largest over the sampled instants of the period (:data:`~bladecase.study.render.ENGINEERING_SAMPLES` per period and
+:data:`~bladecase.study.render.PHASE_SAMPLES` per contact phase, as the tip amplitude is sampled) and over every node
+of the mesh (the nodal stress, :func:`bladecase.fe.stress.nodal_stress`: each element's stress at its nodes averaged
+over the elements that share it) — exceeds it, as :mod:`~bladecase.study.validity` cuts at the amplitude limit; the
+report and ``summary.json`` say where each arc was cut and why (the stress, where in the blade and when).
+
+The stress is linear in the displacement, and the displacement of a reduced model's orbit is a combination of a few
+vectors: ``u(t) = V x(t)`` (+ ``closed_shape · λ(t)`` for the massless contact model). The nodal stress of each
+vector is computed once per model (:func:`bladecase.fe.stress.stress_modes`, one pass over the cells); an orbit's
+stress at its sampled instants is then ``σ(t) = Σ_j c_j(t) σ_j`` (one product), its von Mises equivalent and its peak.
+A model with many vectors (the ``full`` method) expands each orbit's sampled displacements instead.
+
+>>> from bladecase.study.schema import loads
+>>> from bladecase.study.stages import build_contact, build_mesh, build_model, build_reduced
+>>> s = loads('study = {name = "s"}\\ngeometry = {kind = "plate", span = 0.1, chord = 0.02, size = 0.01}\\n'
+...           'fem = {order = 1, thickness = 0.002}\\ncontact = {clearance = 1e-4, model = "massless", '
+...           'casing_stiffness = 1e6, face = "tip", normal = [1.0, 0.0]}\\n'
+...           'reduction = {method = "massless", size = 4}\\nsearch = {ipp = [1]}\\n')
+>>> model = build_model(s, build_mesh(s))
+>>> reduced = build_reduced(s, model, build_contact(s, model))
+>>> stress = orbit_stress(reduced)      # its basis's vectors and the closed phase's shape, 6 components at each node
+>>> stress.modes.shape == (reduced.n + 1, len(stress.points), 6)
+True
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from .. import log
+from ..fe.stress import fe_node_points, stress_modes, von_mises_voigt
+from ..reduction import MasslessReducedModel, ReducedModel
+
+__all__ = ["MAX_MODES", "OrbitStress", "orbit_stress", "orbit_times", "stress_cuts"]
+
+#: Above this many vectors a model's orbits are expanded instant by instant (their stress computed per orbit).
+MAX_MODES = 256
+#: Values of the stress ``(instants × nodes × 6)`` held at once when an orbit's peak is taken.
+BATCH_VALUES = 4_000_000
+
+
+def orbit_times(orbit) -> np.ndarray:
+    """The instants at which an orbit's stress (and tip amplitude, :func:`~bladecase.study.render.orbit_engineering`)
+    is sampled: :data:`~bladecase.study.render.ENGINEERING_SAMPLES` over the period and
+    :data:`~bladecase.study.render.PHASE_SAMPLES` in each contact phase."""
+    from .render import ENGINEERING_SAMPLES, PHASE_SAMPLES
+
+    T = float(orbit.T)
+    intervals = [tuple(map(float, c)) for c in getattr(orbit, "contact_intervals", [])]
+    return np.unique(np.mod(np.concatenate([np.linspace(0.0, T, ENGINEERING_SAMPLES, endpoint=False)]
+                                           + [np.linspace(a, b, PHASE_SAMPLES) for a, b in intervals]), T))
+
+
+@dataclasses.dataclass
+class OrbitStress:
+    """The nodal stress of a reduced model's orbits (the module). ``modes`` ``(k, N, 6)``: the stress of each vector
+    of the expansion (``None``: expanded per orbit); ``points`` ``(N, 3)``: where the ``N`` nodes are (m)."""
+
+    reduced: ReducedModel
+    modes: np.ndarray | None
+    points: np.ndarray
+
+    def coefficients(self, x: np.ndarray) -> np.ndarray:
+        """The weights ``(k, instants)`` of :attr:`modes` for reduced states ``x`` ``(n, instants)``."""
+        if type(self.reduced).free_dofs is MasslessReducedModel.free_dofs:
+            return np.vstack([x, np.atleast_2d(self.reduced.multiplier(x))])
+        return x
+
+    def field(self, x: np.ndarray) -> np.ndarray:
+        """The stress ``(instants, N, 6)`` of reduced states ``x`` ``(n, instants)`` (Pa, :data:`VOIGT` order)."""
+        if self.modes is None:
+            return stress_modes(self.reduced.model, self.reduced.free_dofs(x)).reshape(x.shape[1], -1, 6)
+        return np.einsum("kt,kns->tns", self.coefficients(x), self.modes)
+
+    def peak(self, orbit) -> dict:
+        """The orbit's peak von Mises stress over its sampled instants and every node: ``von_mises_pa``, where
+        (``at_mm``, the node's position) and when (``t_over_T``)."""
+        times = orbit_times(orbit)
+        x, _ = orbit.state(times)
+        n = self.points.shape[0]
+        step = max(1, BATCH_VALUES // (6 * n))
+        best, where = -1.0, (0, 0)
+        for a in range(0, times.size, step):
+            vm = von_mises_voigt(self.field(x[:, a:a + step]))  # (instants, nodes)
+            i, j = np.unravel_index(int(np.argmax(vm)), vm.shape)
+            if vm[i, j] > best:
+                best, where = float(vm[i, j]), (a + i, j)
+        return {"von_mises_pa": best, "at_mm": [float(c) for c in np.round(self.points[where[1]] * 1e3, 4)],
+                "t_over_T": float(times[where[0]] / orbit.T)}
+
+    def __call__(self, orbit) -> float:
+        """The orbit's peak von Mises stress (Pa)."""
+        return self.peak(orbit)["von_mises_pa"]
+
+
+def orbit_stress(reduced: ReducedModel) -> OrbitStress:
+    """The stress of ``reduced``'s orbits: the nodal stress of each vector of its expansion computed once (its basis,
+    and the massless model's closed-phase shape), or, for a model of more than :data:`MAX_MODES` vectors or another
+    expansion, per orbit."""
+    model = reduced.model
+    points = fe_node_points(model)
+    kind = type(reduced).free_dofs
+    if reduced.n + 1 > MAX_MODES or kind not in (ReducedModel.free_dofs, MasslessReducedModel.free_dofs):
+        return OrbitStress(reduced, None, points)
+    V = reduced.basis.toarray() if hasattr(reduced.basis, "toarray") else np.asarray(reduced.basis)
+    if kind is MasslessReducedModel.free_dofs:
+        V = np.column_stack([V, reduced.closed_shape])
+    return OrbitStress(reduced, stress_modes(model, V), points)
+
+
+def stress_cuts(searched: list, found: list, yield_strength: float) -> tuple[list, list[dict]]:
+    """Every model's families (``found[i]`` of ``searched[i]``) with their arcs cut where an orbit's peak von Mises
+    stress exceeds ``yield_strength`` (Pa), and the main model's cuts: :func:`~bladecase.study.validity.cut_arcs`'s
+    records (``von_mises_beyond``, ``von_mises_cut`` in Pa) with where and when the first orbit beyond peaks
+    (``at_mm``, ``t_over_T``), each logged."""
+    from .validity import cut_arcs
+
+    out, main = [], []
+    for n, (reduced, fams) in enumerate(zip(searched, found)):
+        stress = orbit_stress(reduced)
+        cut, cuts = cut_arcs(fams, [stress] * len(fams), yield_strength, name="von_mises")
+        out.append(cut)
+        if n == 0:
+            for c in cuts:
+                c.update(stress.peak(fams[c["family"]].orbits[c["orbit_beyond"]]))
+                c.pop("von_mises_pa", None)
+            main = cuts
+    for c in main:
+        at = (f"its last orbit within it, T = {c['T_cut']:.8g} s ({1 / c['T_cut']:.6g} Hz, "
+              f"{c['von_mises_cut'] / 1e6:.4g} MPa)" if c["T_cut"] else "none of its orbits is within it")
+        log.warning("family %d: an admissible arc is cut at the elastic limit: the peak von Mises stress is %.4g MPa "
+                    "at T = %.8g s (at %s mm, t/T = %.3f), above [material] yield_strength = %.4g MPa; %s",
+                    c["family"], c["von_mises_beyond"] / 1e6, c["T_beyond"], c["at_mm"], c["t_over_T"],
+                    yield_strength / 1e6, at)
+    return out, main
