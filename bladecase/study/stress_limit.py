@@ -78,7 +78,8 @@ class OrbitStress:
         """The stress ``(instants, N, 6)`` of reduced states ``x`` ``(n, instants)`` (Pa, :data:`VOIGT` order)."""
         if self.modes is None:
             return stress_modes(self.reduced.model, self.reduced.free_dofs(x)).reshape(x.shape[1], -1, 6)
-        return np.einsum("kt,kns->tns", self.coefficients(x), self.modes)
+        k, n, _ = self.modes.shape
+        return (self.coefficients(x).T @ self.modes.reshape(k, n * 6)).reshape(x.shape[1], n, 6)
 
     def peak(self, orbit) -> dict:
         """The orbit's peak von Mises stress over its sampled instants and every node: ``von_mises_pa``, where
