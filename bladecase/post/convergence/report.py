@@ -28,7 +28,9 @@ def _how(figure: dict) -> str:
         return ""
     if not figure.get("monotone"):
         return "not monotone"
-    return "order not established" if figure.get("order") is None else f"order {figure['order']:.2g} out of range"
+    if figure.get("regime") == "order out of range":
+        return "order out of range" if figure.get("order") is None else f"order {figure['order']:.2g} out of range"
+    return "changes not shrinking"
 
 
 def convergence_report(section: dict | None) -> list[str]:

@@ -25,11 +25,14 @@ procedure of Celik et al. 2008, J. Fluids Eng. 130, 078001, and ASME V&V 20):
   :data:`ORDER_RANGE`: the Richardson extrapolation ``f₀`` and the error of the study's own mesh
   ``1.25 |f(h_study) − f₀|`` (:data:`SAFETY`, Roache's factor when three meshes establish the order), relative to
   ``f₀``;
-* **order not established** — oscillatory convergence (the changes alternate in sign: "not monotone") or an
-  order outside :data:`ORDER_RANGE` (the meshes are not in the asymptotic range): no extrapolation, and the error
-  ``3 Δ`` (:data:`SAFETY_UNESTABLISHED`, Roache's factor when the order cannot be established), with ``Δ`` the
-  range of the figure over all the meshes (the largest difference between two of them: the data range of Eça and
-  Hoekstra's procedure), relative to the finest mesh's value.
+* **order not established** — oscillatory convergence (the changes alternate in sign: "not monotone"), changes
+  that do not shrink under refinement (no positive order), or an order outside :data:`ORDER_RANGE` (the meshes are
+  not in the asymptotic range): no extrapolation, and the error ``3 Δ`` (:data:`SAFETY_UNESTABLISHED`, Roache's
+  factor when the order cannot be established), with ``Δ`` the range of the figure over all the meshes (the largest
+  difference between two of them: the data range of Eça and Hoekstra's procedure), relative to the finest mesh's
+  value.
+
+Nothing here is fitted to a particular study: the two factors and the order range are the published rule's.
 
 An estimate above :data:`FLAG` (2 %) is flagged in the report and the verdict.
 
@@ -97,10 +100,12 @@ def richardson(h: Sequence[float], values: Sequence[float | None], study_h: floa
     """Observed order, Richardson extrapolation and the error estimate of one figure over meshes of sizes ``h``
     (any order; the three finest are used), for the mesh of size ``study_h`` (default the coarsest: the study's).
 
-    Returns ``{"order", "extrapolated", "error", "monotone", "safety", "flag"}``: ``error`` the grid convergence
-    index of the module, relative to the extrapolated value (or to the finest value when there is none); ``safety``
-    its factor, 1.25 (order established) or 3 (not); ``None`` everywhere when fewer than three meshes have the
-    figure.
+    Returns ``{"order", "extrapolated", "error", "monotone", "regime", "safety", "flag"}``: ``error`` the grid
+    convergence index of the module, relative to the extrapolated value (or to the finest value when there is none);
+    ``safety`` its factor, 1.25 (order established) or 3 (not); ``regime`` why: ``"asymptotic"`` (an order in
+    :data:`ORDER_RANGE`), ``"oscillating"`` (not monotone), ``"not shrinking"`` (monotone, but the last change is
+    not smaller than any positive order allows), ``"order out of range"``; ``None`` everywhere when fewer than three
+    meshes have the figure.
 
     >>> r = richardson([0.5, 1.0, 0.7], [4.0 + 2 * 0.5**2, 6.0, 4.0 + 2 * 0.7**2], study_h=1.0)  # f = 4 + 2h²
     >>> round(r["order"], 9), round(r["extrapolated"], 9), round(r["error"], 9), r["flag"]
@@ -111,7 +116,8 @@ def richardson(h: Sequence[float], values: Sequence[float | None], study_h: floa
     """
     pairs = sorted(((float(a), float(v)) for a, v in zip(h, values) if v is not None and math.isfinite(v)),
                    reverse=True)
-    out = {"order": None, "extrapolated": None, "error": None, "monotone": None, "safety": None, "flag": None}
+    out = {"order": None, "extrapolated": None, "error": None, "monotone": None, "regime": None, "safety": None,
+           "flag": None}
     if len(pairs) < 3:
         return out
     hs, fs = zip(*pairs)
@@ -125,11 +131,14 @@ def richardson(h: Sequence[float], values: Sequence[float | None], study_h: floa
         f0 = fs[-1] - (fs[-2] - fs[-1]) * h3 ** p / (h2 ** p - h3 ** p)
         scale = abs(f0) or abs(fs[-1]) or 1.0
         error = SAFETY * abs(at - f0) / scale
-        out.update(order=p, extrapolated=f0, error=error, monotone=True, safety=SAFETY)
+        out.update(order=p, extrapolated=f0, error=error, monotone=True, regime="asymptotic", safety=SAFETY)
     else:  # the order is not established: Roache's factor 3 on the data range
         spread = max(fs) - min(fs)
         scale = abs(fs[-1]) or 1.0
-        out.update(order=p, error=SAFETY_UNESTABLISHED * spread / scale, monotone=monotone,
+        h1, h2, h3 = hs[-3:]
+        shrinking = monotone and d21 / d32 > math.log(h1 / h2) / math.log(h2 / h3)  # the ratio as the order → 0
+        regime = "oscillating" if not monotone else "order out of range" if shrinking else "not shrinking"
+        out.update(order=p, error=SAFETY_UNESTABLISHED * spread / scale, monotone=monotone, regime=regime,
                    safety=SAFETY_UNESTABLISHED)
     out["flag"] = out["error"] > FLAG
     return out
@@ -141,16 +150,16 @@ def estimate_words(figure: dict) -> str:
 
     >>> estimate_words(richardson([1.0, 0.7, 0.5], [10.0, 10.4, 10.1]))
     'not monotone: 3 × the range over the meshes'
+    >>> estimate_words(richardson([1.0, 0.7, 0.5], [10.0, 10.1, 10.5]))   # the second change is the larger
+    'the changes do not shrink with the mesh: 3 × the range over the meshes'
     >>> estimate_words(richardson([1.0, 0.7, 0.5], [1.0, 1.5, 1.6]))   # order 4.4: established
     ''
     """
     if figure.get("safety") != SAFETY_UNESTABLISHED:
         return ""
-    if not figure.get("monotone"):
-        return "not monotone: 3 × the range over the meshes"
-    order = figure.get("order")
-    why = "no observed order" if order is None else f"observed order {order:.2g} outside {ORDER_RANGE[0]:g}–" \
-        f"{ORDER_RANGE[1]:g}"
+    why = {"oscillating": "not monotone", "not shrinking": "the changes do not shrink with the mesh"}.get(
+        figure.get("regime"), f"observed order {figure.get('order') or 0:.2g} outside {ORDER_RANGE[0]:g}–"
+        f"{ORDER_RANGE[1]:g}")
     return f"{why}: 3 × the range over the meshes"
 
 
