@@ -128,3 +128,33 @@ def test_a_low_yield_cuts_the_arc_and_says_so(cut):
 def test_a_yield_strength_in_mpa_is_refused(value, words):
     with pytest.raises(StudyError, match=words):
         _study(value)
+
+
+def test_the_every_node_family_is_cut_at_the_yield(tmp_path):
+    """``points = "nodes"``: the family (its peak von Mises 55.7 → 70.6 MPa over its first six orbits) stops at its
+    last orbit below 70 MPa; the first dropped is beyond it, by the orbit expanded to the mesh (the nodes' forces'
+    shapes included) at its peak instant; the report says where and why."""
+    from bladecase.nsm.massless.nodal_modes import nodal_family
+    from bladecase.post.nodal.report import nodal_report
+    from bladecase.reduction.nodes import nodal_model
+    from bladecase.study.nodal.stage import nodal_stage
+    from bladecase.study.stages import build_contact, build_mesh, build_model
+
+    study = loads(STRIP.replace('model = "massless"', 'model = "massless"\npoints = "nodes"').replace(
+        'material = {preset = "steel"}', f'material = {{preset = "steel", yield_strength = {YIELD!r}}}'))
+    model = build_model(study, build_mesh(study))
+    contact = build_contact(study, model)
+    section = nodal_stage(study, model, contact, [], None, folder=tmp_path, figures=False)
+    c = section["validity"]["stress_cut"]
+    k = c["index"]
+    assert section["orbits"] == k >= 2 and section["end"]["kind"] == "yield_strength"
+    assert c["von_mises_cut_pa"] <= YIELD < c["von_mises_beyond_pa"]
+    nodal = nodal_model(model, contact, 8, residual=True)
+    family = nodal_family(nodal.system, 0, through_resonances=True, freq_ratio=1 / 0.95)  # the same, uncut
+    beyond = family.orbits[k]
+    assert beyond.frequency == pytest.approx(c["frequency_beyond_hz"], rel=1e-9)
+    x, _ = beyond.state([c["t_over_T"] * beyond.T])
+    vm = von_mises(nodal_stress(model, nodal.free_dofs(x)[:, 0]))
+    assert vm.max() == pytest.approx(c["von_mises_beyond_pa"], rel=1e-10)
+    text = "\n".join(nodal_report(section))
+    assert "**The family is cut at the elastic limit**" in text and "above the yield strength 70 MPa" in text

@@ -8,10 +8,13 @@ largest over the sampled instants of the period (:data:`~bladecase.study.render.
 :data:`~bladecase.study.render.PHASE_SAMPLES` per contact phase, as the tip amplitude is sampled) and over every node
 of the mesh (the nodal stress, :func:`bladecase.fe.stress.nodal_stress`: each element's stress at its nodes averaged
 over the elements that share it) — exceeds it, as :mod:`~bladecase.study.validity` cuts at the amplitude limit; the
-report and ``summary.json`` say where each arc was cut and why (the stress, where in the blade and when).
+report and ``summary.json`` say where each arc was cut and why (the stress, where in the blade and when). The
+every-node family (``[contact] points = "nodes"``) is cut at its first orbit beyond the yield strength
+(:func:`cut_nodal_family`), as at the amplitude limit.
 
 The stress is linear in the displacement, and the displacement of a reduced model's orbit is a combination of a few
-vectors: ``u(t) = V x(t)`` (+ ``closed_shape · λ(t)`` for the massless contact model). The nodal stress of each
+vectors: ``u(t) = V x(t)`` (+ ``closed_shape · λ(t)`` for the massless contact model, + ``closed_shapes · λ(t)``
+with one force per node for the every-node model). The nodal stress of each
 vector is computed once per model (:func:`bladecase.fe.stress.stress_modes`, one pass over the cells); an orbit's
 stress at its sampled instants is then ``σ(t) = Σ_j c_j(t) σ_j`` (one product), its von Mises equivalent and its peak.
 A model with many vectors (the ``full`` method) expands each orbit's sampled displacements instead.
@@ -38,8 +41,12 @@ import numpy as np
 from .. import log
 from ..fe.stress import fe_node_points, stress_modes, von_mises_voigt
 from ..reduction import MasslessReducedModel, ReducedModel
+from ..reduction.nodes import NodalReducedModel
 
-__all__ = ["MAX_MODES", "OrbitStress", "orbit_stress", "orbit_times", "stress_cuts"]
+__all__ = ["MAX_MODES", "OrbitStress", "cut_nodal_family", "orbit_stress", "orbit_times", "stress_cuts"]
+
+#: The expansions whose vectors :func:`orbit_stress` combines: ``u = V x`` plus these shapes times these forces.
+_EXPANSIONS = (ReducedModel.free_dofs, MasslessReducedModel.free_dofs, NodalReducedModel.free_dofs)
 
 #: Above this many vectors a model's orbits are expanded instant by instant (their stress computed per orbit).
 MAX_MODES = 256
@@ -70,8 +77,11 @@ class OrbitStress:
 
     def coefficients(self, x: np.ndarray) -> np.ndarray:
         """The weights ``(k, instants)`` of :attr:`modes` for reduced states ``x`` ``(n, instants)``."""
-        if type(self.reduced).free_dofs is MasslessReducedModel.free_dofs:
+        kind = type(self.reduced).free_dofs
+        if kind is MasslessReducedModel.free_dofs:
             return np.vstack([x, np.atleast_2d(self.reduced.multiplier(x))])
+        if kind is NodalReducedModel.free_dofs:
+            return np.vstack([x, np.asarray(self.reduced.system.forces(x)).reshape(-1, x.shape[1])])
         return x
 
     def field(self, x: np.ndarray) -> np.ndarray:
@@ -109,11 +119,12 @@ def orbit_stress(reduced: ReducedModel) -> OrbitStress:
     model = reduced.model
     points = fe_node_points(model)
     kind = type(reduced).free_dofs
-    if reduced.n + 1 > MAX_MODES or kind not in (ReducedModel.free_dofs, MasslessReducedModel.free_dofs):
+    shapes = {MasslessReducedModel.free_dofs: lambda: reduced.closed_shape[:, None],
+              NodalReducedModel.free_dofs: lambda: reduced.closed_shapes}.get(kind, lambda: np.zeros((model.n_dofs, 0)))
+    if kind not in _EXPANSIONS or reduced.n + shapes().shape[1] > MAX_MODES:
         return OrbitStress(reduced, None, points)
     V = reduced.basis.toarray() if hasattr(reduced.basis, "toarray") else np.asarray(reduced.basis)
-    if kind is MasslessReducedModel.free_dofs:
-        V = np.column_stack([V, reduced.closed_shape])
+    V = np.column_stack([V, shapes()])
     return OrbitStress(reduced, stress_modes(model, V), points)
 
 
@@ -142,3 +153,30 @@ def stress_cuts(searched: list, found: list, yield_strength: float) -> tuple[lis
                     c["family"], c["von_mises_beyond"] / 1e6, c["T_beyond"], c["at_mm"], c["t_over_T"],
                     yield_strength / 1e6, at)
     return out, main
+
+
+def cut_nodal_family(family, nodal: NodalReducedModel, yield_strength: float) -> tuple[object, dict | None]:
+    """The every-node ``family`` (:class:`~bladecase.nsm.massless.NodalFamily` of ``nodal``) cut at its first orbit
+    whose peak von Mises stress exceeds ``yield_strength`` (Pa; :func:`~bladecase.study.validity.first_beyond`,
+    :func:`~bladecase.study.validity.cut_family`: its ``end`` of kind ``"yield_strength"``), and the record of the
+    cut (``None``: none). Logged."""
+    from .validity import cut_family, first_beyond
+
+    stress = orbit_stress(nodal)
+    k, values = first_beyond(family.orbits, stress, yield_strength)
+    if k is None:
+        return family, None
+    beyond, last = family.orbits[k], (family.orbits[k - 1] if k else None)
+    peak = stress.peak(beyond)
+    cut = {"index": k, "yield_strength_pa": float(yield_strength), "frequency_beyond_hz": float(beyond.frequency),
+           "energy_beyond_j": float(beyond.energy), "von_mises_beyond_pa": values[k], "at_mm": peak["at_mm"],
+           "t_over_T": peak["t_over_T"], "frequency_cut_hz": None if last is None else float(last.frequency),
+           "energy_cut_j": None if last is None else float(last.energy),
+           "von_mises_cut_pa": None if last is None else values[k - 1], "orbits_beyond": len(family.orbits) - k}
+    stop = (f"cut at the elastic limit: at {beyond.frequency:.6g} Hz ({beyond.energy:.4g} J) the peak von Mises stress "
+            f"is {values[k] / 1e6:.4g} MPa (at {peak['at_mm']} mm), above [material] yield_strength = "
+            f"{yield_strength / 1e6:.4g} MPa")
+    end = {"kind": "yield_strength", "frequency_hz": cut["frequency_cut_hz"], "energy_j": cut["energy_cut_j"], **cut}
+    log.warning("every face node a contact: the family is %s; its figures stop at %s", stop,
+                "its first orbit" if last is None else f"{last.frequency:.6g} Hz ({last.energy:.4g} J)")
+    return cut_family(family, k, stop, end), cut
