@@ -150,7 +150,8 @@ def test_the_every_node_family_is_cut_at_the_yield(tmp_path):
     assert section["orbits"] == k >= 2 and section["end"]["kind"] == "yield_strength"
     assert c["von_mises_cut_pa"] <= YIELD < c["von_mises_beyond_pa"]
     nodal = nodal_model(model, contact, 8, residual=True)
-    family = nodal_family(nodal.system, 0, through_resonances=True, freq_ratio=1 / 0.95)  # the same, uncut
+    family = nodal_family(nodal.system, 0, through_resonances=True,  # the same, up to the first orbit beyond
+                          energy_max=c["energy_beyond_j"] * (1 + 1e-9))
     beyond = family.orbits[k]
     assert beyond.frequency == pytest.approx(c["frequency_beyond_hz"], rel=1e-9)
     x, _ = beyond.state([c["t_over_T"] * beyond.T])
@@ -158,3 +159,30 @@ def test_the_every_node_family_is_cut_at_the_yield(tmp_path):
     assert vm.max() == pytest.approx(c["von_mises_beyond_pa"], rel=1e-10)
     text = "\n".join(nodal_report(section))
     assert "**The family is cut at the elastic limit**" in text and "above the yield strength 70 MPa" in text
+
+
+def test_at_speed_the_centrifugal_prestress_is_added():
+    """At 8000 rpm about an axis 0.3 m below the root the steady centrifugal stress is added at every instant: the
+    peak equals the von Mises of (prestress + the orbit's stress expanded to the mesh) at its instant, to 1e-10."""
+    from bladecase.fe.rotation import spun_state
+
+    text = STRIP + "[rotation]\nspeed = 8000\naxis = {origin = [0, -0.3, 0], direction = [0, 0, 1]}\n"
+    from bladecase.fe import stiffness_factor
+    from bladecase.study.rotation.stage import operating_point
+    from bladecase.study.stages import build_contact, build_mesh, build_model, build_reduced, search
+
+    study = loads(text.replace("scan = 8", "scan = 4"))
+    model = build_model(study, build_mesh(study))
+    model, contact, factor, _ = operating_point(study, model, build_contact(study, model), stiffness_factor(model))
+    reduced = build_reduced(study, model, contact, factor=factor)
+    orbit = next(o for f in search(study, reduced.system, progress=False) for o in f.orbits
+                 if o is not None and o.admissible)
+    stress = orbit_stress(reduced)
+    assert stress.steady is not None
+    peak = stress.peak(orbit)
+    x, _ = orbit.state([peak["t_over_T"] * orbit.T])
+    u0 = spun_state(reduced.model)[2]
+    total = nodal_stress(reduced.model, u0) + nodal_stress(reduced.model, reduced.free_dofs(x)[:, 0])
+    assert peak["von_mises_pa"] == pytest.approx(von_mises(total).max(), rel=1e-10)
+    vibration = von_mises(nodal_stress(reduced.model, reduced.free_dofs(x)[:, 0])).max()
+    assert abs(peak["von_mises_pa"] - vibration) > 0.01 * vibration  # the prestress matters here

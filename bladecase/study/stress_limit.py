@@ -17,7 +17,13 @@ vectors: ``u(t) = V x(t)`` (+ ``closed_shape · λ(t)`` for the massless contact
 with one force per node for the every-node model). The nodal stress of each
 vector is computed once per model (:func:`bladecase.fe.stress.stress_modes`, one pass over the cells); an orbit's
 stress at its sampled instants is then ``σ(t) = Σ_j c_j(t) σ_j`` (one product), its von Mises equivalent and its peak.
-A model with many vectors (the ``full`` method) expands each orbit's sampled displacements instead.
+A model with many vectors (the ``full`` method) expands each orbit's sampled displacements instead. At speed
+(``[rotation]``: a model linearised about its centrifugal state) the steady centrifugal stress is added at every
+instant (``σ₀ + σ(t)``; its Cauchy stress when the state is geometrically nonlinear): the blade yields under both.
+
+The peak is a nodal value of the mesh: at a sharp re-entrant corner of the clamp the exact stress is singular, and
+the nodal peak there grows under refinement; a limit it crosses first at such a corner is the model's clamp, not the
+blade's — read where the cut happened (``at_mm``).
 
 >>> from bladecase.study.schema import loads
 >>> from bladecase.study.stages import build_contact, build_mesh, build_model, build_reduced
@@ -74,6 +80,7 @@ class OrbitStress:
     reduced: ReducedModel
     modes: np.ndarray | None
     points: np.ndarray
+    steady: np.ndarray | None = None  #: ``(N, 6)``: the centrifugal prestress at speed (``None``: at rest)
 
     def coefficients(self, x: np.ndarray) -> np.ndarray:
         """The weights ``(k, instants)`` of :attr:`modes` for reduced states ``x`` ``(n, instants)``."""
@@ -87,9 +94,11 @@ class OrbitStress:
     def field(self, x: np.ndarray) -> np.ndarray:
         """The stress ``(instants, N, 6)`` of reduced states ``x`` ``(n, instants)`` (Pa, :data:`VOIGT` order)."""
         if self.modes is None:
-            return stress_modes(self.reduced.model, self.reduced.free_dofs(x)).reshape(x.shape[1], -1, 6)
-        k, n, _ = self.modes.shape
-        return (self.coefficients(x).T @ self.modes.reshape(k, n * 6)).reshape(x.shape[1], n, 6)
+            out = stress_modes(self.reduced.model, self.reduced.free_dofs(x)).reshape(x.shape[1], -1, 6)
+        else:
+            k, n, _ = self.modes.shape
+            out = (self.coefficients(x).T @ self.modes.reshape(k, n * 6)).reshape(x.shape[1], n, 6)
+        return out if self.steady is None else out + self.steady
 
     def peak(self, orbit) -> dict:
         """The orbit's peak von Mises stress over its sampled instants and every node: ``von_mises_pa``, where
@@ -118,14 +127,30 @@ def orbit_stress(reduced: ReducedModel) -> OrbitStress:
     expansion, per orbit."""
     model = reduced.model
     points = fe_node_points(model)
+    steady = _prestress(model)
     kind = type(reduced).free_dofs
     shapes = {MasslessReducedModel.free_dofs: lambda: reduced.closed_shape[:, None],
               NodalReducedModel.free_dofs: lambda: reduced.closed_shapes}.get(kind, lambda: np.zeros((model.n_dofs, 0)))
     if kind not in _EXPANSIONS or reduced.n + shapes().shape[1] > MAX_MODES:
-        return OrbitStress(reduced, None, points)
+        return OrbitStress(reduced, None, points, steady)
     V = reduced.basis.toarray() if hasattr(reduced.basis, "toarray") else np.asarray(reduced.basis)
     V = np.column_stack([V, shapes()])
-    return OrbitStress(reduced, stress_modes(model, V), points)
+    return OrbitStress(reduced, stress_modes(model, V), points, steady)
+
+
+def _prestress(model) -> np.ndarray | None:
+    """The centrifugal prestress ``(N, 6)`` of a model at speed (:func:`bladecase.fe.rotation.spun_state`), ``None``
+    at rest."""
+    from ..fe.rotation import spun_state
+    from ..fe.stress import VOIGT, nodal_stress
+
+    state = spun_state(model)
+    if state is None:
+        return None
+    _, _, u0, static = state
+    sigma = nodal_stress(model, u0, "cauchy" if static == "nonlinear" else "linear")
+    rows, cols = zip(*VOIGT)
+    return sigma[:, rows, cols]
 
 
 def stress_cuts(searched: list, found: list, yield_strength: float) -> tuple[list, list[dict]]:
