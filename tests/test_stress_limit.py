@@ -27,9 +27,13 @@ from bladecase.study.stress_limit import OrbitStress, orbit_stress, orbit_times
 YIELD = 7e7  # Pa: inside the strip's backbone (55.7 → 89 MPa)
 
 
+def _with_yield(text: str, yield_strength: float):
+    return loads(text.replace('material = {preset = "steel"}',
+                              f'material = {{preset = "steel", yield_strength = {yield_strength!r}}}'))
+
+
 def _study(yield_strength: float):
-    return loads(STRIP.replace('material = {preset = "steel"}',
-                               f'material = {{preset = "steel", yield_strength = {yield_strength!r}}}'))
+    return _with_yield(STRIP, yield_strength)
 
 
 @pytest.fixture(scope="module")
@@ -186,3 +190,23 @@ def test_at_speed_the_centrifugal_prestress_is_added():
     assert peak["von_mises_pa"] == pytest.approx(von_mises(total).max(), rel=1e-10)
     vibration = von_mises(nodal_stress(reduced.model, reduced.free_dofs(x)[:, 0])).max()
     assert abs(peak["von_mises_pa"] - vibration) > 0.01 * vibration  # the prestress matters here
+
+
+def test_a_campbell_band_is_cut_at_the_yield():
+    """At 8000 rpm the centrifugal prestress alone exceeds 70 MPa: no orbit of the band is within the elastic limit,
+    the band is dropped, and the summary's entry, the log and the report say where and why."""
+    from bladecase.post.rotation.report import _cut_lines
+    from bladecase.study.executor import SerialExecutor
+    from bladecase.study.rotation.stage import campbell_stage
+    from bladecase.study.stages import build_contact, build_mesh, build_model
+
+    text = STRIP.replace("scan = 8", "scan = 4").replace("periods = [0.95, 1.0]", "periods = [0.995, 1.0]") + \
+        "[rotation]\nspeeds = [8000]\naxis = {origin = [0, -0.3, 0], direction = [0, 0, 1]}\n"
+    study = _with_yield(text, YIELD)
+    model = build_model(study, build_mesh(study))
+    _, section = campbell_stage(study, model, build_contact(study, model), SerialExecutor())
+    (cut,) = section["band_stress_cuts"]
+    assert section["bands"] == [None] and cut["high_hz"] is None and cut["f_cut_hz"] is None
+    assert cut["von_mises_beyond_pa"] > YIELD and cut["yield_strength_pa"] == YIELD
+    text = "\n".join(_cut_lines(section, study["rotation"]["speed_unit"]))
+    assert "**Bands cut at the elastic limit:** at 8000 rpm" in text and "no band is left" in text

@@ -49,7 +49,8 @@ from ..fe.stress import fe_node_points, stress_modes, von_mises_voigt
 from ..reduction import MasslessReducedModel, ReducedModel
 from ..reduction.nodes import NodalReducedModel
 
-__all__ = ["MAX_MODES", "OrbitStress", "cut_nodal_family", "orbit_stress", "orbit_times", "stress_cuts"]
+__all__ = ["MAX_MODES", "OrbitStress", "band_cut", "cut_nodal_family", "model_cuts", "orbit_stress", "orbit_times",
+           "stress_cuts"]
 
 #: The expansions whose vectors :func:`orbit_stress` combines: ``u = V x`` plus these shapes times these forces.
 _EXPANSIONS = (ReducedModel.free_dofs, MasslessReducedModel.free_dofs, NodalReducedModel.free_dofs)
@@ -153,22 +154,28 @@ def _prestress(model) -> np.ndarray | None:
     return sigma[:, rows, cols]
 
 
-def stress_cuts(searched: list, found: list, yield_strength: float) -> tuple[list, list[dict]]:
-    """Every model's families (``found[i]`` of ``searched[i]``) with their arcs cut where an orbit's peak von Mises
-    stress exceeds ``yield_strength`` (Pa), and the main model's cuts: :func:`~bladecase.study.validity.cut_arcs`'s
-    records (``von_mises_beyond``, ``von_mises_cut`` in Pa) with where and when the first orbit beyond peaks
-    (``at_mm``, ``t_over_T``), each logged."""
+def model_cuts(reduced: ReducedModel, families: list, yield_strength: float) -> tuple[list, list[dict]]:
+    """``families`` of ``reduced`` with their arcs cut where an orbit's peak von Mises stress exceeds
+    ``yield_strength`` (Pa), and one record per cut: :func:`~bladecase.study.validity.cut_arcs`'s (``von_mises_beyond``,
+    ``von_mises_cut`` in Pa) with where and when the first orbit beyond peaks (``at_mm``, ``t_over_T``)."""
     from .validity import cut_arcs
 
+    stress = orbit_stress(reduced)
+    cut, cuts = cut_arcs(families, [stress] * len(families), yield_strength, name="von_mises")
+    for c in cuts:
+        peak = stress.peak(families[c["family"]].orbits[c["orbit_beyond"]])
+        c.update(at_mm=peak["at_mm"], t_over_T=peak["t_over_T"])
+    return cut, cuts
+
+
+def stress_cuts(searched: list, found: list, yield_strength: float) -> tuple[list, list[dict]]:
+    """Every model's families (``found[i]`` of ``searched[i]``) cut at ``yield_strength`` (:func:`model_cuts`), and
+    the main model's cuts, each logged."""
     out, main = [], []
     for n, (reduced, fams) in enumerate(zip(searched, found)):
-        stress = orbit_stress(reduced)
-        cut, cuts = cut_arcs(fams, [stress] * len(fams), yield_strength, name="von_mises")
+        cut, cuts = model_cuts(reduced, fams, yield_strength)
         out.append(cut)
         if n == 0:
-            for c in cuts:
-                c.update(stress.peak(fams[c["family"]].orbits[c["orbit_beyond"]]))
-                c.pop("von_mises_pa", None)
             main = cuts
     for c in main:
         at = (f"its last orbit within it, T = {c['T_cut']:.8g} s ({1 / c['T_cut']:.6g} Hz, "
@@ -178,6 +185,19 @@ def stress_cuts(searched: list, found: list, yield_strength: float) -> tuple[lis
                     c["family"], c["von_mises_beyond"] / 1e6, c["T_beyond"], c["at_mm"], c["t_over_T"],
                     yield_strength / 1e6, at)
     return out, main
+
+
+def band_cut(reduced: ReducedModel, families: list, yield_strength: float) -> tuple[list, dict | None]:
+    """One speed of the Campbell diagram: ``families`` cut at ``yield_strength`` (:func:`model_cuts`) and the record
+    of the band's cut (``None``: not cut): the lowest frequency beyond the limit, its peak von Mises stress, where
+    and when, and the last orbit within (``f_cut_hz``, ``von_mises_cut_pa``)."""
+    cut, cuts = model_cuts(reduced, families, yield_strength)
+    if not cuts:
+        return families, None
+    c = min(cuts, key=lambda c: 1.0 / c["T_beyond"])
+    return cut, {"yield_strength_pa": float(yield_strength), "f_beyond_hz": 1.0 / c["T_beyond"],
+                 "von_mises_beyond_pa": c["von_mises_beyond"], "at_mm": c["at_mm"], "t_over_T": c["t_over_T"],
+                 "f_cut_hz": None if c["T_cut"] is None else 1.0 / c["T_cut"], "von_mises_cut_pa": c["von_mises_cut"]}
 
 
 def cut_nodal_family(family, nodal: NodalReducedModel, yield_strength: float) -> tuple[object, dict | None]:
