@@ -1,13 +1,15 @@
-"""The elastic limit: ``[material] yield_strength`` cuts the admissible arcs where an orbit's peak von Mises stress
-exceeds it, and the report, the summary and the verdict say where and why.
+"""The elastic limit: ``[material] yield_strength`` cuts the admissible arcs (the every-node family, the Campbell
+bands) where an orbit's peak von Mises stress exceeds it, and the report, the summary and the verdict say where and
+why.
 
 Checked: the stress of many displacements at once (:func:`bladecase.fe.stress.stress_modes`) is each one's
 :func:`~bladecase.fe.stress.nodal_stress`; the nodal stress of a tip-loaded cantilever against beam theory; an orbit's
 peak von Mises from the basis' stresses equals the nodal stress of the orbit expanded to the mesh at the same instant
-(and the per-orbit expansion's, and every node's: the peak evaluates only the nodes whose stress bound reaches it);
-on the massless plate strip (steel, its backbone's peak von Mises 55.7 MPa at
-grazing → 89 MPa at the arc's top), a yield strength of 70 MPa cuts the arc at the last orbit below it, the report,
-summary and verdict say so; a yield strength typed in MPa is refused with the value in Pa.
+(and the per-orbit expansion's, and every node's: the peak evaluates only the nodes whose stress bound reaches it),
+the centrifugal prestress added at speed; on the massless plate strip (steel, its backbone's peak von Mises 55.7 MPa
+at grazing → 89 MPa at the arc's top), a yield strength of 70 MPa cuts the arc at the last orbit below it, the
+every-node family at its first orbit beyond, and at 8000 rpm (the prestress alone above it) the Campbell band whole;
+the report, summary and verdict say so; a yield strength typed in MPa is refused with the value in Pa.
 """
 
 from __future__ import annotations
