@@ -13,7 +13,7 @@ import pytest
 
 from bladecase.fe import natural_frequencies
 from bladecase.study import run
-from bladecase.study.convergence.stage import FLAG, SAFETY, richardson, scaled_study
+from bladecase.study.convergence.stage import FLAG, SAFETY, SAFETY_UNESTABLISHED, richardson, scaled_study
 from bladecase.study.schema import StudyError, loads
 from bladecase.study.stages import build_mesh, build_model
 
@@ -48,7 +48,7 @@ def test_richardson_recovers_a_power_law_on_unequal_ratios(p):
 def test_an_oscillating_figure_has_no_order_and_a_conservative_error():
     r = richardson([1.0, 0.7, 0.5], [10.0, 10.4, 10.1])
     assert r["order"] is None and r["extrapolated"] is None and r["monotone"] is False
-    assert r["error"] == pytest.approx(SAFETY * 0.4 / 10.1) and r["flag"] == (r["error"] > FLAG)
+    assert r["error"] == pytest.approx(SAFETY_UNESTABLISHED * 0.4 / 10.1) and r["flag"] == (r["error"] > FLAG)
     assert richardson([1.0, 0.7], [1.0, 2.0])["error"] is None  # two meshes: no estimate
     assert richardson([1.0, 0.7, 0.5], [1.0, None, 2.0])["error"] is None
 

@@ -18,6 +18,11 @@ Two stresses:
 
 A plane model's out-of-plane stress is ``σ_zz = λ tr(ε)`` in plane strain (``ε_zz = 0``) and ``0`` in plane stress;
 :func:`von_mises` takes all six components.
+
+The small-strain stress is linear in the displacement: :func:`stress_modes` gives it for many displacements at once
+(the columns of a reduced model's basis, one pass over the cells, their gradients computed once), in Voigt order
+``xx, yy, zz, xy, yz, zx`` (:data:`VOIGT`); a combination ``Σ_j q_j σ_j`` of them is the stress of ``Σ_j q_j u_j``,
+whose von Mises equivalent :func:`von_mises_voigt` reads.
 """
 
 from __future__ import annotations
@@ -26,10 +31,16 @@ import numpy as np
 
 from .model import FEModel
 
-__all__ = ["STRESS_KINDS", "fe_node_points", "nodal_stress", "von_mises"]
+__all__ = ["STRESS_KINDS", "VOIGT", "fe_node_points", "nodal_stress", "stress_modes", "von_mises", "von_mises_voigt"]
 
 #: The stresses :func:`nodal_stress` computes.
 STRESS_KINDS = ("linear", "cauchy")
+
+#: The components of :func:`stress_modes`: Voigt order ``xx, yy, zz, xy, yz, zx`` as ``(row, column)`` pairs.
+VOIGT = ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (2, 0))
+
+#: Values held at once by :func:`stress_modes` (vectors × nodal points × 9 per batch of cells), to bound memory.
+BATCH_VALUES = 2_000_000
 
 #: Where the evaluation points of an element's nodes may sit from the nodes themselves (× the model's size).
 NODE_RTOL = 1e-8
@@ -179,4 +190,85 @@ def von_mises(sigma) -> np.ndarray:
     s = np.asarray(sigma, dtype=float)
     a, b, c = s[..., 0, 0], s[..., 1, 1], s[..., 2, 2]
     shear = s[..., 0, 1] ** 2 + s[..., 1, 2] ** 2 + s[..., 2, 0] ** 2
+    return np.sqrt(0.5 * ((a - b) ** 2 + (b - c) ** 2 + (c - a) ** 2) + 3.0 * shear)
+
+
+def stress_modes(model: FEModel, vectors) -> np.ndarray:
+    """The small-strain nodal stress (:func:`nodal_stress`, ``kind="linear"``) of each column of ``vectors``, in
+    one pass over the cells: ``(k, N, 6)`` in :data:`VOIGT` order (Pa per unit of the column).
+
+    Parameters
+    ----------
+    model : FEModel
+        The model the displacements are of.
+    vectors : (model.n_dofs, k) array_like
+        Displacements on the free dofs, one per column (e.g. a reduced model's basis; a dense array).
+
+    Returns
+    -------
+    (k, N, 6) ndarray
+        ``out[j]`` is :func:`nodal_stress` of ``vectors[:, j]`` at the model's ``N`` scalar FE nodes, its components
+        ``σ_xx, σ_yy, σ_zz, σ_xy, σ_yz, σ_zx``.
+
+    Raises
+    ------
+    ValueError
+        ``vectors`` not ``(n_dofs, k)`` or not finite.
+
+    Examples
+    --------
+    Two stretches of a steel bar along x with its sides held: their stresses, and that of their sum, are linear.
+
+    >>> from skfem import MeshTet
+    >>> from bladecase.fe import Mesh, assemble
+    >>> t = MeshTet.init_tensor(np.linspace(0, 0.1, 5), *2 * [np.linspace(0, 0.01, 2)])
+    >>> bar = assemble(Mesh(t.p.T, {"tetra": t.t.T}, dim=3, groups={"root": np.flatnonzero(t.p[0] == 0)}),
+    ...                "steel", order=1)
+    >>> u = np.where(bar.dofs.direction == 0, bar.dofs.coords[:, 0], 0.0)
+    >>> S = stress_modes(bar, np.c_[1e-3 * u, 2e-3 * u])
+    >>> lam, mu = bar.material.lame()
+    >>> S.shape, bool(np.allclose(S[1], 2 * S[0])), bool(np.allclose(S[0, :, 0], (lam + 2 * mu) * 1e-3))
+    ((2, 20, 6), True, True)
+    """
+    import scipy.sparse as sp
+
+    V = np.asarray(vectors, dtype=float)
+    if V.ndim != 2 or V.shape[0] != model.n_dofs or not np.all(np.isfinite(V)):
+        raise ValueError(f"vectors must be a finite ({model.n_dofs}, k) array (the model's free dofs, one "
+                         f"displacement a column), got shape {V.shape}")
+    from .assembly import CHUNK_CELLS, _gradients
+
+    basis, nodal = _nodal_basis(model)
+    dim, k = model.dim, V.shape[1]
+    full = np.zeros((dim * basis.N, k))
+    full[model.dofs.fe_index] = V
+    U = full.reshape(basis.N, dim, k)
+    points = basis.element_dofs.shape[0]
+    step = int(max(1, min(CHUNK_CELLS, BATCH_VALUES // max(1, 9 * k * points))))
+    rows, cols = zip(*VOIGT)
+    total = np.zeros((basis.N, k * 6))
+    for start in range(0, basis.nelems, step):
+        cells = slice(start, min(start + step, basis.nelems))
+        G = _gradients(nodal, cells)  # (cells, local dofs a, dim, points q)
+        owners = basis.element_dofs[:, cells].T  # (cells, points)
+        H = np.einsum("eaik,eajq->keqij", U[owners], G)  # ∇u of every vector at each nodal point
+        n_cells = H.shape[1]
+        sigma = _cell_stress(model, H.reshape(k * n_cells, points, dim, dim), "linear")[..., rows, cols]
+        sigma = sigma.reshape(k, n_cells * points, 6).transpose(1, 0, 2).reshape(n_cells * points, k * 6)
+        P = sp.csr_array((np.ones(owners.size), (owners.ravel(), np.arange(owners.size))),
+                         shape=(basis.N, owners.size))  # nodal point → its node
+        total += P @ sigma
+    count = np.bincount(basis.element_dofs.ravel(), minlength=basis.N)
+    return (total / np.maximum(count, 1)[:, None]).reshape(basis.N, k, 6).transpose(1, 0, 2)
+
+
+def von_mises_voigt(s) -> np.ndarray:
+    """The von Mises equivalent of stresses ``(..., 6)`` in :data:`VOIGT` order (as :func:`von_mises`).
+
+    >>> float(von_mises_voigt(np.array([100.0, 0, 0, 0, 0, 0]))), round(float(von_mises_voigt(np.eye(6)[3])), 12)
+    (100.0, 1.732050807569)
+    """
+    s = np.asarray(s, dtype=float)
+    a, b, c = s[..., 0], s[..., 1], s[..., 2]
+    shear = s[..., 3] ** 2 + s[..., 4] ** 2 + s[..., 5] ** 2
     return np.sqrt(0.5 * ((a - b) ** 2 + (b - c) ** 2 + (c - a) ** 2) + 3.0 * shear)

@@ -224,8 +224,42 @@ def _nodal_animation_words(anims: list[dict]) -> list[str]:
 
 
 def _validity_words(v: dict | None) -> list[str]:
+    """Where the admissible arcs were cut at the small-displacement limit and at the elastic limit (nothing when
+    none was)."""
+    if not v:
+        return []
+    return _amplitude_cut_words(v) + _stress_cut_words(v)
+
+
+def _stress_cut_words(v: dict) -> list[str]:
+    """Where the admissible arcs were cut at ``[material] yield_strength`` (nothing when none was).
+
+    >>> v = {"yield_strength_pa": 8.8e8, "stress_cuts": [{"family": 0, "T_cut": 1 / 212.0, "von_mises_cut": 8.5e8,
+    ...      "T_beyond": 1 / 212.5, "von_mises_beyond": 9.1e8, "at_mm": [1.0, 2.0, 0.0], "t_over_T": 0.25}]}
+    >>> print(_stress_cut_words(v)[1])  # doctest: +NORMALIZE_WHITESPACE
+    **Cut at the elastic limit:** the model is linear elastic, valid while the stress stays below the material's
+    yield strength, 880 MPa (`[material] yield_strength`): family 0's arc ends at 212 Hz (T = 0.0047169811 s, peak
+    von Mises 850 MPa); beyond it the peak von Mises stress is 910 MPa at 212.5 Hz, at (1, 2, 0) mm, t/T = 0.25.
+    The orbits beyond stay in `modes.json` but are no part of any admissible arc.
+    """
+    if not v.get("stress_cuts"):
+        return []
+    where = []
+    for c in v["stress_cuts"]:
+        at = (f"ends at {1 / c['T_cut']:.6g} Hz (T = {c['T_cut']:.8g} s, peak von Mises "
+              f"{c['von_mises_cut'] / 1e6:.4g} MPa)" if c.get("T_cut") else "is dropped whole")
+        point = ", ".join(f"{x:.4g}" for x in c["at_mm"])
+        where.append(f"family {c['family']}'s arc {at}; beyond it the peak von Mises stress is "
+                     f"{c['von_mises_beyond'] / 1e6:.4g} MPa at {1 / c['T_beyond']:.6g} Hz, at ({point}) mm, "
+                     f"t/T = {c['t_over_T']:.3g}")
+    return ["", "**Cut at the elastic limit:** the model is linear elastic, valid while the stress stays below the "
+            f"material's yield strength, {v['yield_strength_pa'] / 1e6:.4g} MPa (`[material] yield_strength`): "
+            + "; ".join(where) + ". The orbits beyond stay in `modes.json` but are no part of any admissible arc."]
+
+
+def _amplitude_cut_words(v: dict) -> list[str]:
     """Where the admissible arcs were cut at the small-displacement limit (nothing when none was)."""
-    if not v or not v.get("cuts"):
+    if not v.get("cuts"):
         return []
     where = []
     for c in v["cuts"]:

@@ -351,7 +351,9 @@ def _compute(study: Study, staging: Path, stage: _Stages, progress: bool, execut
 
 def _small_displacements(study: Study, model, searched: list, found: list) -> tuple[list, dict]:
     """Every model's families with their arcs cut at ``[search] amplitude_limit`` × the span
-    (:mod:`~bladecase.study.validity`), and the summary's ``validity`` section (the main model's cuts)."""
+    (:mod:`~bladecase.study.validity`) and, with ``[material] yield_strength``, where an orbit's peak von Mises
+    stress exceeds it (:mod:`~bladecase.study.stress_limit`), and the summary's ``validity`` section (the main
+    model's cuts)."""
     from .render import tip_amplitude
     from .validity import blade_span, cut_arcs
 
@@ -370,8 +372,15 @@ def _small_displacements(study: Study, model, searched: list, found: list) -> tu
                     "T = %.8g s, more than %.4g mm (%g %% of the %.4g mm span); %s", c["family"],
                     c["tip_amplitude_beyond"] * 1e3, c["T_beyond"], limit * 1e3,
                     100 * study["search"]["amplitude_limit"], span * 1e3, at)
-    return out, {"span_m": span, "amplitude_limit": study["search"]["amplitude_limit"], "limit_m": limit,
-                 "cuts": main_cuts}
+    validity = {"span_m": span, "amplitude_limit": study["search"]["amplitude_limit"], "limit_m": limit,
+                "cuts": main_cuts}
+    yield_strength = study["material"].get("yield_strength")
+    if yield_strength is not None:  # the elastic limit: arcs cut where an orbit's peak von Mises exceeds the yield
+        from .stress_limit import stress_cuts
+
+        out, stress = stress_cuts(searched, out, float(yield_strength))
+        validity.update(yield_strength_pa=float(yield_strength), stress_cuts=stress)
+    return out, validity
 
 
 def _convergence(study: Study, model, reduced, families, f1: float, animations: list, executor, progress: bool

@@ -83,6 +83,7 @@ from .values import (  # noqa: F401  (RANGES, LIMITS: part of the schema's docum
     _study_name,
     _vector,
     _window,
+    _yield_strength,
     show,
 )
 
@@ -128,6 +129,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "E": Key(_NUM, None, "Young's modulus (Pa).", _in_range("E")),
         "nu": Key(_NUM, None, "Poisson's ratio.", lambda v: None if -1 < v < 0.5 else "must be in (-1, 0.5)"),
         "rho": Key(_NUM, None, "Density (kg/m³).", _density),
+        "yield_strength": Key(_NUM, None, "Yield strength (Pa, SI as E): when given, admissible arcs are cut where an "
+                              "orbit's peak von Mises stress exceeds it (the linear-elastic model's limit); not set: "
+                              "no stress limit.", _yield_strength),
     },
     "fem": {
         "order": Key(_INT, 2, "Polynomial order of the elements (1 or 2).", _one_of(1, 2)),

@@ -48,10 +48,14 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1))
 
 
-def cut_arcs(families: Sequence, amplitudes: Sequence[Callable], limit: float) -> tuple[list, list[dict]]:
+def cut_arcs(families: Sequence, amplitudes: Sequence[Callable], limit: float, name: str = "tip_amplitude"
+             ) -> tuple[list, list[dict]]:
     """Every family's arcs cut where ``amplitude(orbit) > limit`` (one function per family, its model's); returns the
-    families with their cut arcs and one record per cut (family, the first orbit beyond: its period and amplitude).
-    An arc's end that is kept keeps its refined period; a new end is the last orbit within the limit (not refined)."""
+    families with their cut arcs and one record per cut (family, the first orbit beyond: its index ``orbit_beyond``
+    in the family, its period and its value ``{name}_beyond``; the last orbit within: ``T_cut``, ``{name}_cut``).
+    An arc's end that is kept keeps its refined period; a new end is the last orbit within the limit (not refined).
+    Any measure of an orbit cuts the same way (the peak von Mises stress against the yield strength:
+    :mod:`~bladecase.study.stress_limit`)."""
     out, cuts = [], []
     for i, (fam, amplitude) in enumerate(zip(families, amplitudes)):
         arcs = []
@@ -66,10 +70,10 @@ def cut_arcs(families: Sequence, amplitudes: Sequence[Callable], limit: float) -
             onset = int(np.nanargmin(np.where(within, np.nan, values)))  # the least amplitude beyond the limit
             kept = np.flatnonzero(within & np.isfinite(values))
             edge = int(kept[np.argmin(np.abs(kept - onset))]) if kept.size else None
-            cuts.append({"family": i, "ipp": int(fam.k), "T_beyond": float(orbits[onset].T),
-                         "tip_amplitude_beyond": float(values[onset]),
+            cuts.append({"family": i, "ipp": int(fam.k), "orbit_beyond": int(index[onset]),
+                         "T_beyond": float(orbits[onset].T), f"{name}_beyond": float(values[onset]),
                          "T_cut": None if edge is None else float(orbits[edge].T),
-                         "tip_amplitude_cut": None if edge is None else float(values[edge])})
+                         f"{name}_cut": None if edge is None else float(values[edge])})
             for a, b in _runs(within):
                 arcs.append(_sub_arc(fam, arc, int(index[a]), int(index[b])))
         out.append(dataclasses.replace(fam, arcs=arcs) if arcs != fam.arcs else fam)

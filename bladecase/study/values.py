@@ -106,6 +106,7 @@ def _int_at_least(n):
 #: precision no longer delivers the stated tolerances (energies ``~ K d²`` overflow, eigen-solutions and
 #: impact times lose their digits): ``[contact] clearance``, ``[material] E`` and ``rho``.
 RANGES = {"clearance": (1e-9, 10.0, "m"), "E": (1e3, 1e13, "Pa"), "rho": (1e-2, 1e5, "kg/m³"),
+          "yield_strength": (1e4, 1e11, "Pa"),
           "casing_stiffness": (1e-3, 1e15, "N/m"), "thickness": (1e-9, 100.0, "m"),
           "amplitude": (1e-9, 1e9, "N or Pa"), "alpha": (0.0, 1.0, "s"), "beta": (0.0, 1e6, "1/s"),
           "scale": (1e-12, 1e15, ""), "coordinate": (0.0, 1e6, "m"), "tol": (0.0, 1e6, "m")}
@@ -388,6 +389,21 @@ def _density(v) -> str | None:
                 f"{v * 1e12:.6g} (kg/m³) and E in Pa (MPa × 1e6, e.g. 113800 MPa is E = 1.138e11), and read the mesh "
                 'in millimetres with [mesh] unit = "mm"')
     return f"must be in [{lo:g}, {hi:g}] (kg/m³)"
+
+
+def _yield_strength(v) -> str | None:
+    """``[material] yield_strength`` in Pa, with what to do when it looks like MPa (a metal's 200 to 2000).
+
+    >>> _yield_strength(8.8e8) is None, _yield_strength(880.0)[:52]
+    (True, 'must be a stress in Pa in [10000, 1e+11]; 880 looks ')
+    """
+    lo, hi, _ = RANGES["yield_strength"]
+    if math.isfinite(v) and lo <= v <= hi:
+        return None
+    if math.isfinite(v) and 1.0 <= v < lo:
+        return (f"must be a stress in Pa in [{lo:g}, {hi:g}]; {v:g} looks like MPa: bladecase takes SI material "
+                f"constants whatever the mesh's unit, give yield_strength = {v * 1e6:.6g} (Pa)")
+    return f"must be in [{lo:g}, {hi:g}] (Pa)"
 
 
 def _mesh_format(v) -> str | None:

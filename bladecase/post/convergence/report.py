@@ -22,6 +22,17 @@ def _value(x: float | None) -> str:
     return "—" if x is None else f"{x:.4g}"
 
 
+def _how(figure: dict) -> str:
+    """Why a figure's error is 3 × the range (its order not established), in words; ``""`` otherwise."""
+    if figure.get("error") is None or figure.get("safety", 1.25) == 1.25:
+        return ""
+    if not figure.get("monotone"):
+        return "not monotone"
+    if figure.get("regime") == "order out of range":
+        return "order out of range" if figure.get("order") is None else f"order {figure['order']:.2g} out of range"
+    return "changes not shrinking"
+
+
 def convergence_report(section: dict | None) -> list[str]:
     """Markdown lines of the ``convergence`` section of a run's summary (``None``: the mesh error is unknown)."""
     if not section:
@@ -40,15 +51,20 @@ def convergence_report(section: dict | None) -> list[str]:
                 f"{', '.join(f'×{h:g}' for h in section['requested'])})")
     lines = ["", "## Mesh convergence", "",
              f"The study run on meshes {', '.join(f'×{h:.4g}' for h in meshes)} ({made}; {dofs} "
-             f"free dofs){at}. Error: 1.25 × the distance of this study's value from the Richardson extrapolation of "
-             f"the three finest meshes, relative; above {100 * section['flag']:g} % in bold.", "",
+             f"free dofs){at}. Error (the grid convergence index): 1.25 × the distance of this study's value from the "
+             "Richardson extrapolation of the three finest meshes where they establish an observed order; where they "
+             "do not (not monotone, or an order out of range), 3 × the range of the values over the meshes; relative, "
+             f"above {100 * section['flag']:g} % in bold.", "",
              "| figure | " + " | ".join(f"×{h:.4g}" + (" (this study)" if h == 1 else "") for h in meshes)
              + " | observed order | converged (Richardson) | error of this study's mesh |",
              "|---|" + "---:|" * (len(meshes) + 3)]
     for f in section["figures"].values():
         error = "—" if f["error"] is None else f"{100 * f['error']:.2g} %"
         if f["flag"]:
-            error = f"**{error}**" + ("" if f["monotone"] else " (not monotone)")
+            error = f"**{error}**"
+        how = _how(f)
+        if how:
+            error += f" ({how})"
         unit = f" ({f['unit']})" if f["unit"] else ""
         order = "—" if f["order"] is None else f"{f['order']:.2g}"
         lines.append(f"| {f['words']}{unit} | " + " | ".join(_value(v) for v in f["values"])

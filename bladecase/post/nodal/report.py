@@ -85,6 +85,8 @@ ln(E / 0.00925 J), from 211.3 Hz): extrapolate along it to read the backbone bey
     end = section.get("end")
     if end and end.get("kind") == "amplitude_limit":
         return limit_words(end)
+    if end and end.get("kind") == "yield_strength":
+        return yield_words(end)
     if not end or end.get("kind") != "internal_resonance":
         return f"- The family ends: {section.get('stop', 'where the continuation stopped')}."
     return (f"- The family ends in an internal resonance at {end['frequency_hz']:.5g} Hz: its motion turns into the "
@@ -149,6 +151,27 @@ in `nodal_modes.csv`). Where a tongue sits depends on the mesh; the backbone on 
             "either side does not.")
 
 
+def yield_words(end: dict) -> str:
+    """The report's line on a family cut at the elastic limit (``end["kind"] == "yield_strength"``,
+    :func:`bladecase.study.stress_limit.cut_nodal_family`).
+
+    >>> print(yield_words({"frequency_beyond_hz": 231.2, "energy_beyond_j": 4.1, "von_mises_beyond_pa": 9.1e8,
+    ...     "at_mm": [1.0, 2.0, 0.0], "yield_strength_pa": 8.8e8, "frequency_cut_hz": 230.8, "energy_cut_j": 3.2,
+    ...     "von_mises_cut_pa": 8.6e8}))
+    - **The family is cut at the elastic limit**: at 231.2 Hz (4.1 J) the peak von Mises stress is 910 MPa (at \
+(1, 2, 0) mm), above the yield strength 880 MPa (`[material] yield_strength`), where a linear-elastic model of the \
+blade no longer holds; every figure above stops at the last orbit within it, 230.8 Hz (3.2 J, 860 MPa).
+    """
+    last = ("the grazing orbit is already beyond it" if end.get("frequency_cut_hz") is None else
+            f"every figure above stops at the last orbit within it, {end['frequency_cut_hz']:.5g} Hz "
+            f"({end['energy_cut_j']:.3g} J, {end['von_mises_cut_pa'] / 1e6:.4g} MPa)")
+    point = ", ".join(f"{x:.4g}" for x in end["at_mm"])
+    return (f"- **The family is cut at the elastic limit**: at {end['frequency_beyond_hz']:.5g} Hz "
+            f"({end['energy_beyond_j']:.3g} J) the peak von Mises stress is {end['von_mises_beyond_pa'] / 1e6:.4g} MPa "
+            f"(at ({point}) mm), above the yield strength {end['yield_strength_pa'] / 1e6:.4g} MPa "
+            f"(`[material] yield_strength`), where a linear-elastic model of the blade no longer holds; {last}.")
+
+
 def nodal_report(section: dict | None) -> list[str]:
     """Markdown lines for ``summary["nodal_modes"]`` (:func:`bladecase.study.nodal.stage.nodal_stage`)."""
     if not section or not section.get("rows"):
@@ -157,6 +180,7 @@ def nodal_report(section: dict | None) -> list[str]:
         end = section.get("end") or {}
         return ["", "## Every face node a contact", "",
                 limit_words(end) if end.get("kind") == "amplitude_limit" else
+                yield_words(end) if end.get("kind") == "yield_strength" else
                 f"- No orbit: {section.get('stop', 'the family could not be started')}."]
     rows = section["rows"]
     top = max(backbone_rows(section), key=lambda r: r["energy_j"])

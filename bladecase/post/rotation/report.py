@@ -122,6 +122,23 @@ def _campbell_lines(c: dict) -> list[str]:
 
 
 def _cut_lines(c: dict, unit: str) -> list[str]:
+    """Where and why the bands were cut at the small-displacement limit and at the elastic limit, speed by speed."""
+    return _amplitude_cut_lines(c, unit) + _stress_cut_lines(c, unit)
+
+
+def _stress_cut_lines(c: dict, unit: str) -> list[str]:
+    """Where and why the bands were cut at ``[material] yield_strength``, speed by speed."""
+    cuts = [(x, cut) for x, cut in zip(c["speeds_rad_s"], c.get("band_stress_cuts") or []) if cut]
+    if not cuts:
+        return []
+    words = [f"at {speed_words(x, unit)}, "
+             + (f"the band stops at {cut['high_hz']:.2f} Hz" if cut.get("high_hz") is not None else "no band is left")
+             + f": {cut['reason']}" for x, cut in cuts]
+    return ["", "**Bands cut at the elastic limit:** " + "; ".join(words) + ". Beyond, the blade yields: a "
+            "linear-elastic model no longer holds, and the band's edge there is not a figure to quote."]
+
+
+def _amplitude_cut_lines(c: dict, unit: str) -> list[str]:
     """Where and why the bands were cut at the small-displacement limit, speed by speed."""
     cuts = [(x, cut) for x, cut in zip(c["speeds_rad_s"], c.get("band_cuts") or []) if cut]
     if not cuts:

@@ -38,6 +38,12 @@ class _Found(_Base):
             j = self.grown_from(lo, hi)
             at = f" at {_freq_span(lo, hi)} Hz" + (f", {self.where(lo, hi, j)}" if j is not None else "")
         v = self.s.get("validity") or {}
+        if v.get("stress_cuts"):  # admissible orbits, but all beyond the elastic limit
+            self.code("cut_at_yield_strength")
+            return (f"No admissible nonsmooth mode within the elastic limit in the searched periods {where}: "
+                    f"{_plural(len(self.fams), 'family', 'families')} of orbits with {what}{at}, whose admissible "
+                    f"orbits all stress the blade beyond its yield strength, "
+                    f"{v['yield_strength_pa'] / 1e6:.4g} MPa (peak von Mises).")
         if v.get("cuts"):  # admissible orbits, but all beyond the small-displacement limit
             self.code("cut_at_amplitude_limit")
             return (f"No admissible nonsmooth mode within the small-displacement limit in the searched periods "

@@ -253,6 +253,11 @@ class _Trust(_Base):
 
     def _small_displacements(self, limits: list) -> None:
         v = self.s.get("validity") or {}
+        if v.get("stress_cuts"):
+            self.code("cut_at_yield_strength")
+            limits.append(f"{'t' if not limits else 'T'}he arcs end where the peak von Mises stress exceeds the "
+                          f"yield strength, {v['yield_strength_pa'] / 1e6:.4g} MPa: beyond, the blade yields and a "
+                          "linear-elastic model does not hold.")
         if not v.get("cuts"):
             return
         self.code("cut_at_amplitude_limit")

@@ -87,6 +87,8 @@ REASONS = {
                       "(admissible_arcs[*].tongue, backbone_f_hi)",
     "cut_at_amplitude_limit": "admissible arcs were cut where the tip amplitude exceeds [search] amplitude_limit × "
                               "the span (validity.cuts)",
+    "cut_at_yield_strength": "admissible arcs were cut where an orbit's peak von Mises stress exceeds [material] "
+                             "yield_strength (validity.stress_cuts)",
     "switch_contact_model": "Newton's impact law, an orbit that failed the reference check (or none animated) and "
                             "energies that scatter across models: the massless contact model is advised",
 }

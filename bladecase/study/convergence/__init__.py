@@ -9,7 +9,10 @@ The names of :mod:`~bladecase.study.convergence.stage` are re-exported here.
 from .stage import (
     FIGURES,
     FLAG,
+    SAFETY,
+    SAFETY_UNESTABLISHED,
     convergence_stage,
+    estimate_words,
     mesh_figures,
     mesh_row,
     mesh_size,
@@ -18,5 +21,5 @@ from .stage import (
     scaled_study,
 )
 
-__all__ = ["FIGURES", "FLAG", "convergence_stage", "mesh_figures", "mesh_row", "mesh_size", "refined_mesh",
-           "richardson", "scaled_study"]
+__all__ = ["FIGURES", "FLAG", "SAFETY", "SAFETY_UNESTABLISHED", "convergence_stage", "estimate_words", "mesh_figures",
+           "mesh_row", "mesh_size", "refined_mesh", "richardson", "scaled_study"]

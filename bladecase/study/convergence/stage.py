@@ -17,12 +17,24 @@ A study that reads its mesh from a file (``[mesh] path``) is refined by splittin
 The sizes actually used, ``1/n``, are the ``h`` of the order and the extrapolation (``meshes`` in the summary; the
 factors asked for are its ``requested``, the parts per edge its ``splits``).
 
-For each figure, with ``h`` the element-size ratios: the observed order ``p`` of the three finest meshes
-(``f = f₀ + C hᵖ`` solved exactly for unequal refinement ratios), the Richardson extrapolation ``f₀`` and the
-error estimate of the study's own mesh, ``1.25 |f(h_study) − f₀|`` (Roache's safety factor for three meshes),
-relative to ``f₀``. A sequence that does not converge monotonically has no order; its error is bounded by ``1.25 ×``
-the largest change between meshes and said to be so. An estimate above :data:`FLAG` (2 %) is flagged in the report
-and the verdict.
+For each figure, with ``h`` the element-size ratios, the grid convergence index (GCI; Roache 1998, in the
+procedure of Celik et al. 2008, J. Fluids Eng. 130, 078001, and ASME V&V 20):
+
+* **order established** — the three finest meshes converge monotonically (same sign of both changes) with an
+  observed order ``p`` (``f = f₀ + C hᵖ`` solved exactly for unequal refinement ratios) in
+  :data:`ORDER_RANGE`: the Richardson extrapolation ``f₀`` and the error of the study's own mesh
+  ``1.25 |f(h_study) − f₀|`` (:data:`SAFETY`, Roache's factor when three meshes establish the order), relative to
+  ``f₀``;
+* **order not established** — oscillatory convergence (the changes alternate in sign: "not monotone"), changes
+  that do not shrink under refinement (no positive order), or an order outside :data:`ORDER_RANGE` (the meshes are
+  not in the asymptotic range): no extrapolation, and the error ``3 Δ`` (:data:`SAFETY_UNESTABLISHED`, Roache's
+  factor when the order cannot be established), with ``Δ`` the range of the figure over all the meshes (the largest
+  difference between two of them: the data range of Eça and Hoekstra's procedure), relative to the finest mesh's
+  value.
+
+Nothing here is fitted to a particular study: the two factors and the order range are the published rule's.
+
+An estimate above :data:`FLAG` (2 %) is flagged in the report and the verdict.
 
 >>> row = richardson([1.0, 0.7, 0.5], [210.5, 212.479, 213.094])
 >>> round(row["order"], 2), round(row["extrapolated"], 2), round(100 * row["error"], 2)
@@ -41,13 +53,15 @@ from ... import log
 from ...fe import splits_for
 from ..schema import Study, StudyError
 
-__all__ = ["FIGURES", "FLAG", "convergence_stage", "mesh_figures", "mesh_row", "mesh_size", "refined_mesh",
-           "richardson", "scaled_study"]
+__all__ = ["FIGURES", "FLAG", "SAFETY", "SAFETY_UNESTABLISHED", "convergence_stage", "estimate_words", "mesh_figures",
+           "mesh_row", "mesh_size", "refined_mesh", "richardson", "scaled_study"]
 
 #: An error estimate (relative) above which a figure is flagged.
 FLAG = 0.02
-#: Roache's safety factor of the grid-convergence index with three meshes.
+#: Roache's safety factor of the grid-convergence index when three meshes establish the observed order.
 SAFETY = 1.25
+#: Roache's safety factor when they do not (oscillatory convergence, an order outside :data:`ORDER_RANGE`).
+SAFETY_UNESTABLISHED = 3.0
 #: Observed orders outside this range are not trusted (the meshes are not in the asymptotic range).
 ORDER_RANGE = (0.5, 8.0)
 
@@ -86,35 +100,67 @@ def richardson(h: Sequence[float], values: Sequence[float | None], study_h: floa
     """Observed order, Richardson extrapolation and the error estimate of one figure over meshes of sizes ``h``
     (any order; the three finest are used), for the mesh of size ``study_h`` (default the coarsest: the study's).
 
-    Returns ``{"order", "extrapolated", "error", "monotone", "flag"}``: ``error`` relative to the extrapolated
-    value (or to the finest value when there is none); ``None`` everywhere when fewer than three meshes have the
-    figure.
+    Returns ``{"order", "extrapolated", "error", "monotone", "regime", "safety", "flag"}``: ``error`` the grid
+    convergence index of the module, relative to the extrapolated value (or to the finest value when there is none);
+    ``safety`` its factor, 1.25 (order established) or 3 (not); ``regime`` why: ``"asymptotic"`` (an order in
+    :data:`ORDER_RANGE`), ``"oscillating"`` (not monotone), ``"not shrinking"`` (monotone, but the last change is
+    not smaller than any positive order allows), ``"order out of range"``; ``None`` everywhere when fewer than three
+    meshes have the figure.
 
     >>> r = richardson([0.5, 1.0, 0.7], [4.0 + 2 * 0.5**2, 6.0, 4.0 + 2 * 0.7**2], study_h=1.0)  # f = 4 + 2h²
     >>> round(r["order"], 9), round(r["extrapolated"], 9), round(r["error"], 9), r["flag"]
     (2.0, 4.0, 0.625, True)
+    >>> r = richardson([1.0, 0.7, 0.5], [10.0, 10.4, 10.1])   # oscillates: 3 × the range 0.4, over 10.1
+    >>> r["monotone"], r["order"], r["safety"], round(r["error"], 6)
+    (False, None, 3.0, 0.118812)
     """
     pairs = sorted(((float(a), float(v)) for a, v in zip(h, values) if v is not None and math.isfinite(v)),
                    reverse=True)
-    out = {"order": None, "extrapolated": None, "error": None, "monotone": None, "flag": None}
+    out = {"order": None, "extrapolated": None, "error": None, "monotone": None, "regime": None, "safety": None,
+           "flag": None}
     if len(pairs) < 3:
         return out
     hs, fs = zip(*pairs)
     study_h = hs[0] if study_h is None else float(study_h)
     at = dict(pairs).get(study_h, fs[0])
+    d21, d32 = fs[-2] - fs[-3], fs[-1] - fs[-2]
+    monotone = d21 != 0.0 and d32 != 0.0 and (d21 > 0) == (d32 > 0)
     p = _order(hs[-3:], fs[-3:])
     if p is not None and ORDER_RANGE[0] <= p <= ORDER_RANGE[1]:
         h2, h3 = hs[-2], hs[-1]
         f0 = fs[-1] - (fs[-2] - fs[-1]) * h3 ** p / (h2 ** p - h3 ** p)
         scale = abs(f0) or abs(fs[-1]) or 1.0
         error = SAFETY * abs(at - f0) / scale
-        out.update(order=p, extrapolated=f0, error=error, monotone=True)
-    else:
+        out.update(order=p, extrapolated=f0, error=error, monotone=True, regime="asymptotic", safety=SAFETY)
+    else:  # the order is not established: Roache's factor 3 on the data range
         spread = max(fs) - min(fs)
         scale = abs(fs[-1]) or 1.0
-        out.update(order=p, error=SAFETY * spread / scale, monotone=p is not None)
+        h1, h2, h3 = hs[-3:]
+        shrinking = monotone and d21 / d32 > math.log(h1 / h2) / math.log(h2 / h3)  # the ratio as the order → 0
+        regime = "oscillating" if not monotone else "order out of range" if shrinking else "not shrinking"
+        out.update(order=p, error=SAFETY_UNESTABLISHED * spread / scale, monotone=monotone, regime=regime,
+                   safety=SAFETY_UNESTABLISHED)
     out["flag"] = out["error"] > FLAG
     return out
+
+
+def estimate_words(figure: dict) -> str:
+    """How a figure's error was estimated, in words: ``""`` when the order is established (1.25 × the distance from
+    the Richardson extrapolation), else why not and the rule used instead.
+
+    >>> estimate_words(richardson([1.0, 0.7, 0.5], [10.0, 10.4, 10.1]))
+    'not monotone: 3 × the range over the meshes'
+    >>> estimate_words(richardson([1.0, 0.7, 0.5], [10.0, 10.1, 10.5]))   # the second change is the larger
+    'the changes do not shrink with the mesh: 3 × the range over the meshes'
+    >>> estimate_words(richardson([1.0, 0.7, 0.5], [1.0, 1.5, 1.6]))   # order 4.4: established
+    ''
+    """
+    if figure.get("safety") != SAFETY_UNESTABLISHED:
+        return ""
+    why = {"oscillating": "not monotone", "not shrinking": "the changes do not shrink with the mesh"}.get(
+        figure.get("regime"), f"observed order {figure.get('order') or 0:.2g} outside {ORDER_RANGE[0]:g}–"
+        f"{ORDER_RANGE[1]:g}")
+    return f"{why}: 3 × the range over the meshes"
 
 
 # ----------------------------------------------------------------------------- the meshes
@@ -277,8 +323,9 @@ def convergence_stage(study: Study, main: dict, ratio: float | None, ipp: int, e
     flagged = [k for k, f in figures.items() if f["flag"]]
     for k in flagged:
         f = figures[k]
-        log.warning("mesh convergence: %s is off its mesh-converged value by %.2g %% on the study's mesh%s",
-                    f["words"], 100 * f["error"], "" if f["monotone"] else " (not monotone over the meshes)")
+        how = estimate_words(f)
+        log.warning("mesh convergence: %s is off its mesh-converged value by up to %.2g %% on the study's mesh%s",
+                    f["words"], 100 * f["error"], f" ({how})" if how else "")
     out = {"meshes": h, "dofs": [r["dofs"] for r in table], "ratio": ratio, "ipp": ipp, "flag": FLAG,
            "rows": table, "figures": figures, "flagged": flagged}
     if not study.parametric:

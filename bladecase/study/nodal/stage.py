@@ -213,6 +213,11 @@ def nodal_stage(study, model, contact, families, reduced, *, factor=None, folder
 
     fam = nodal_family(nodal.system, 0, through_resonances=True, stop_when=beyond, **cap)  # to the face mean's energy
     fam, validity = _small_displacements(study, model, nodal, fam)
+    if study["material"].get("yield_strength") is not None:  # the elastic limit (study/stress_limit.py)
+        from ..stress_limit import cut_nodal_family
+
+        fam, validity["stress_cut"] = cut_nodal_family(fam, nodal, float(study["material"]["yield_strength"]))
+        validity["yield_strength_pa"] = float(study["material"]["yield_strength"])
     orbits = fam.orbits
     reference = (nodal_extension(nodal, REFERENCE_FACTOR * nodal.n, factor) if study["output"]["reference"]
                  and orbits else None)

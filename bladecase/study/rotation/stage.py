@@ -139,7 +139,7 @@ def _speed_point(omega: float, *, study: Study, model, contact, axis: RotationAx
     state, phi, f = modes_at_speed(model, float(omega), axis, n, static=study["rotation"].get("static", "auto"))
     point = {"shapes": phi if sample is None else np.ascontiguousarray(phi[sample]), "frequencies_hz": f,
              "clearance": None if contact is None else running_clearance(study, model, contact, state, cold=True),
-             "band_hz": None, "note": None, "cut": None}
+             "band_hz": None, "note": None, "cut": None, "stress_cut": None}
     if not bands or contact is None:
         return point
     d = point["clearance"]["clearance_running_m"]
@@ -150,6 +150,10 @@ def _speed_point(omega: float, *, study: Study, model, contact, axis: RotationAx
     reduced = build_reduced(study, state.model, hot, factor=state.factor)
     families = search(study, reduced.system, label=speed_words(omega, study["rotation"]["speed_unit"]))
     families, point["cut"] = _cut_band(study, model, reduced, families)
+    if study["material"].get("yield_strength") is not None:  # the elastic limit (study/stress_limit.py)
+        from ..stress_limit import band_cut
+
+        families, point["stress_cut"] = band_cut(reduced, families, float(study["material"]["yield_strength"]))
     arcs = [a for f in families for a in f.arcs]
     if arcs:
         point["band_hz"] = (min(1.0 / a.T_hi for a in arcs), max(1.0 / a.T_lo for a in arcs))
@@ -212,13 +216,16 @@ def campbell_stage(study: Study, model, contact, executor, progress: bool = Fals
     section["closure_m"] = [x.get("closure_m") for x in clear] if contact is not None else None
     section["bands"] = [None if b is None else {"mode": _rank0(c, s), "low_hz": b[0], "high_hz": b[1],
                                                 "truncated": bool(points[s]["note"]),
-                                                "cut": points[s]["cut"] is not None}
+                                                "cut": points[s]["cut"] is not None
+                                                or points[s]["stress_cut"] is not None}
                         for s, b in enumerate(bands)]
     section["band_notes"] = [p["note"] for p in points]
     section["band_cuts"] = [_cut_words(p["cut"], b, unit, x) for p, b, x in zip(points, bands, w)]
-    for s, cut in enumerate(section["band_cuts"]):
-        if cut is not None:
-            cut["mode"] = _rank0(c, s)  # the band's mode (0-based), as in "bands"
+    section["band_stress_cuts"] = [_stress_cut_words(p["stress_cut"], b, unit, x) for p, b, x in zip(points, bands, w)]
+    for s, (cut, stress) in enumerate(zip(section["band_cuts"], section["band_stress_cuts"])):
+        for x in (cut, stress):
+            if x is not None:
+                x["mode"] = _rank0(c, s)  # the band's mode (0-based), as in "bands"
     section["risks"] = band_risks(w, bands, section["engine_orders"])
     if c.uncertain_links:
         s, j = c.uncertain_links[0]
@@ -247,6 +254,24 @@ def _cut_words(cut: dict | None, band: tuple | None, unit: str, omega: float) ->
     where = (f"its upper edge stops at {band[1]:.2f} Hz" if band is not None
              else "no admissible orbit is within the limit: no band")
     log.warning("Campbell at %s: the nonsmooth-mode band is cut at the small-displacement limit: %s; %s",
+                speed_words(omega, unit), where, out["reason"])
+    return out
+
+
+def _stress_cut_words(cut: dict | None, band: tuple | None, unit: str, omega: float) -> dict | None:
+    """One speed's entry of ``summary["campbell"]["band_stress_cuts"]``: the band's cut at ``[material]
+    yield_strength`` (:func:`~bladecase.study.stress_limit.band_cut`) with its new upper edge and the reason in
+    words, logged; ``None`` where the band was not cut there."""
+    if cut is None:
+        return None
+    point = ", ".join(f"{x:.4g}" for x in cut["at_mm"])
+    out = dict(cut, high_hz=None if band is None else band[1],
+               reason=f"the peak von Mises stress reaches {cut['von_mises_beyond_pa'] / 1e6:.4g} MPa at "
+                      f"{cut['f_beyond_hz']:.2f} Hz (at ({point}) mm), above the yield strength "
+                      f"{cut['yield_strength_pa'] / 1e6:.4g} MPa ([material] yield_strength)")
+    where = (f"its upper edge stops at {band[1]:.2f} Hz" if band is not None
+             else "no admissible orbit is within the limit: no band")
+    log.warning("Campbell at %s: the nonsmooth-mode band is cut at the elastic limit: %s; %s",
                 speed_words(omega, unit), where, out["reason"])
     return out
 
