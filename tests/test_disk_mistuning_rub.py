@@ -51,7 +51,7 @@ def _direct_peaks(delta, band):
     out = []
     for j in range(N):
         i = int(np.argmax(grid[:, j]))
-        res = minimize_scalar(lambda f: -amp(f)[j], bounds=(band[max(i - 1, 0)], band[min(i + 1, band.size - 1)]),
+        res = minimize_scalar(lambda f, j=j: -amp(f)[j], bounds=(band[max(i - 1, 0)], band[min(i + 1, band.size - 1)]),
                               method="bounded", options={"xatol": 1e-12})
         out.append(max(-res.fun, grid[i, j]))
     return np.array(out)

@@ -62,6 +62,15 @@ def _deviations(v) -> str | None:
     return None
 
 
+def _clearance(v) -> str | None:
+    values = v if isinstance(v, list) else [v]
+    ok = all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) and x > 0 for x in values)
+    if not values or not ok:
+        return ("must be the casing clearance at the blade tips (m, > 0): one number for every blade, or a list of "
+                "one per blade (N numbers)")
+    return None
+
+
 #: ``[mistuning]``: key → :class:`~bladecase.study.keys.Key`.
 MISTUNING_KEYS: dict[str, Key] = {
     "std": Key(_NUM, None, "Standard deviation of the blades' relative stiffness deviations (normal, e.g. 0.02): "
@@ -79,6 +88,9 @@ MISTUNING_KEYS: dict[str, Key] = {
     "model": Key(_STR, "snm", "'snm' (subset of nominal modes: the family's tuned modes, the blade's own stiffness "
                  "scaled) or 'fmm' (fundamental mistuning model: the family's strain energy assumed in the blades).",
                  _one_of(*MODELS)),
+    "clearance": Key((int, float, list), None, "The casing clearance at the blade tips (m): one number, or one per "
+                     "blade (N numbers). Given: which blade rubs first as the forcing rises, how soon against the "
+                     "tuned disk, by how much before the next (mistuning_rub.csv).", _clearance),
     "blade": Key(_STR, None, "For a sector mesh file: the node group of the blade (its cells, those with every node "
                  "in the group, are what mistuning scales). The parametric sector's blade is what lies beyond the "
                  "rim radius.", _name),
@@ -112,6 +124,10 @@ relative stiffness deviation per blade (3 numbers)
     if d is not None and len(d) != sectors:
         raise StudyError(f"[mistuning] deviations: {len(d)} values, but the disk has {sectors} blades: give one "
                          f"relative stiffness deviation per blade ({sectors} numbers)")
+    c = m.get("clearance")
+    if isinstance(c, list) and len(c) != sectors:
+        raise StudyError(f"[mistuning] clearance: {len(c)} values, but the disk has {sectors} blades: give one "
+                         f"clearance (m) for every blade, or one per blade ({sectors} numbers)")
 
 
 def mistuning_checks(c: dict) -> None:
