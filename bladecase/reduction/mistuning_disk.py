@@ -67,14 +67,16 @@ def blade_coupling(disk: DiskModel, blade_stiffness) -> np.ndarray:
     return np.array(out)
 
 
-def mistuned_disk(disk: DiskModel, coupling: np.ndarray, delta) -> NodalSystem:
-    """The disk's :class:`NodalSystem` with blade ``j``'s stiffness × ``(1 + delta[j])`` (module docstring)."""
+def mistuned_disk(disk: DiskModel, coupling: np.ndarray, delta, gap=None) -> NodalSystem:
+    """The disk's :class:`NodalSystem` with blade ``j``'s stiffness × ``(1 + delta[j])`` (module docstring);
+    ``gap``: each contact's clearance (``(N·m,)``, blade-major; default the disk's)."""
     d = np.asarray(delta, dtype=float)
     if d.shape != (disk.sectors,) or not np.all(np.isfinite(d)) or np.any(d <= -1):
         raise ValueError(f"delta must be {disk.sectors} finite deviations > -1 (blade j's stiffness × (1 + delta[j]))"
                          f", got shape {d.shape}")
     s = disk.system
-    return NodalSystem(s.M, s.S + np.einsum("j,jab->ab", d, coupling), s.W, s.flexibility, s.gap,
+    return NodalSystem(s.M, s.S + np.einsum("j,jab->ab", d, coupling), s.W, s.flexibility,
+                       s.gap if gap is None else gap,
                        None if not np.isfinite(s.casing).any() else s.casing, nodes=s.nodes)
 
 

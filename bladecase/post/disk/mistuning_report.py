@@ -17,7 +17,7 @@ below Whitehead's bound 1.725 for 6 blades.
 
 from __future__ import annotations
 
-__all__ = ["ASSUMPTIONS", "mistuning_lines", "mistuning_sentence", "rub_lines"]
+__all__ = ["ASSUMPTIONS", "contact_lines", "mistuning_lines", "mistuning_sentence", "rub_lines"]
 
 #: Each model's assumptions in one sentence.
 ASSUMPTIONS = {
@@ -64,7 +64,31 @@ def mistuning_lines(m: dict | None) -> list[str]:
              + f"{m['largest']:.4f} on blade {m['largest_blade']} at {m['largest_frequency_hz']:.2f} Hz.",
              f"- Whitehead's bound ½(1 + √N) = {m['whitehead_bound']:.4f} for N = {m['sectors']}: "
              f"{m['above_bound']} sample(s) above it" + (" (none expected: check the family is isolated)."
-                                                         if m["above_bound"] else ".")] + rub_lines(m.get("rub"))
+                                                         if m["above_bound"] else ".")] + (
+                rub_lines(m.get("rub")) + contact_lines(m.get("contact")))
+
+
+def contact_lines(c: dict | None) -> list[str]:
+    """The report's words on how hard the mistuned blades rub (``summary["mistuning"]["contact"]``; ``[]``
+    without it).
+
+    >>> c = {"force_n": 300.0, "samples": 3, "tuned_peak_force_n": 700.0, "tuned_frequency_hz": 1600.0,
+    ...      "largest_force_n": {"p50": 830.0, "max": 840.0}, "ratio_to_tuned": {"p50": 1.19, "max": 1.2},
+    ...      "worst_sample": 1, "worst_blade": 3, "unsettled": 0, "touching_blades_p50": 4.0}
+    >>> contact_lines(c)[0][:58]
+    '- Rub at a tip force of 300 N (each blade its own massless'
+    """
+    if not c:
+        return []
+    r = c["ratio_to_tuned"]
+    ratio = "" if r["p50"] is None else f" ({r['p50']:.3f} and {r['max']:.3f} times the tuned disk's)"
+    return [f"- Rub at a tip force of {c['force_n']:.4g} N (each blade its own massless contact at its tip, the "
+            f"steady rub at each sample's resonance, {c['samples']} samples): the tuned disk's blades press "
+            f"{c['tuned_peak_force_n']:.4g} N at {c['tuned_frequency_hz']:.2f} Hz; mistuned, the hardest-pressing "
+            f"blade {c['largest_force_n']['p50']:.4g} N (median) to {c['largest_force_n']['max']:.4g} N{ratio} — "
+            f"blade {c['worst_blade']} of sample {c['worst_sample']}; a median {c['touching_blades_p50']:.0f} blades "
+            f"touch" + (f"; {c['unsettled']} sample(s) did not settle" if c["unsettled"] else "")
+            + ". `mistuning_contact.csv` has every blade's peak force."]
 
 
 def rub_lines(r: dict | None) -> list[str]:

@@ -179,6 +179,11 @@ def compute_mistuning(study: Study, staging: Path, files: dict, *, fe_model, mes
     })
     if m["clearance"] is not None:
         section["rub"] = _first_rub(m, fe_model, axis, tip, shared, deltas, staging, files, executor, progress)
+    if m["force"] is not None:
+        from .mistuning_contact import compute_contacts
+
+        section["contact"] = compute_contacts(m, fe_model, sector, axis, tip, cells, deltas, hz, staging, files,
+                                              executor, progress)
     log.info("mistuning (%s, family %d, engine order %d, ζ = %g): %d sample(s) of %d blades, amplification "
              "median %.4f, largest %.4f (sample %d, blade %d); Whitehead's bound %.4f, %d sample(s) above it",
              model.kind, m["family"], order, m["damping"], deltas.shape[0], n, section["percentiles"]["p50"],

@@ -91,6 +91,14 @@ MISTUNING_KEYS: dict[str, Key] = {
     "clearance": Key((int, float, list), None, "The casing clearance at the blade tips (m): one number, or one per "
                      "blade (N numbers). Given: which blade rubs first as the forcing rises, how soon against the "
                      "tuned disk, by how much before the next (mistuning_rub.csv).", _clearance),
+    "force": Key(_NUM, None, "With 'clearance': the engine-order force at each blade's tip (N, amplitude) at which "
+                 "every blade's rub is computed — each blade its own massless contact at its tip node, the steady "
+                 "rub at the mistuned disk's resonance (mistuning_contact.csv). Needs [fem] mass = 'lumped'.",
+                 lambda v: None if math.isfinite(v) and v > 0 else "must be a force amplitude > 0 (N)"),
+    "contact_samples": Key(_INT, 10, "With 'force': how many samples (the first ones) are run with contact.",
+                           _int_between(1, MAX_SAMPLES)),
+    "casing_stiffness": Key(_NUM, None, "With 'force': the casing's stiffness at each tip (N/m); default: rigid.",
+                            lambda v: None if math.isfinite(v) and v > 0 else "must be a stiffness > 0 (N/m)"),
     "blade": Key(_STR, None, "For a sector mesh file: the node group of the blade (its cells, those with every node "
                  "in the group, are what mistuning scales). The parametric sector's blade is what lies beyond the "
                  "rim radius.", _name),
@@ -159,6 +167,11 @@ def mistuning_checks(c: dict) -> None:
     elif m["std"] is None:
         raise StudyError("[mistuning] std: required for random samples (the standard deviation of the blades' "
                          "relative stiffness deviations, e.g. std = 0.02), or give 'deviations' (N numbers)")
+    if m["force"] is not None and m["clearance"] is None:
+        raise StudyError("[mistuning] force: the rub of each blade needs the casing: give [mistuning] clearance (m)")
+    if m["force"] is not None and (c.get("fem") or {}).get("mass") != "lumped":
+        raise StudyError("[mistuning] force: each blade's contact is a massless contact (its tip's mass moved to its "
+                         f"neighbours): [fem] mass = 'lumped', got {(c.get('fem') or {}).get('mass')!r}")
     n = sectors_of(c)
     if n is not None:
         check_deviations(m, n)
