@@ -43,6 +43,7 @@ from ...reduction.mistuning_stats import (
 )
 from ..executor import Executor
 from ..schema import Study, StudyError
+from .mistuning_contact import compute_contacts, radial_response
 from .mistuning_keys import check_deviations
 
 __all__ = ["blade_cells", "compute_mistuning", "excitation_dof", "mistuning_csv", "radial_response"]
@@ -180,8 +181,6 @@ def compute_mistuning(study: Study, staging: Path, files: dict, *, fe_model, mes
     if m["clearance"] is not None:
         section["rub"] = _first_rub(m, fe_model, axis, tip, shared, deltas, staging, files, executor, progress)
     if m["force"] is not None:
-        from .mistuning_contact import compute_contacts
-
         section["contact"] = compute_contacts(m, fe_model, sector, axis, tip, cells, deltas, hz, staging, files,
                                               executor, progress)
     log.info("mistuning (%s, family %d, engine order %d, ζ = %g): %d sample(s) of %d blades, amplification "
@@ -192,18 +191,6 @@ def compute_mistuning(study: Study, staging: Path, files: dict, *, fe_model, mes
         log.warning("mistuning: %d sample(s) above Whitehead's bound %.4f: the forced family is not isolated or the "
                     "sweep does not resolve the peaks", above, stats.bound)
     return section
-
-
-def radial_response(fe_model, axis, node: int) -> np.ndarray:
-    """The sector dof vector ``r`` of the tip ``node``'s radial displacement about ``axis`` (``rᵀu``: how far the tip
-    moves towards a casing of revolution)."""
-    p = fe_model.mesh.points[node] - axis.origin
-    radial = p - (p @ axis.direction) * axis.direction
-    radial = radial / np.linalg.norm(radial)
-    r = np.zeros(fe_model.n_dofs)
-    here = np.flatnonzero(fe_model.dofs.node == node)
-    r[here] = radial[fe_model.dofs.direction[here]]
-    return r
 
 
 def _first_rub(m: dict, fe_model, axis, tip: dict, shared: dict, deltas: np.ndarray, staging: Path, files: dict,

@@ -26,10 +26,21 @@ from ...io import write_text
 from ..executor import Executor
 from ..schema import StudyError
 
-__all__ = ["compute_contacts", "sample_contacts"]
+__all__ = ["compute_contacts", "radial_response", "sample_contacts"]
 
 #: Frequencies of the band scanned for the mistuned disk's linear resonance (the forcing frequency of a sample).
 SCAN = 801
+
+def radial_response(fe_model, axis, node: int) -> np.ndarray:
+    """The sector dof vector ``r`` of the tip ``node``'s radial displacement about ``axis`` (``rᵀu``: how far the tip
+    moves towards a casing of revolution)."""
+    p = fe_model.mesh.points[node] - axis.origin
+    radial = p - (p @ axis.direction) * axis.direction
+    radial = radial / np.linalg.norm(radial)
+    r = np.zeros(fe_model.n_dofs)
+    here = np.flatnonzero(fe_model.dofs.node == node)
+    r[here] = radial[fe_model.dofs.direction[here]]
+    return r
 
 
 def sample_contacts(delta, *, disk, coupling, load, residual, band, zeta: float, gap) -> dict:
@@ -54,7 +65,6 @@ def compute_contacts(m: dict, fe_model, sector, axis, tip: dict, cells: np.ndarr
     from ...reduction.disk import disk_model, massless_sector
     from ...reduction.mistuning_disk import blade_coupling, engine_order_load
     from ...reduction.mistuning_fe import blade_stiffness
-    from .mistuning import radial_response
 
     n = sector.sectors
     c = np.broadcast_to(np.asarray(m["clearance"], dtype=float), (n,))
