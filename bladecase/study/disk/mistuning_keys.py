@@ -157,8 +157,8 @@ def mistuning_checks(c: dict) -> None:
                          f"{g.get('kind')!r} geometry: use [geometry] kind = 'sector' (a disk sector with its blade), "
                          "or a sector mesh file with [cyclic]; or remove [mistuning]")
     if (c.get("contact") or {}).get("clearance") is not None:
-        raise StudyError("[mistuning]: the mistuned disk's forced response is linear (no contact yet): remove "
-                         "[contact] (or [mistuning])")
+        raise StudyError("[mistuning]: the mistuned disk's rub is set in [mistuning] itself (clearance: who rubs "
+                         "first; force: how hard each blade rubs), not by [contact]: remove [contact] (or [mistuning])")
     if m["deviations"] is not None:
         both = [k for k in ("std", "samples") if m[k] != MISTUNING_KEYS[k].default]
         if both:
