@@ -71,13 +71,16 @@ DISK_DENSE = 400
 class Diameter:
     """One nodal diameter of the massless sector: ``lam`` (ω², ascending), ``shapes`` (complex sector modes,
     ``φᴴMφ = 1``), ``G`` (``m × m`` complex: the contacts' static compliance under the cyclic constraint of ``k``),
-    ``seconds`` (factorisation, modes and compliance)."""
+    ``seconds`` (factorisation, modes and compliance); ``static`` (``n_dofs × m`` complex: the sector's static
+    response ``X_k`` to each contact's unit force under the cyclic constraint of ``k``, ``G_k = WᵀX_k``; the
+    contacts' fields on the mesh, :mod:`bladecase.reduction.disk_fields`)."""
 
     k: int
     lam: np.ndarray
     shapes: np.ndarray
     G: np.ndarray
     seconds: float
+    static: np.ndarray | None = field(default=None, repr=False)
 
 
 def _check_contact(sector: CyclicSector, W, gap) -> tuple[np.ndarray, np.ndarray]:
@@ -146,10 +149,12 @@ def diameter(sector: CyclicSector, W, k: int, count: int) -> Diameter:
     X = X.reshape(R.shape)
     if real:
         G = (R.T @ X).astype(complex)
+        static = (Tr @ X).astype(complex)
     else:
         br, bi, xr, xi = R[:mk], R[mk:], X[:mk], X[mk:]
         G = R.T @ X + 1j * (br.T @ xi - bi.T @ xr)
-    return Diameter(k, lam, shapes, 0.5 * (G + G.conj().T), time.perf_counter() - start)
+        static = (Tr @ xr - Ti @ xi) + 1j * (Ti @ xr + Tr @ xi)  # T z, T = T_r + iT_i, z = x_r + ix_i
+    return Diameter(k, lam, shapes, 0.5 * (G + G.conj().T), time.perf_counter() - start, static)
 
 
 @dataclass(frozen=True, eq=False)

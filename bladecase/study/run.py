@@ -31,6 +31,7 @@ from ..post.verdict import verdict
 from ..progress import progress_counter
 from .comparison.stage import FE_MODES, compare_models, summary_section
 from .disk.cyclic import compute_linear
+from .disk.cyclic_keys import cyclic_requested
 from .documents import contact_summary, families_document, family_summary, model_summary, reduced_summary, write_mesh
 from .executor import Executor, make_executor
 from .forcing.stage import forced_response, forced_scene
@@ -163,14 +164,15 @@ def run(study: Study | str | os.PathLike, out: str | os.PathLike | None = None, 
     try:
         with log.transcript() as lines:
             log.info("study %s (%s) → %s", study.name, study.source, out)
-            compute = _compute if study.has_contact else compute_linear  # no contact: linear modes (a disk: cyclic)
+            # no contact: linear modes; a disk (cyclic): its own stage, with its contact when it has one
+            compute = _compute if study.has_contact and not cyclic_requested(study.config) else compute_linear
             summary, families, models = compute(study, staging, stages, progress, executor or own)
             summary["timings_s"] = dict(stages.timings, total=round(time.perf_counter() - t_start, 3))
             log.info("results in %s (%.1f s)", out, summary["timings_s"]["total"])
         write_text(staging / "run.log", "\n".join(lines) + "\n")
         summary["outputs"] = sorted(set(staged_names(staging)) | {"summary.json", "report.md"})
-        summary["verdict"] = (verdict(summary, staging / "modes.json") if study.has_contact
-                              else cyclic_verdict(summary) if summary.get("cyclic") else modes_verdict(summary))
+        summary["verdict"] = (cyclic_verdict(summary) if summary.get("cyclic") else
+                              verdict(summary, staging / "modes.json") if study.has_contact else modes_verdict(summary))
         write_json(staging / "summary.json", summary)
         write_text(staging / "report.md", cyclic_report(summary) if summary.get("cyclic") else report(summary))
         publish(staging, out, RUN_RESULTS, whole=True)

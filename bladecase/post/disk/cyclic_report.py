@@ -23,12 +23,55 @@ from __future__ import annotations
 
 from .mistuning_report import mistuning_lines, mistuning_sentence
 
-__all__ = ["cyclic_report", "cyclic_verdict", "engine_order_words"]
+__all__ = ["cyclic_report", "cyclic_verdict", "engine_order_words", "nonsmooth_lines", "nonsmooth_sentence"]
 
 
 def engine_order_words(c: dict) -> list[str]:
     """One sentence per engine order near a mode at the SAFE speed (``near``), e.g. ``EO 3 on mode 1 of ND 1``."""
     return [f"EO {r['order']} on mode {j} of ND {r['diameter']}" for r in c["engine_orders"] for j in r["near"]]
+
+
+def nonsmooth_sentence(n: dict) -> str:
+    """The whole disk's travelling nonsmooth mode in one sentence (``summary["cyclic"]["nonsmooth"]``).
+
+    >>> n = {"diameter": 2, "direction": "forward", "mode": 1, "orbits": [{"frequency_hz": 100.0},
+    ...      {"frequency_hz": 101.5, "max_force_n": 3.0}], "check": {"periods": 10, "return_error": 1e-12},
+    ...      "stable": True}
+    >>> nonsmooth_sentence(n)[:91]
+    'Against the casing, the forward travelling wave of mode 1 of ND 2 rubs: 2 orbits, 100.00 → '
+    """
+    o = n["orbits"]
+    return (f"Against the casing, the {n['direction']} travelling wave of mode {n['mode']} of ND {n['diameter']} "
+            f"rubs: {len(o)} orbit{'s' if len(o) != 1 else ''}, {o[0]['frequency_hz']:.2f} → "
+            f"{o[-1]['frequency_hz']:.2f} Hz, the last (largest force {o[-1]['max_force_n']:.3g} N) back within "
+            f"{n['check']['return_error']:.1e} after {n['check']['periods']} periods in the whole disk without the "
+            f"symmetry, {'stable' if n['stable'] else 'unstable'}.")
+
+
+def nonsmooth_lines(n: dict | None) -> list[str]:
+    """The report's section on the whole disk's travelling nonsmooth mode (empty without one)."""
+    if not n:
+        return []
+    lines = ["", "## The whole disk against the casing", "",
+             f"- Reduced disk: {n['contacts']} contacts (each blade's own), {n['reduced_dofs']} modal coordinates "
+             f"({n['modes_per_diameter']} modes per nodal diameter, the contacts' residual flexibility restored).",
+             f"- The {n['direction']} wave of mode {n['mode']} of nodal diameter {n['diameter']} "
+             f"({n['linear_frequency_hz']:.2f} Hz linear): blade j moves as blade 0 {n['diameter']}·j/N of a period "
+             f"later, found over 1/{n['fraction']} of the period against the blade shift.", "",
+             "| orbit | frequency (Hz) | energy (J) | largest force (N) | return after 1 period |",
+             "|---|---|---|---|---|"]
+    lines += [f"| {r['orbit']} | {r['frequency_hz']:.4f} | {r['energy_j']:.4g} | {r['max_force_n']:.4g} | "
+              f"{r['return_error_1T']:.1e} |" for r in n["orbits"]]
+    lines += ["", f"- The last orbit flown {n['check']['periods']} periods in the whole disk without the symmetry: "
+              f"back within {n['check']['return_error']:.1e}; Floquet: {'stable' if n['stable'] else 'unstable'} "
+              f"(largest non-trivial |μ| {n['largest_multiplier']:.6f})."]
+    a = n.get("animated")
+    if a:
+        lines.append(f"- Animated on the annulus ({a['disk_nodes']} nodes, {a['frames']} frames): "
+                     + ", ".join(f"`{a[k]}`" for k in ("pvd", "gif", "mp4") if k in a)
+                     + f"; largest penetration into the casing {a['max_penetration_mm'] * 1e3:.4g} µm "
+                     f"(blade {a['worst_blade']}), largest force {a['max_force_n']:.4g} N.")
+    return lines
 
 
 def cyclic_verdict(summary: dict) -> dict:
@@ -47,6 +90,8 @@ def cyclic_verdict(summary: dict) -> dict:
                   f"{c['speed_rpm']:.0f} rpm" + (": " + ", ".join(near) if near else "") + ".")
     else:
         found += "; at rest (no speed: no engine-order line)."
+    if c.get("nonsmooth"):
+        found += " " + nonsmooth_sentence(c["nonsmooth"])
     if summary.get("mistuning"):
         found += " " + mistuning_sentence(summary["mistuning"])
     trust = ("The tuned disk's modes from one sector under the cyclic constraint (every sector identical, the faces "
@@ -100,6 +145,7 @@ def cyclic_report(summary: dict) -> str:
         lines += ["", "## Campbell diagram per nodal diameter", "",
                   f"- {len(c['campbell']['speeds_rad_s'])} speeds, every nodal diameter's modes about the disk's "
                   "centrifugal state (the sector's faces tied): `campbell_nd.png`."]
+    lines += nonsmooth_lines(c.get("nonsmooth"))
     lines += mistuning_lines(summary.get("mistuning"))
     files = summary.get("files") or {}
     lines += ["", "## Files", ""] + [f"- `{x}`" for k, x in files.items() if isinstance(x, str)]

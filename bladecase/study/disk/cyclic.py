@@ -11,6 +11,9 @@ all-or-nothing publication as every run:
 * ``safe.png`` — the SAFE (ZZENF) diagram with the engine-order zig-zag at the SAFE speed;
 * ``vtk/annulus_<stem>.pvd`` + ``vtk/annulus_<stem>/`` — the whole disk as one mesh with the expanded mode
   (``[cyclic] expand``), one period of a standing or a forward/backward travelling wave, ``[output] frames`` frames;
+* with ``[cyclic] nonsmooth`` and a ``[contact]``: a travelling-wave nonsmooth mode of the whole disk against the
+  casing, animated on the annulus (:mod:`bladecase.study.disk.nonsmooth`: ``disk_modes.csv``, ``vtk/disk_*.pvd``,
+  ``animations/disk_*.gif``);
 * with ``[rotation] speeds``: the Campbell diagram of every nodal diameter (``campbell_nd.png``);
 * ``summary.json["cyclic"]`` and the report's words (which nodal diameter each engine order excites, the modes near
   the engine-order lines).
@@ -326,6 +329,12 @@ def compute_cyclic(study: Study, staging: Path, stage, progress: bool, executor:
         if "vtu" in o["formats"]:
             expanded = _expand(study, staging, mesh, model, solved, spectrum, expand_spec(cy, n))
             files["annulus"] = expanded["file"]
+    nonsmooth = None
+    if cy["nonsmooth"]:
+        from .nonsmooth import compute_disk_modes
+
+        with stage("nonsmooth"):
+            nonsmooth = compute_disk_modes(study, staging, files, model=model, sector=solved)
     mistuning = None
     if mistuning_requested(study.config):
         from .mistuning import compute_mistuning
@@ -351,7 +360,7 @@ def compute_cyclic(study: Study, staging: Path, stage, progress: bool, executor:
         "speed_rad_s": speed, "speed_rpm": None if speed is None else speed * 60 / (2 * math.pi),
         "diameters": [{"nd": k, "frequencies_hz": m.frequencies.tolist(), "multiplicity": m.multiplicity,
                        "unknowns": m.size, "seconds": m.seconds} for k, m in spectrum.items()],
-        "engine_orders": table, "expanded": expanded, "campbell": campbell,
+        "engine_orders": table, "expanded": expanded, "campbell": campbell, "nonsmooth": nonsmooth,
     }
     summary = {
         "study": study.name, "source": study.source, "bladecase_version": __version__,

@@ -24,7 +24,8 @@ from __future__ import annotations
 from ..keys import _INT, _LIST, _NUM, _STR, Key, StudyError
 from ..values import _int_between, _name, _positive
 
-__all__ = ["CYCLIC_KEYS", "WAVES", "cyclic_checks", "cyclic_requested", "expand_spec"]
+__all__ = ["CYCLIC_KEYS", "NONSMOOTH_GROWTH", "WAVES", "cyclic_checks", "cyclic_requested", "expand_spec",
+           "nonsmooth_checks"]
 
 #: The expansions of ``[cyclic] expand`` (:func:`bladecase.fe.cyclic_waves.annulus_field`).
 WAVES = ("cos", "sin", "forward", "backward")
@@ -62,6 +63,28 @@ def _expand(v) -> str | None:
     return None
 
 
+def _nonsmooth(v) -> str | None:
+    keys = {"diameter", "mode", "growth", "modes"}
+    extra = set(v) - keys
+    if extra:
+        return f"unknown key {sorted(extra)[0]!r} (valid: {', '.join(sorted(keys))})"
+    k, m, c = v.get("diameter", 1), v.get("mode", 1), v.get("modes", 4)  # mode: default chosen in the stage
+    if isinstance(k, bool) or not isinstance(k, int) or not 1 <= k < MAX_SECTORS:
+        return f"diameter must be the travelling wave's nodal diameter (1 … N−1; k > N/2: backward), got {k!r}"
+    if isinstance(m, bool) or not isinstance(m, int) or not 1 <= m <= 50:
+        return f"mode must be an integer from 1 (the lowest of its nodal diameter) to 50, got {m!r}"
+    if isinstance(c, bool) or not isinstance(c, int) or not 1 <= c <= 50:
+        return f"modes must be the modes kept per nodal diameter in the disk's reduced model, 1 … 50, got {c!r}"
+    g = v.get("growth", list(NONSMOOTH_GROWTH))
+    if (not isinstance(g, list) or not g or not all(isinstance(x, (int, float)) and not isinstance(x, bool)
+                                                     and 1 < x <= 100 for x in g) or sorted(g) != g):
+        return f"growth must be an increasing list of energies over the grazing wave's, each in (1, 100], got {g!r}"
+    return None
+
+
+#: ``[cyclic] nonsmooth``: the energies of the travelling family over its grazing wave's, by default.
+NONSMOOTH_GROWTH = (1.05, 1.2, 1.4)
+
 #: ``[cyclic]``: key → :class:`~bladecase.study.keys.Key`.
 CYCLIC_KEYS: dict[str, Key] = {
     "sectors": Key(_INT, None, "N, the number of sectors (blades) of the disk; default: the [geometry]'s "
@@ -87,6 +110,14 @@ CYCLIC_KEYS: dict[str, Key] = {
                   "wave = 'forward'} — wave 'cos' or 'sin' (standing), 'forward' or 'backward' (travelling, "
                   "0 < k < N/2). Default: mode 1 of nodal diameter 1 as a forward wave (a standing wave for N < 3).",
                   _expand),
+    "nonsmooth": Key((dict,), None, "A travelling-wave nonsmooth mode of the whole disk against the casing ([contact] "
+                     "with model = 'massless', each blade's contact its own): {diameter = k, mode = j, modes = 4, "
+                     "growth = [1.05, 1.2, 1.4]} — the wave of mode j of k nodal diameters (k > N/2: the backward "
+                     "wave of N − k; default j: the mode that moves the contacts most along the casing normal for "
+                     "its energy), its family at the energies 'growth' × the grazing wave's, in a reduced disk "
+                     "of 'modes' modes per nodal diameter; the last orbit flown 10 periods in the whole disk "
+                     "without the symmetry, and animated on the annulus (disk_modes.csv, vtk/, animations/).",
+                     _nonsmooth),
 }
 
 
@@ -143,10 +174,38 @@ def cyclic_checks(c: dict) -> None:
         return
     if n is not None:
         check_diameters(cy, n)
-    if c.get("contact", {}).get("clearance") is not None:
+    contact = c.get("contact", {})
+    if contact.get("clearance") is not None and not cy.get("nonsmooth"):
         raise StudyError("[contact]: a cyclic study ([cyclic], [geometry] kind = 'sector') computes the linear modes "
-                         "of the bladed disk by nodal diameter; the contact of a whole disk is not available yet: "
-                         "remove [contact] (or study one blade without [cyclic])")
+                         "of the bladed disk by nodal diameter; its contact is for the whole disk's nonsmooth mode: "
+                         "add [cyclic] nonsmooth = {diameter = k} (or remove [contact], or study one blade without "
+                         "[cyclic])")
+    if cy.get("nonsmooth"):
+        nonsmooth_checks(cy, contact, n)
+
+
+def nonsmooth_checks(cy: dict, contact: dict, n: int | None) -> None:
+    """``[cyclic] nonsmooth`` against ``[contact]`` (a clearance, the massless model) and N (a travelling wave:
+    ``0 < k < N``, ``2k ≠ N``).
+
+    >>> try:
+    ...     nonsmooth_checks({"nonsmooth": {"diameter": 6}}, {"clearance": 1e-4, "model": "massless"}, 12)
+    ... except StudyError as exc:
+    ...     print(str(exc).split(":")[:2])
+    ['[cyclic] nonsmooth', ' diameter = 6 of a disk of 12 sectors is a standing wave (k = N/2)']
+    """
+    ns = cy["nonsmooth"]
+    if contact.get("clearance") is None:
+        raise StudyError("[cyclic] nonsmooth: the whole disk's nonsmooth mode needs a casing: add [contact] with its "
+                         "clearance (and face, e.g. face = 'tip', model = 'massless')")
+    if contact.get("model") != "massless":
+        raise StudyError(f"[contact] model: the whole disk's nonsmooth mode uses the massless contact model (each "
+                         f"blade's contact its own): model = 'massless', got {contact.get('model')!r}")
+    k = ns.get("diameter", 1)
+    if n is not None and (k >= n or 2 * k == n):
+        raise StudyError(f"[cyclic] nonsmooth: diameter = {k} of a disk of {n} sectors is "
+                         + ("a standing wave (k = N/2)" if 2 * k == n else "not a nodal diameter")
+                         + ": a travelling wave needs 0 < k < N, k ≠ N/2")
 
 
 def check_diameters(cy: dict, n: int) -> None:

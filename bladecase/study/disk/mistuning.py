@@ -15,7 +15,11 @@ one pattern ``deviations``) run through the study's executor, each a
 * ``mistuning.csv`` — one row a sample: ``sample, amplitude, amplification, blade, frequency_hz``;
 * ``mistuning.png`` — the histogram of the amplification factor against Whitehead's bound;
 * ``summary["mistuning"]`` — the model, the forcing, the percentiles, the largest, the bound ``½(1 + √N)`` and how
-  many samples exceed it.
+  many samples exceed it;
+* with ``[mistuning] clearance``: who rubs first (:mod:`bladecase.reduction.mistuning_rub`, each sample a
+  :func:`~bladecase.reduction.mistuning_rub.sample_rub` task through the same executor) — each blade's tip excursion
+  along the radius at the tip node (the casing normal) against its clearance as the forcing rises:
+  ``mistuning_rub.csv`` (``sample, first_blade, level_n, tuned_ratio, lead``) and ``summary["mistuning"]["rub"]``.
 """
 
 from __future__ import annotations
@@ -39,9 +43,10 @@ from ...reduction.mistuning_stats import (
 )
 from ..executor import Executor
 from ..schema import Study, StudyError
+from .mistuning_contact import compute_contacts, radial_response
 from .mistuning_keys import check_deviations
 
-__all__ = ["blade_cells", "compute_mistuning", "excitation_dof", "mistuning_csv"]
+__all__ = ["blade_cells", "compute_mistuning", "excitation_dof", "mistuning_csv", "radial_response"]
 
 
 def blade_cells(mesh, axis, geometry, group: str | None) -> np.ndarray:
@@ -173,6 +178,11 @@ def compute_mistuning(study: Study, staging: Path, files: dict, *, fe_model, mes
         "above_bound": above, "largest_frequency_hz": float(stats.frequencies[worst]),
         "largest_deviations": stats.deltas[worst].tolist(),
     })
+    if m["clearance"] is not None:
+        section["rub"] = _first_rub(m, fe_model, axis, tip, shared, deltas, staging, files, executor, progress)
+    if m["force"] is not None:
+        section["contact"] = compute_contacts(m, fe_model, sector, axis, tip, cells, deltas, hz, staging, files,
+                                              executor, progress)
     log.info("mistuning (%s, family %d, engine order %d, ζ = %g): %d sample(s) of %d blades, amplification "
              "median %.4f, largest %.4f (sample %d, blade %d); Whitehead's bound %.4f, %d sample(s) above it",
              model.kind, m["family"], order, m["damping"], deltas.shape[0], n, section["percentiles"]["p50"],
@@ -181,3 +191,43 @@ def compute_mistuning(study: Study, staging: Path, files: dict, *, fe_model, mes
         log.warning("mistuning: %d sample(s) above Whitehead's bound %.4f: the forced family is not isolated or the "
                     "sweep does not resolve the peaks", above, stats.bound)
     return section
+
+
+def _first_rub(m: dict, fe_model, axis, tip: dict, shared: dict, deltas: np.ndarray, staging: Path, files: dict,
+               executor: Executor, progress: bool) -> dict:
+    """Who rubs first in each sample (module docstring): ``mistuning_rub.csv`` and ``summary["mistuning"]["rub"]``."""
+    from ...reduction.mistuning_rub import blade_peaks, first_rub, sample_rub
+
+    n = deltas.shape[1]
+    c = np.broadcast_to(np.asarray(m["clearance"], dtype=float), (n,))
+    kw = {**shared, "response": radial_response(fe_model, axis, tip["node"]), "clearance": c}
+    tuned_peaks, _ = blade_peaks(kw["model"], np.zeros(n), kw["order"], kw["frequencies"], zeta=kw["zeta"],
+                                 force=kw["force"], response=kw["response"])
+    if not tuned_peaks.max() > 0:
+        raise StudyError(f"[mistuning] clearance: engine order {kw['order']} does not move the blade tip (node "
+                         f"{tip['node']}) along the radius: no blade ever reaches the casing")
+    tuned = first_rub(tuned_peaks, c)
+    rows = executor.map(sample_rub, list(deltas), shared={**kw, "tuned_level": tuned["level"]},
+                        desc="first rub per sample", progress=progress)
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(["sample", "first_blade", "level_n", "tuned_ratio", "lead"])
+    for i, r in enumerate(rows):
+        w.writerow([i, r["blade"], repr(r["level"]), repr(r["tuned_ratio"]), repr(r["lead"])])
+    write_text(staging / "mistuning_rub.csv", buf.getvalue())
+    files["mistuning_rub"] = "mistuning_rub.csv"
+    ratio = np.array([r["tuned_ratio"] for r in rows])
+    lead = np.array([r["lead"] for r in rows])
+    soonest = int(np.argmin(ratio))
+    counts = np.bincount([r["blade"] for r in rows], minlength=n)
+    out = {"clearance_m": c.tolist() if np.ptp(c) else float(c[0]), "tuned_level_n": tuned["level"],
+           "tuned_blade": tuned["blade"], "response": "radial at the tip node",
+           "tuned_ratio": {"min": float(ratio.min()), "p5": float(np.percentile(ratio, 5)),
+                           "p50": float(np.percentile(ratio, 50)), "max": float(ratio.max())},
+           "lead": {"p5": float(np.percentile(lead, 5)), "p50": float(np.percentile(lead, 50))},
+           "first_blade_counts": counts.tolist(), "soonest_sample": soonest, "soonest_blade": rows[soonest]["blade"],
+           "soonest_level_n": rows[soonest]["level"], "soonest_peaks": rows[soonest]["peaks"]}
+    log.info("first rub (clearance %s m): the tuned disk rubs at a tip force of %.4g N; mistuned, %.4g (median) to "
+             "%.4g times that (sample %d, blade %d first)", out["clearance_m"], tuned["level"],
+             out["tuned_ratio"]["p50"], out["tuned_ratio"]["min"], soonest, out["soonest_blade"])
+    return out

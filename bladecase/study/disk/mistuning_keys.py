@@ -62,6 +62,15 @@ def _deviations(v) -> str | None:
     return None
 
 
+def _clearance(v) -> str | None:
+    values = v if isinstance(v, list) else [v]
+    ok = all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) and x > 0 for x in values)
+    if not values or not ok:
+        return ("must be the casing clearance at the blade tips (m, > 0): one number for every blade, or a list of "
+                "one per blade (N numbers)")
+    return None
+
+
 #: ``[mistuning]``: key → :class:`~bladecase.study.keys.Key`.
 MISTUNING_KEYS: dict[str, Key] = {
     "std": Key(_NUM, None, "Standard deviation of the blades' relative stiffness deviations (normal, e.g. 0.02): "
@@ -79,6 +88,17 @@ MISTUNING_KEYS: dict[str, Key] = {
     "model": Key(_STR, "snm", "'snm' (subset of nominal modes: the family's tuned modes, the blade's own stiffness "
                  "scaled) or 'fmm' (fundamental mistuning model: the family's strain energy assumed in the blades).",
                  _one_of(*MODELS)),
+    "clearance": Key((int, float, list), None, "The casing clearance at the blade tips (m): one number, or one per "
+                     "blade (N numbers). Given: which blade rubs first as the forcing rises, how soon against the "
+                     "tuned disk, by how much before the next (mistuning_rub.csv).", _clearance),
+    "force": Key(_NUM, None, "With 'clearance': the engine-order force at each blade's tip (N, amplitude) at which "
+                 "every blade's rub is computed — each blade its own massless contact at its tip node, the steady "
+                 "rub at the mistuned disk's resonance (mistuning_contact.csv). Needs [fem] mass = 'lumped'.",
+                 lambda v: None if math.isfinite(v) and v > 0 else "must be a force amplitude > 0 (N)"),
+    "contact_samples": Key(_INT, 10, "With 'force': how many samples (the first ones) are run with contact.",
+                           _int_between(1, MAX_SAMPLES)),
+    "casing_stiffness": Key(_NUM, None, "With 'force': the casing's stiffness at each tip (N/m); default: rigid.",
+                            lambda v: None if math.isfinite(v) and v > 0 else "must be a stiffness > 0 (N/m)"),
     "blade": Key(_STR, None, "For a sector mesh file: the node group of the blade (its cells, those with every node "
                  "in the group, are what mistuning scales). The parametric sector's blade is what lies beyond the "
                  "rim radius.", _name),
@@ -112,6 +132,10 @@ relative stiffness deviation per blade (3 numbers)
     if d is not None and len(d) != sectors:
         raise StudyError(f"[mistuning] deviations: {len(d)} values, but the disk has {sectors} blades: give one "
                          f"relative stiffness deviation per blade ({sectors} numbers)")
+    c = m.get("clearance")
+    if isinstance(c, list) and len(c) != sectors:
+        raise StudyError(f"[mistuning] clearance: {len(c)} values, but the disk has {sectors} blades: give one "
+                         f"clearance (m) for every blade, or one per blade ({sectors} numbers)")
 
 
 def mistuning_checks(c: dict) -> None:
@@ -133,8 +157,8 @@ def mistuning_checks(c: dict) -> None:
                          f"{g.get('kind')!r} geometry: use [geometry] kind = 'sector' (a disk sector with its blade), "
                          "or a sector mesh file with [cyclic]; or remove [mistuning]")
     if (c.get("contact") or {}).get("clearance") is not None:
-        raise StudyError("[mistuning]: the mistuned disk's forced response is linear (no contact yet): remove "
-                         "[contact] (or [mistuning])")
+        raise StudyError("[mistuning]: the mistuned disk's rub is set in [mistuning] itself (clearance: who rubs "
+                         "first; force: how hard each blade rubs), not by [contact]: remove [contact] (or [mistuning])")
     if m["deviations"] is not None:
         both = [k for k in ("std", "samples") if m[k] != MISTUNING_KEYS[k].default]
         if both:
@@ -143,6 +167,11 @@ def mistuning_checks(c: dict) -> None:
     elif m["std"] is None:
         raise StudyError("[mistuning] std: required for random samples (the standard deviation of the blades' "
                          "relative stiffness deviations, e.g. std = 0.02), or give 'deviations' (N numbers)")
+    if m["force"] is not None and m["clearance"] is None:
+        raise StudyError("[mistuning] force: the rub of each blade needs the casing: give [mistuning] clearance (m)")
+    if m["force"] is not None and (c.get("fem") or {}).get("mass") != "lumped":
+        raise StudyError("[mistuning] force: each blade's contact is a massless contact (its tip's mass moved to its "
+                         f"neighbours): [fem] mass = 'lumped', got {(c.get('fem') or {}).get('mass')!r}")
     n = sectors_of(c)
     if n is not None:
         check_deviations(m, n)
