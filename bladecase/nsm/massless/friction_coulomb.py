@@ -108,7 +108,7 @@ class CoulombFlight:
         f = np.zeros(self.n) if load is None else np.asarray(load, dtype=float).reshape(-1)
         if f.shape != (self.n,) or not np.all(np.isfinite(f)):
             raise ValueError(f"load must be a finite vector of the {self.n} interior dofs, got shape {f.shape}")
-        self.fq = self.phi.T @ f
+        self.load, self.fq = f, self.phi.T @ f
         self._phases: dict[bytes, CoulombPhase] = {}
 
     def phase(self, codes: np.ndarray) -> CoulombPhase:
