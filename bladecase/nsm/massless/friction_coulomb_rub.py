@@ -10,7 +10,7 @@ balance of a stick–slip trajectory (:func:`coulomb_energy`) and the rub respon
 (``f`` a constant load; ``z'`` the nodes' tangential velocities: a sticking node moves with the casing, ``z' = V``, so
 friction there feeds the vibration the casing's work ``τV``). With every node sliding along ``+`` it is the balance of
 the rotation model (:mod:`~bladecase.nsm.massless.friction_energy`). The integrals are Gauss–Legendre quadratures on
-each phase's pieces (a quarter of its fastest period), at two orders: their difference is the stated error.
+each phase's pieces (one period of that phase's fastest term), at two orders: their difference is the stated error.
 
 >>> import numpy as np
 >>> from bladecase.nsm import Damping
@@ -40,6 +40,10 @@ __all__ = ["CoulombEnergy", "coulomb_energy", "coulomb_rub_response", "stick_sha
 
 #: Gauss–Legendre orders of the two quadratures (their difference: the stated error).
 ORDERS = (10, 20)
+
+#: Quadrature pieces per period of a phase's fastest term (20 points a period: far beyond round-off for its
+#: exponentials; the two orders' difference says so).
+PIECES_PER_PERIOD = 1
 
 
 @dataclass(frozen=True)
@@ -79,10 +83,18 @@ def coulomb_energy(tr: CoulombTrajectory, t0: float, t1: float) -> CoulombEnergy
     if not (0 <= t0 < t1 <= tr.t_end * (1 + 1e-12)):
         raise ValueError(f"[t0, t1] = [{t0!r}, {t1!r}] must lie in the trajectory's [0, {tr.t_end!r}] with t0 < t1")
     fl = tr.flight
-    fast = max(max(float(np.abs(fl.phase(c).lam).max()) for c in np.unique(tr.codes, axis=0)), fl.nu, 1e-300)
-    h = 2 * np.pi / (4 * fast)
-    cuts = np.r_[t0, tr.starts[(tr.starts > t0) & (tr.starts < t1)], t1]
-    pieces = [np.linspace(a, b, max(1, int(np.ceil((b - a) / h))) + 1) for a, b in zip(cuts[:-1], cuts[1:])]
+    inside = (tr.starts > t0) & (tr.starts < t1)
+    cuts = np.r_[t0, tr.starts[inside], t1]
+    first = max(int(np.searchsorted(tr.starts, t0, side="right")) - 1, 0)
+    held = np.r_[first, np.flatnonzero(inside)]  # the phase holding each piece
+    period = {}
+    for i in held:
+        key = tr.codes[i].tobytes()
+        if key not in period:  # each phase's own fastest term: its pieces that period long
+            fastest = max(float(np.abs(fl.phase(tr.codes[i]).lam).max()), fl.nu, 1e-300)
+            period[key] = 2 * np.pi / (PIECES_PER_PERIOD * fastest)
+    pieces = [np.linspace(a, b, max(1, int(np.ceil((b - a) / period[tr.codes[i].tobytes()]))) + 1)
+              for a, b, i in zip(cuts[:-1], cuts[1:], held)]
     edges = np.unique(np.concatenate(pieces))
     mid, half = 0.5 * (edges[1:] + edges[:-1]), 0.5 * np.diff(edges)
     out = []
