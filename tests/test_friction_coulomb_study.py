@@ -68,3 +68,44 @@ def test_coulomb_at_engine_speed_is_the_rotation_model(blade, tmp_path, caplog):
     text = "\n".join(rub_report(coulomb))
     assert "stick–slip (model 'coulomb')" in text and "share of contact time a node spends sticking" in text
     assert "The sliding is dominated by the rotation" not in text
+
+
+def test_demo_blade_against_a_casing_at_rest_sticks(blade):
+    """The demo blade's tip (26 contact nodes, their normal and tangential compliances from the FE model) released
+    from its first mode against a casing at rest: the nodes stick at each reversal of their sliding, the coupled nodes
+    changing together (a node's change moves its neighbours' sliding velocities); the energy balance closes to 1e-9
+    and Coulomb's law holds all along."""
+    from dataclasses import replace
+
+    import numpy as np
+
+    from bladecase.nsm import Damping
+    from bladecase.nsm.massless.friction_coulomb import CODES, simulate_coulomb
+    from bladecase.nsm.massless.friction_coulomb_rub import coulomb_energy, stick_share
+    from bladecase.reduction.nodal_friction import nodal_friction
+    from bladecase.reduction.nodes import nodal_model
+    from bladecase.study.stages import build_contact
+
+    study = loads(_study(rub=RUB), source="<coulomb>")
+    reduced = nodal_model(blade, build_contact(study, blade), 8, residual=True)
+    axis = study.config["rotation"]["axis"]
+    f = replace(nodal_friction(reduced, 0.15, axis["origin"], axis["direction"]), model="coulomb")
+    s = reduced.system
+    x0 = s.modes[1][:, 0].copy()
+    x0 *= 1.5 * np.min(s.gap / np.abs(s.W.T @ x0)) * np.sign((s.W.T @ x0).sum())
+    period = 2 * np.pi / s.modes[0][0]
+    tr = simulate_coulomb(s, f, x0, np.zeros(s.n), 2 * period, damping=Damping(zeta=0.005), sliding=0.0)
+    share = stick_share(tr, 0.0, 2 * period)
+    assert tr.complete and share.max() > 0.005
+    e = coulomb_energy(tr, 0.0, 2 * period)
+    assert abs(e.relative) < 1e-9 and e.friction < 0 < e.damping
+    t = np.union1d(np.linspace(0.0, 2 * period, 2001), np.minimum(tr.starts + 1e-12 * period, 2 * period))
+    codes = tr.codes[np.searchsorted(tr.starts, t, side="right") - 1].T
+    _, _, lam, tau, _, zd = tr.sample(t)
+    top = lam.max()
+    # within round-off of the coupled compliances' solves (5e-8 of the largest force measured)
+    assert np.all(lam >= -1e-9 * top) and np.all(np.abs(tau) <= 0.15 * lam + 1e-7 * top)
+    slide = (codes == CODES["slip+"]) | (codes == CODES["slip-"])
+    sigma = np.where(codes == CODES["slip+"], 1.0, -1.0)
+    assert np.all(-sigma[slide] * zd[slide] >= -1e-9 * np.abs(zd).max())
+    assert np.all(np.abs(zd[codes == CODES["stick"]]) <= 1e-9 * np.abs(zd).max())

@@ -63,6 +63,10 @@ CODES = {"open": OPEN, "slip+": SLIP_POS, "slip-": SLIP_NEG, "stick": STICK}
 #: Relative size (to the signal's rate terms) below which a signal starting on its surface has a zero slope.
 FLAT_RTOL = 1e-7
 
+#: Relative size (to the signal's terms) within which a signal starting a phase counts as on its surface when the
+#: phase is checked at a switch: the coupled compliances' solves lose a few digits there.
+ADMISSIBLE_RTOL = 1e-6
+
 #: Points at which a second-order start is checked positive over its first flight.
 LEAVE_POINTS = 16
 
@@ -142,50 +146,67 @@ class CoulombFlight:
 
     # ------------------------------------------------------------------ switches
 
-    def _start(self, codes, anchors, q, p, t) -> tuple[RampSignals, np.ndarray, np.ndarray] | None:
-        """The phase ``codes`` started at ``(q, p, t)``: its signals (over a unit horizon, for the check), which
-        start on their surface, and which of those start flat (zero slope, curving up); ``None`` if inadmissible."""
+    def _violations(self, codes, anchors, q, p, t) -> tuple[CoulombPhase, list[int]]:
+        """The phase ``codes`` started at ``(q, p, t)`` and its signals that start inadmissible, the most negative
+        first: below 0, or on their surface and not leaving it (falling, or flat and not curving up)."""
         ph = self.phase(codes)
         amp = ph.amplitudes(q, p, t, anchors)
         sig = ph.signals(self, amp, t, anchors, 0.0)
         f0, d0 = (v[0] for v in sig.values(0.0))
         scale = np.maximum(sig.magnitude, np.finfo(float).tiny)
         rate = np.abs(sig.C) @ np.abs(sig.lam) + np.abs(sig.E) * sig.nu + np.abs(sig.slope)
-        on = np.abs(f0) <= SURFACE_RTOL * scale
-        if np.any(f0[~on] < 0):
-            return None
+        on = np.abs(f0) <= ADMISSIBLE_RTOL * scale
         flat = on & (np.abs(d0) <= FLAT_RTOL * np.maximum(rate, np.finfo(float).tiny))
-        if np.any(on & ~flat & (d0 < 0)) or np.any(flat & (sig.second() <= 0)):
-            return None
-        return sig, on, flat
+        bad = (~on & (f0 < 0)) | (on & ~flat & (d0 < 0)) | (flat & (sig.second() <= 0))
+        order = np.argsort(np.where(on, 0.0, f0 / scale), kind="stable")
+        return ph, [int(k) for k in order if bad[k]]
+
+    def _start(self, codes, anchors, q, p, t) -> bool:
+        """Whether the phase ``codes`` starts admissible at ``(q, p, t)`` (:meth:`_violations`)."""
+        return not self._violations(codes, anchors, q, p, t)[1]
 
     def _anchor(self, ph: CoulombPhase, j: int, q, t: float, anchors) -> float:
         """``z_j(t) − V_j t``: the anchor of node ``j`` sticking from ``t`` (its tangential position continuous)."""
         z = ph.Zq[j] @ q + ph.Zr[j] @ ph.rho(self, t, anchors)
         return float(z - self.V[j] * t)
 
-    def _switch(self, ph: CoulombPhase, k: int, codes, anchors, q, p, t):
-        """The codes and anchors after the signal ``k`` of the phase ``ph`` reached 0 (module docstring)."""
-        j, kind = ph.meta[k]
+    def _options(self, ph: CoulombPhase, j: int, kind: str, codes, p, t: float) -> tuple:
+        """The next states of node ``j`` when its signal ``kind`` of the phase ``ph`` reaches 0, in order."""
         if kind == "gap":
-            zdot = ph.Zq[j] @ p + ph.Zr[j] @ self.rho_rate(t)[:, 0]
-            rel = self.V[j] - zdot
+            rel = self.V[j] - (ph.Zq[j] @ p + ph.Zr[j] @ self.rho_rate(t)[:, 0])
             s = SLIP_POS if rel >= 0 else SLIP_NEG
-            order = (s, STICK, SLIP_POS + SLIP_NEG - s)
-        elif kind == "force":
-            order = (OPEN,)
-        elif kind == "slip":
-            order = (STICK, SLIP_POS + SLIP_NEG - codes[j])  # stick, or the sliding reverses
-        else:
-            order = (SLIP_POS if kind == "cone+" else SLIP_NEG,)
-        for c in order:
-            new, anc = codes.copy(), anchors.copy()
-            new[j] = c
+            return (s, STICK, SLIP_POS + SLIP_NEG - s)
+        if kind == "force":
+            return (OPEN,)
+        if kind == "slip":
+            return (STICK, SLIP_POS + SLIP_NEG - codes[j])  # stick, or the sliding reverses
+        return (SLIP_POS if kind == "cone+" else SLIP_NEG,)
+
+    def _switch(self, ph: CoulombPhase, k: int, codes, anchors, q, p, t):
+        """The codes and anchors after the signal ``k`` of the phase ``ph`` reached 0 (module docstring). The
+        massless nodes are coupled through their compliances: one node's change can make another's signal start
+        inadmissible (a sliding node's relative velocity jumps with its neighbour's force rate); that node then
+        changes too, as its own signal says, until the new phase starts admissible."""
+        j, kind = ph.meta[k]
+        order = self._options(ph, j, kind, codes, p, t)
+
+        def put(node, c, new, anc):
+            new, anc = new.copy(), anc.copy()
+            new[node] = c
             if c == STICK:
-                anc[j] = self._anchor(ph, j, q, t, anchors)
-            started = self._start(new, anc, q, p, t)
-            if started is not None:
-                return new, anc
+                anc[node] = self._anchor(ph, node, q, t, anchors)
+            return new, anc
+
+        for c in order:
+            new, anc = put(j, c, codes, anchors)
+            for _ in range(2 * self.m + 2):
+                cand, bad = self._violations(new, anc, q, p, t)
+                if not bad:
+                    return new, anc
+                i, kind_i = cand.meta[bad[0]]
+                if i == j:  # the switching node itself: its next option
+                    break
+                new, anc = put(i, self._options(cand, i, kind_i, new, p, t)[0], new, anc)
         raise ValueError(f"at t = {t:.12g} s contact node {self.system.nodes[j]} ({kind} signal at 0) has no "
                          f"admissible next state (tried {[_NAMES[c] for c in order]}): a grazing or degenerate switch")
 
@@ -229,7 +250,7 @@ class CoulombFlight:
             if codes.shape != (self.m,) or not np.all(np.isin(codes, list(CODES.values()))):
                 raise ValueError(f"codes must give each of the {self.m} nodes one of {CODES}, got {codes.tolist()}")
             anchors = self._stick_anchors(codes, q, t)
-        if self._start(codes, anchors, q, p, t) is None:
+        if not self._start(codes, anchors, q, p, t):
             raise ValueError(f"the initial state is not admissible with the node codes {codes.tolist()} (a force "
                              "or a clearance negative, or a sliding against its relative velocity)")
         starts, cl, al, qs, ps, amps = [], [], [], [], [], []
