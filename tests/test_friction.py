@@ -236,7 +236,7 @@ def test_bad_inputs_are_named():
     with pytest.raises(ValueError, match="mu must be a finite number >= 0, got nan"):
         Friction(float("nan"), T=np.eye(2))
     with pytest.raises(ValueError, match="valid: rotation"):
-        Friction(0.1, T=np.eye(2), model="coulomb")
+        Friction(0.1, T=np.eye(2), model="stick")
     with pytest.raises(ValueError, match=r"C_nt must be a finite \(2, 2\) array"):
         Friction(0.1, T=np.eye(2), C_nt=np.eye(3))
     with pytest.raises(ValueError, match=r"does not match the system's \(n, m\) = \(2, 2\)"):

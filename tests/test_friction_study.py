@@ -97,7 +97,6 @@ def test_friction_zero_is_the_rub_without_friction_bit_for_bit(blade, plain, wit
 
 
 @pytest.mark.parametrize("friction, rub, match", [
-    ('{mu = 0.15, model = "coulomb"}', RUB, r"stick–slip\) is not available yet; what is: model = \"rotation\""),
     ("{mu = -0.1}", RUB, r"mu must be a finite number in \[0, 2\]"),
     ("{model = \"rotation\"}", RUB, r"needs mu"),
     ("{mu = 0.1, law = 1}", RUB, r"unknown key 'law'"),

@@ -29,7 +29,9 @@ has contact phases of finite duration instead of impacts. One module per step:
   :mod:`~bladecase.nsm.massless.friction_energy` — the energy balance with friction, per revolution, and the rub
   with friction (:func:`energy_balance`, :func:`friction_rub`), and :mod:`~bladecase.nsm.massless.friction_modes` —
   a mode's frequency and damping ratio with friction by the extended periodic motion concept
-  (:func:`friction_mode`);
+  (:func:`friction_mode`), and :mod:`~bladecase.nsm.massless.friction_coulomb` — stick–slip Coulomb friction, the
+  sliding speed free to vanish (:func:`simulate_coulomb`: each node open, sliding either way or sticking, every
+  combination a linear phase flown exactly);
 - :mod:`~bladecase.nsm.massless.wear` — an abradable coating round the casing worn by the tip (:class:`Abradable`,
   :class:`WearProfile`, :func:`pass_tip`);
 - :mod:`~bladecase.nsm.massless.rub` — the rub response of a turning blade at one speed and over speeds
@@ -60,6 +62,7 @@ from .friction import (
     simulate_friction,
     sliding_check,
 )
+from .friction_coulomb import CoulombFlight, CoulombTrajectory, simulate_coulomb
 from .friction_energy import FrictionEnergy, energy_balance, per_revolution
 from .friction_modes import FrictionMode, decay_ratio, friction_mode
 from .friction_rub import FrictionRub, friction_rub
@@ -111,7 +114,7 @@ __all__ = [
     # friction, friction_energy, wear
     "FRICTION_MODELS", "Friction", "FrictionFlight", "SlidingCheck", "friction_flight", "lemke", "simulate_friction",
     "sliding_check", "FrictionEnergy", "FrictionRub", "energy_balance", "friction_rub", "per_revolution",
-    "FrictionMode", "decay_ratio", "friction_mode",
+    "FrictionMode", "decay_ratio", "friction_mode", "CoulombFlight", "CoulombTrajectory", "simulate_coulomb",
     "Abradable", "Profile", "WearProfile", "WearRub", "pass_tip", "vibration_ratio", "wear_rub",
     # bar
     "CONTACT_MODELS", "bar", "bar_continuum_band_energy", "bar_continuum_energy", "bar_continuum_field",

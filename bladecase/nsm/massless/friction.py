@@ -61,8 +61,9 @@ from .nodes import (
 __all__ = ["FRICTION_MODELS", "SLIDING_RATIO", "Friction", "FrictionFlight", "SlidingCheck", "friction_flight",
            "lemke", "simulate_friction", "sliding_check"]
 
-#: The friction models the solver flies.
-FRICTION_MODELS = ("rotation",)
+#: The friction models: ``"rotation"`` flown here, ``"coulomb"`` (stick–slip) by
+#: :mod:`~bladecase.nsm.massless.friction_coulomb`.
+FRICTION_MODELS = ("rotation", "coulomb")
 
 #: ``max|z'_j| / ΩR_j`` above which the rotation-dominated sliding is not a safe assumption at node ``j``.
 SLIDING_RATIO = 0.1
@@ -87,7 +88,8 @@ class Friction:
     radius : (m,) array_like or None
         Each node's radius about the engine axis (m), for :func:`sliding_check`.
     model : str
-        ``"rotation"`` (the one flown: :data:`FRICTION_MODELS`).
+        ``"rotation"`` (flown here) or ``"coulomb"`` (stick–slip: :func:`~bladecase.nsm.massless.friction_coulomb.
+        simulate_coulomb`): :data:`FRICTION_MODELS`.
 
     >>> Friction(0.15, T=np.ones((3, 2))).mu
     0.15
@@ -110,7 +112,7 @@ class Friction:
         if not number or not np.isfinite(mu) or mu < 0:
             raise ValueError(f"friction coefficient mu must be a finite number >= 0, got {mu!r}")
         if self.model not in FRICTION_MODELS:
-            raise ValueError(f"friction model {self.model!r} is not flown here (valid: {', '.join(FRICTION_MODELS)})")
+            raise ValueError(f"friction model {self.model!r} is not known (valid: {', '.join(FRICTION_MODELS)})")
         T = np.asarray(self.T, dtype=float)
         T = T.reshape(-1, 1) if T.ndim == 1 else T
         if T.ndim != 2 or not np.all(np.isfinite(T)):
@@ -260,6 +262,9 @@ class FrictionFlight(NodalFlight):
         if not isinstance(friction, Friction):
             raise ValueError(f"friction must be a Friction, got {type(friction).__name__}")
         friction.check(system)
+        if friction.model != "rotation":
+            raise ValueError(f"friction model {friction.model!r} is flown by bladecase.nsm.massless.friction_coulomb "
+                             "(simulate_coulomb), not by FrictionFlight (the rotation model)")
         self.friction = friction
         self.Tq = self.phi.T @ friction.T
         self.H_mu = friction.H(system)

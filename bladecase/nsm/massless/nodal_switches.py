@@ -174,14 +174,17 @@ def first_switch(sig: _Signals, horizon: float, on: np.ndarray, chunk: int = 256
             js = np.flatnonzero(U[i])
             a = float(tau[i])
             late = starts[js] > a  # the interval holding a signal's start: searched from there
+            best = None  # the earliest root among them (several signals may start on their surfaces at once)
             for j in js[late]:
                 row = sig.row(j)
                 fs, ds = (float(v) for v in row(float(starts[j])))
                 root = _search(row, float(B2[j]), float(hmin[j]), float(starts[j]), float(tau[i + 1]), fs,
                                float(F[i + 1, j]), ds, float(D[i + 1, j]), _newton)
-                if root is not None:
-                    early = _earliest(sig, B2, hmin, a, float(root), js[~late])
-                    return early if early is not None else (float(root), int(j))
+                if root is not None and (best is None or root < best[0]):
+                    best = (float(root), int(j))
+            if best is not None:
+                early = _earliest(sig, B2, hmin, a, best[0], js[~late])
+                return early if early is not None else best
             js = js[~late]
             if js.size:
                 hit = _many(sig, B2, hmin, a, float(tau[i + 1]), js, F[i, js], F[i + 1, js], D[i, js], D[i + 1, js])

@@ -179,6 +179,12 @@ def _friction_lines(f: dict | None, unit: str) -> list[str]:
                    f"damping takes {top['damping_j']:.4g} J and the stored energy changes by "
                    f"{top['stored_change_j']:.4g} J; the balance closes to {f['worst_residual']:.1e} (relative, worst "
                    "revolution of every speed's window; `rub.csv` gives every speed).")
+    if f.get("model") == "coulomb":
+        if rows:
+            out.append("- Stick–slip, the share of contact time a node spends sticking to the casing (largest over the "
+                       "nodes): " + ", ".join(f"{r['stick_share']:.3g} at {r['speed']:.6g} {unit}" for r in rows)
+                       + ".")
+        return out
     bad = f.get("not_rotation_dominated") or []
     if bad:
         out.append(f"- **The sliding is not dominated by the rotation** at {', '.join(f'{s:.6g}' for s in bad)} "

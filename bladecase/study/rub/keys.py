@@ -2,10 +2,10 @@
 ``[casing] abradable`` (tables), their checks, and the cross-checks with the ``[rub]`` stage that uses them
 (:func:`friction_checks`).
 
->>> _friction({"mu": 0.15}) is None
-True
->>> _friction({"mu": 0.15, "model": "coulomb"})[:60]
-'model = "coulomb" (stick–slip) is not available yet; what is'
+>>> _friction({"mu": 0.15}) is None, _friction({"mu": 0.15, "model": "coulomb"}) is None
+(True, True)
+>>> _friction({"mu": 0.15, "model": "stick"})
+"model must be 'rotation' or 'coulomb', got 'stick'"
 """
 
 from __future__ import annotations
@@ -16,12 +16,8 @@ from ..keys import Key, StudyError
 
 __all__ = ["ABRADABLE_KEY", "FRICTION_KEY", "FRICTION_MODELS", "friction_checks"]
 
-#: The friction models a study may ask for, and those flown today.
+#: The friction models a study may ask for.
 FRICTION_MODELS = ("rotation", "coulomb")
-
-_ROTATION = ('model = "rotation" (Coulomb friction with the sliding dominated by the rotation: the tip slides at '
-             "ΩR, far faster than it vibrates, so the force is mu·λ along the casing's motion; checked per node "
-             "and speed)")
 
 
 def _number(v) -> bool:
@@ -40,9 +36,6 @@ def _friction(v: dict) -> str | None:
     model = v.get("model", "rotation")
     if model not in FRICTION_MODELS:
         return f"model must be 'rotation' or 'coulomb', got {model!r}"
-    if model == "coulomb":
-        return ('model = "coulomb" (stick–slip) is not available yet; what is: ' + _ROTATION
-                + "; a slow speed or a casing at rest, where the sliding speed can vanish, is outside it")
     return None
 
 
@@ -66,7 +59,8 @@ def _abradable(v: dict) -> str | None:
 
 FRICTION_KEY = Key((dict,), None, "Coulomb friction at each contact node of the [rub] response: {mu = 0.15, model = "
                    "'rotation'} ('rotation': the sliding dominated by the rotation, ΩR ≫ the vibration velocity, "
-                   "checked per node and speed; 'coulomb' stick–slip is not available yet); default: none.", _friction)
+                   "checked per node and speed; 'coulomb': stick–slip, each touching node sliding either way or "
+                   "sticking to the casing, for a slow speed); default: none.", _friction)
 
 ABRADABLE_KEY = Key((dict,), None, "An abradable coating on the casing, worn by the [rub] response: {thickness (m), "
                     "yield (Pa: the contact pressure at which it is removed), stiffness (Pa/m), cells (round the "
@@ -84,6 +78,9 @@ def friction_checks(c: dict) -> None:
             raise StudyError("[contact] friction: it acts in the rub response: give [rub] speeds (with an out-of-round "
                              "[casing]), or remove friction")
         ct["friction"] = {"mu": float(fr["mu"]), "model": fr.get("model", "rotation")}
+        if ct["friction"]["model"] == "coulomb" and ab is not None:
+            raise StudyError('[contact] friction: model = "coulomb" (stick–slip) is not run with a [casing] abradable '
+                             'coating; use model = "rotation" with the coating, or remove abradable')
     if ab is not None:
         if not rub:
             raise StudyError("[casing] abradable: the coating is worn by the rub response: give [rub] speeds, or "

@@ -34,16 +34,20 @@ from ... import log
 from ...fe.rotation import SPEED_UNITS, RotationAxis, spin, to_rad_s
 from ...io import csv_cell, save_figure, write_text
 from ...nsm.damping import Damping
-from ...nsm.massless.friction import friction_flight
-from ...nsm.massless.nodes import Rub
 from ...nsm.massless.rub import RUN_ON_FACTOR, rub_response
 from ...nsm.massless.wear_rub import wear_rub
 from ...reduction.contact import Contact
-from ...reduction.nodal_friction import nodal_friction
 from ...reduction.nodes import chord_positions, contact_pressure, nodal_model
 from ..keys import StudyError
 from .contact import check_rub_contact, contact_measure
-from .friction import FRICTION_COLUMNS, friction_columns, friction_section, friction_words, log_friction
+from .friction import (
+    FRICTION_COLUMNS,
+    friction_columns,
+    friction_response,
+    friction_section,
+    friction_words,
+    log_friction,
+)
 from .wear import coating_of, log_wear, wear_figures, wear_section, write_wear
 
 __all__ = ["check_rub_contact", "contact_measure", "crossing_speed", "node_angles", "rub_stage"]
@@ -154,11 +158,9 @@ def _rub_point(speed: float, *, model, contact: Contact, interior: np.ndarray, s
     own = interior if state.static != "nonlinear" else None
     reduced = nodal_model(state.model, hot, size, factor=state.factor, casing=casing, interior=own, residual=True)
     try:
-        fr = None if friction is None else nodal_friction(reduced, friction["mu"], axis.origin, axis.direction,
-                                                          factor=state.factor if reduced.residual else None)
-        flight = friction_flight(reduced.system, fr, damping, Rub(lobes, amplitude, speed, angles))
-        response = rub_response(reduced.system, speed, lobes, amplitude, angles, damping, revolutions, window,
-                                areas=reduced.areas, max_revolutions=max_revolutions, friction=fr, flight=flight)
+        fr, flight, response = friction_response(reduced, friction, axis, state.factor, speed, lobes, amplitude,
+                                                 angles, damping, revolutions, window, max_revolutions,
+                                                 respond=rub_response)
         worn = None if coating is None else wear_rub(reduced.system, coating, speed, lobes, amplitude, angles,
                                                      damping, revolutions, areas=reduced.areas, friction=fr,
                                                      flight=flight)
