@@ -155,4 +155,4 @@ __all__ = [
     # study
     "RunResult", "Study", "StudyError", "demo_study", "load_study", "run",
 ]
-__version__ = "0.7.0"
+__version__ = "0.8.0"
