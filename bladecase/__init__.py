@@ -10,6 +10,23 @@ The package is laid out as the pipeline it runs (see ``docs/architecture.md``):
 - :mod:`bladecase.post` — plots, animations, VTK, reports;
 - :mod:`bladecase.study` — TOML studies run through every stage; :mod:`bladecase.cli` on top.
 
+Each package's ``__init__`` docstring is its module map. Beside the packages, the shared modules, which belong to
+no stage:
+
+- :mod:`bladecase.linalg` — the one SPD factorisation (CHOLMOD where installed, else SuperLU; chosen in
+  ``factor_backend()``) and the one lowest-modes solver; a factorisation is passed on and reused, never recomputed;
+- :mod:`bladecase.linalg_backends` — the sparse factorisations: SuperLU, scikit-sparse's and cvxopt's CHOLMOD;
+- :mod:`bladecase.linalg_block` — block shift-invert Lanczos for a CHOLMOD factor;
+- :mod:`bladecase.threads` — how many BLAS threads a stage may use on a busy machine;
+- :mod:`bladecase.checks` — validators that name the value and what would be valid;
+- :mod:`bladecase.io` — atomic files and folder swaps;
+- :mod:`bladecase.progress` — tqdm's plain bar, or nothing when ``progress=False``;
+- :mod:`bladecase.log` — messages to the ``bladecase`` logger and into a run's own transcript;
+- :mod:`bladecase.registry` — the one ``Registry`` behind reduction methods and output formats;
+- :mod:`bladecase.cli` — argparse over the study stages, the only place that configures logging;
+  :mod:`bladecase.cli_input` (argument types, input files, outputs that would overwrite an input) and
+  :mod:`bladecase.cli_backbone` (the ``backbone`` command) beside it; ``python -m bladecase`` runs it.
+
 Every public name is re-exported here:
 
 >>> import bladecase as bc

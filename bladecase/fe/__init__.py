@@ -3,23 +3,58 @@
 Data in: a parametric geometry or a mesh file. Data out: an :class:`FEModel` (sparse ``K``, ``M`` on the
 free dofs, the dof map) for the reduction layer.
 
-Modules: :mod:`~bladecase.fe.naca` (sections), :mod:`~bladecase.fe.geometry` (parametric blades,
-:func:`blade_mesh`), :mod:`~bladecase.fe.cad` (gmsh bodies), :mod:`~bladecase.fe.mesh` (:class:`Mesh`, files),
-:mod:`~bladecase.fe.cells` (accepted cell types: tetrahedra, hexahedra, wedges, triangles, quadrilaterals),
-:mod:`~bladecase.fe.groups` (named groups of mesh files), :mod:`~bladecase.fe.quality` (cell checks),
-:mod:`~bladecase.fe.select` (:func:`select_nodes`: nodes by group name or coordinates),
-:mod:`~bladecase.fe.material` (:class:`Material`, presets), :mod:`~bladecase.fe.model` (:class:`FEModel`,
-:class:`DofMap`), :mod:`~bladecase.fe.assembly` (:func:`assemble`), :mod:`~bladecase.fe.isoparametric` (the
-curved map of quadratic cells through their midside nodes), :mod:`~bladecase.fe.refine` (:func:`refine_mesh`: a
-mesh's cells split, every edge in ``n``), :mod:`~bladecase.fe.rotation`
-(:func:`~bladecase.fe.rotation.spin`), :mod:`~bladecase.fe.nonlinear_static` (:func:`nonlinear_state`: the
-geometrically nonlinear static state, large rotations), :mod:`~bladecase.fe.campbell` (frequencies against speed),
-:mod:`~bladecase.fe.eigen` (:func:`natural_frequencies`, :func:`stiffness_factor`),
-:mod:`~bladecase.fe.storage` (stage files), :mod:`~bladecase.fe.calculix` (the model as a CalculiX deck, its
-frequencies back), :mod:`~bladecase.fe.cyclic` (:func:`fe_sector`, :func:`cyclic_modes`: a bladed disk's modes by
-nodal diameter from one sector) + :mod:`~bladecase.fe.cyclic_waves` (a sector mode on the whole disk, standing or
-travelling) + :mod:`~bladecase.fe.cyclic_spin` (a spinning disk from one sector, Campbell per nodal diameter),
-:mod:`~bladecase.fe.sector` (:func:`sector_mesh`: a parametric bladed-disk sector).
+Module map, one entry per module (the details are in each module's own docstring):
+
+- :mod:`~bladecase.fe.geometry` — parametric blades and plates meshed by gmsh (:func:`blade_mesh`); the
+  cell-count estimate that refuses a runaway size;
+- :mod:`~bladecase.fe.shapes` — :class:`BladeGeometry`, :class:`PlateGeometry`: the shapes and their checks;
+- :mod:`~bladecase.fe.naca` — NACA 4-digit sections;
+- :mod:`~bladecase.fe.cad` — gmsh bodies;
+- :mod:`~bladecase.fe.sector` — :func:`sector_mesh`: a parametric bladed-disk sector;
+- :mod:`~bladecase.fe.mesh` — :class:`Mesh`, files through meshio; the formats meshio lacks registered once
+  (``_register_types``);
+- :mod:`~bladecase.fe.mesh_checks` — a mesh checked where it enters (a regular complete file, a plausible extent,
+  cells that refer to existing nodes, no unmerged nodes); :class:`~bladecase.fe.mesh_checks.DeckError`, the base of
+  the format readers' errors, and ``SNIFFERS``, the formats' content sniffers, which the readers register: it
+  imports no format;
+- :mod:`~bladecase.fe.cdb` — ANSYS archives, registered with meshio;
+- :mod:`~bladecase.fe.abaqus` — Abaqus and CalculiX decks whatever their suffix (``*INCLUDE``, sets, ``*BOUNDARY``
+  node lists as groups, the file's node numbers kept);
+- :mod:`~bladecase.fe.abaqus_sets` — what a deck's records mean: its numbering, the ``*BOUNDARY`` groups, the
+  body's material;
+- :mod:`~bladecase.fe.abaqus_write` — decks written for CalculiX;
+- :mod:`~bladecase.fe.calculix` — the model as a CalculiX deck, its frequencies back;
+- :mod:`~bladecase.fe.groups` — named node groups of each format;
+- :mod:`~bladecase.fe.cells` — the accepted body cell types (tetrahedra, hexahedra, wedges, triangles,
+  quadrilaterals): node layouts, orientation, scikit-fem element;
+- :mod:`~bladecase.fe.wedge_element` — the quadratic prisms scikit-fem lacks (15-node serendipity, 18-node
+  Lagrange);
+- :mod:`~bladecase.fe.isoparametric` — quadratic cells curved through their midside nodes;
+- :mod:`~bladecase.fe.refine` — :func:`refine_mesh`: a mesh's cells split, every edge in ``n``, on the cells' own
+  map, the named groups carried (the finer meshes of ``[convergence]`` for a mesh file);
+- :mod:`~bladecase.fe.select` — :func:`select_nodes`: a group, or nodes by plane, box, sphere or nearest;
+- :mod:`~bladecase.fe.quality` — cell checks;
+- :mod:`~bladecase.fe.material` — :class:`Material`, presets; a mesh file's own material converted to SI;
+- :mod:`~bladecase.fe.model` — :class:`FEModel`, :class:`DofMap`;
+- :mod:`~bladecase.fe.assembly` — :func:`assemble`: scikit-fem ``K``, ``M``;
+- :mod:`~bladecase.fe.eigen` — :func:`natural_frequencies`, :func:`stiffness_factor`;
+- :mod:`~bladecase.fe.centrifugal` — the rotating frame: ``RotationAxis``, speed units, a model's centrifugal
+  operators at unit speed (the type that :mod:`~bladecase.fe.rotation` and
+  :mod:`~bladecase.fe.nonlinear_static` share);
+- :mod:`~bladecase.fe.rotation` — ``spin``: a model linearised about its centrifugal state (stress stiffening,
+  spin softening) at one speed;
+- :mod:`~bladecase.fe.nonlinear_static` — :func:`nonlinear_state`: the geometrically nonlinear centrifugal state
+  (total Lagrangian St-Venant–Kirchhoff, follower load) and its full tangent, as CalculiX's NLGEOM;
+- :mod:`~bladecase.fe.stress` — ``nodal_stress`` (each element's stress at its nodes, averaged), ``stress_modes``
+  (many displacements in one pass), ``von_mises``;
+- :mod:`~bladecase.fe.campbell` — frequencies against speed, modes followed by MAC, engine-order crossings;
+- :mod:`~bladecase.fe.cyclic` — :func:`fe_sector`, :func:`cyclic_modes`: a bladed disk's sector, its cyclic faces
+  matched by rotation, modes per nodal diameter with one factorisation each;
+- :mod:`~bladecase.fe.cyclic_waves` — a sector mode on the whole disk: standing and forward/backward travelling
+  waves, the annulus as one mesh;
+- :mod:`~bladecase.fe.cyclic_spin` — the sector's centrifugal state with its faces tied, Campbell per nodal
+  diameter;
+- :mod:`~bladecase.fe.storage` — stage files.
 """
 
 from .assembly import assemble

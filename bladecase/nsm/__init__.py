@@ -3,44 +3,44 @@
 Data in: a :class:`LinearSystem` (from a chain, a reduced model or a full FE model — the solver never
 knows which). Data out: periodic orbits, branches (nonsmooth modes) and simulated trajectories.
 
-Each contact model has its own subpackage — :mod:`bladecase.nsm.newton` (Newton's impact law, the impulsive
-model) and :mod:`bladecase.nsm.massless` (the massless contact model); what both share lives here. The pipeline
-inside, one module per step:
+One subpackage per contact model, the rest shared: :mod:`bladecase.nsm.newton` (Newton's impact law, the
+impulsive model) and :mod:`bladecase.nsm.massless` (the massless contact model: contact phases, the several-node
+system, rub, wear and friction), each with its own module map. A model's subpackage imports the shared modules
+here, never another model; a piece two models need moves here. The shared modules that dispatch on the model
+(:mod:`~bladecase.nsm.modes`, :mod:`~bladecase.nsm.sweep`, :mod:`~bladecase.nsm.branches`,
+:mod:`~bladecase.nsm.verify`, :mod:`~bladecase.nsm.energy`) import the subpackages; this package re-exports the
+public names of all three. The shared :mod:`~bladecase.nsm.branches` uses the Newton model's orbit types and
+:mod:`bladecase.nsm.newton.scan` builds :class:`Branch` es, so the subpackages are imported first below (an
+``isort: split`` keeps that order).
 
-- :mod:`~bladecase.nsm.system` — :class:`LinearSystem`, its contact :class:`Spectrum`, :func:`chain`;
-- :mod:`~bladecase.nsm.newton.modal` — :class:`ModalKernel` (periodic impulse response at a period) and the k-ipp
-  equations: :func:`impact_matrices`, :func:`kipp_residual`, :func:`kipp_jacobian`, :func:`newton_times`,
-  :func:`solve_times`;
+Orbits and branches hold a reference to their system but pickle without it (:meth:`Branch.bind`,
+:meth:`Branch.compact`); a branch is serialised in one place, :meth:`Branch.to_dict` / :meth:`Branch.from_dict`.
+
+Module map of the shared modules, one entry per module (the details are in each module's own docstring):
+
+- :mod:`~bladecase.nsm.system` — :class:`LinearSystem` (the type that carries a linear system between stages),
+  its contact :class:`Spectrum`, :func:`chain`;
 - :mod:`~bladecase.nsm.signals` — certified bounds and first roots of trigonometric sums;
-- :mod:`~bladecase.nsm.newton.orbits` — :class:`PeriodicOrbit` (a small record; pickles without its system),
-  :func:`make_orbit` (certified admissibility), :func:`orbit_1ipp`;
-- :mod:`~bladecase.nsm.newton.kipp` — every k-ipp orbit at one period: :func:`orbits_kipp`;
-- :mod:`~bladecase.nsm.continuation` — pseudo-arclength following of ``R(z) = 0`` for any residual with an
-  exact Jacobian (:class:`Curve`, :func:`trace`, :func:`bisect`);
-- :mod:`~bladecase.nsm.newton.families` — the k-ipp residual as such a curve (:class:`KippCurve`);
-- :mod:`~bladecase.nsm.arcs` — the period range of a mode search and the admissible arcs along a followed curve,
-  for either contact model;
-- :mod:`~bladecase.nsm.branches` — :class:`Branch` and :class:`Arc`, the one result type of
-  :func:`nonsmooth_mode` (:mod:`~bladecase.nsm.modes`: continuation, any k, either contact model) and
-  :func:`backbone` (:mod:`~bladecase.nsm.newton.scan`, 1-ipp scan);
-  ``Family``, ``Backbone``, ``Interval`` are their former names;
-- :mod:`~bladecase.nsm.newton.flight` and :mod:`~bladecase.nsm.newton.simulation` — the event-driven simulator:
-  a flight propagator (:class:`ModalFlight`), an impact law (:class:`NewtonImpact`), the event loop
-  (:func:`integrate`) and :func:`simulate`;
-- :mod:`~bladecase.nsm.newton.forced` (+ :mod:`~bladecase.nsm.damped_signals`) — forced–damped exact flight and
-  simulation (:func:`simulate_forced`); :mod:`~bladecase.nsm.damping` — :class:`Damping` and
-  :class:`EnergyBalance`, either contact model; :mod:`~bladecase.nsm.sweep` — forcing-period sweeps
-  with steady-state detection and classification (:func:`forced_sweep`), either contact model;
-  :mod:`~bladecase.nsm.massless.forced` — the massless contact model forced and damped
-  (:func:`simulate_forced_massless`);
+- :mod:`~bladecase.nsm.continuation` — pseudo-arclength following of ``R(z) = 0`` for any residual with an exact
+  Jacobian (:class:`Curve`, :func:`trace`, :func:`bisect`);
+- :mod:`~bladecase.nsm.arcs` — a mode search's period range and the admissible arcs along a followed curve, for
+  either contact model;
+- :mod:`~bladecase.nsm.branches` — :class:`Branch` and :class:`Arc`: one type for backbones and k-ipp families
+  (``Family``, ``Backbone``, ``Interval`` are its former names);
+- :mod:`~bladecase.nsm.modes` — :func:`nonsmooth_mode`: continuation, any k, either contact model;
 - :mod:`~bladecase.nsm.verify` — the independent check of an orbit by simulation (:func:`verify`);
 - :mod:`~bladecase.nsm.floquet` — stability: monodromy with saltation matrices, multipliers, a verdict
   (:func:`floquet`, :func:`branch_stability`, :func:`stable_arcs`);
-- :mod:`~bladecase.nsm.energy` — where an orbit's energy sits (:func:`~bladecase.nsm.energy.modal_energy_split`);
-- :mod:`~bladecase.nsm.massless.model`, :mod:`~bladecase.nsm.massless.orbits` (one contact phase),
-  :mod:`~bladecase.nsm.massless.phases` (any number: :class:`PhasedOrbit`), :mod:`~bladecase.nsm.massless.follow`
-  and :func:`massless_mode` (:mod:`~bladecase.nsm.massless.branches`: a mode followed through phase changes),
-  :mod:`~bladecase.nsm.massless.bar` — the massless contact model (theory §8).
+- :mod:`~bladecase.nsm.energy` — an orbit's energy split over its system's linear modes;
+- :mod:`~bladecase.nsm.damped_signals` — forced–damped exact flight, its certified first contact;
+- :mod:`~bladecase.nsm.damping` — :class:`Damping`, :class:`EnergyBalance`, the forcing inputs, either contact
+  model;
+- :mod:`~bladecase.nsm.sweep` — forcing-period sweeps with steady-state detection and classification
+  (:func:`forced_sweep`), either contact model.
+
+Where to start: :func:`chain` or :func:`bar` for a small system, :func:`nonsmooth_mode` for its modes,
+:func:`verify` and :func:`floquet` for their checks, :func:`simulate` (Newton) and :func:`simulate_forced` /
+:func:`simulate_forced_massless` for time responses.
 """
 
 # The contact models' subpackages first: bladecase.nsm.newton.scan imports the shared .branches, which imports

@@ -13,8 +13,11 @@ has contact phases of finite duration instead of impacts. One module per step:
   (:func:`follow_mode`);
 - :mod:`~bladecase.nsm.massless.branches` — the modes as :class:`~bladecase.nsm.branches.Branch` es
   (:func:`massless_modes`, :func:`massless_mode`);
+- :mod:`~bladecase.nsm.massless.orbit_at` — an orbit of a computed branch at any period
+  (:func:`massless_orbit_at`), solved from its interpolated neighbours;
 - :mod:`~bladecase.nsm.massless.nodal_system` — several contacts, one per contact node (:class:`NodalSystem`):
-  the complementarity of their forces (:func:`lcp`), the clearances of an out-of-round casing (:class:`Rub`);
+  the complementarity of their forces (:func:`lcp`), the clearances of an out-of-round casing (:class:`Rub`), a
+  worn casing's clearance profile whose steps the flights cut at (:class:`Profile`);
 - :mod:`~bladecase.nsm.massless.nodes` — its phases (sets of closed contacts) and the exact event-driven simulator
   (:func:`simulate_nodes`), damped, each phase's first switch found by :mod:`~bladecase.nsm.massless.nodal_switches`;
 - :mod:`~bladecase.nsm.massless.nodal_orbit` — a period's flow of a :class:`NodalSystem` with its exact Jacobian
@@ -29,11 +32,21 @@ has contact phases of finite duration instead of impacts. One module per step:
   :mod:`~bladecase.nsm.massless.friction_energy` — the energy balance with friction, per revolution, and the rub
   with friction (:func:`energy_balance`, :func:`friction_rub`), and :mod:`~bladecase.nsm.massless.friction_modes` —
   a mode's frequency and damping ratio with friction by the extended periodic motion concept
-  (:func:`friction_mode`), and :mod:`~bladecase.nsm.massless.friction_coulomb` — stick–slip Coulomb friction, the
-  sliding speed free to vanish (:func:`simulate_coulomb`: each node open, sliding either way or sticking, every
-  combination a linear phase flown exactly);
+  (:func:`friction_mode`); :mod:`~bladecase.nsm.massless.friction_rub` — the rub with friction over revolutions,
+  each revolution's energy balance and the sliding check (:func:`friction_rub`);
+  :mod:`~bladecase.nsm.massless.friction_coulomb` (with ``friction_coulomb_phase`` and ``friction_coulomb_rub``) —
+  stick–slip Coulomb friction, the sliding speed free to vanish (:func:`simulate_coulomb`: each node open, sliding
+  either way or sticking, every combination a linear phase flown exactly); further friction models sit beside
+  them, in modules named ``friction*``;
 - :mod:`~bladecase.nsm.massless.wear` — an abradable coating round the casing worn by the tip (:class:`Abradable`,
-  :class:`WearProfile`, :func:`pass_tip`);
+  :class:`WearProfile`, :func:`pass_tip`), elastic–perfectly plastic: the profile each tip passage leaves;
+- :mod:`~bladecase.nsm.massless.wear_rub` — the rub that wears the coating: each revolution flown against the
+  profile the previous ones left (:func:`wear_rub`);
+- :mod:`~bladecase.nsm.massless.disk_modes` — travelling-wave nonsmooth modes of a tuned bladed disk: shooting over
+  a fraction of the period against the blade shift, checked on the whole disk without the symmetry, with its
+  Floquet multipliers;
+- :mod:`~bladecase.nsm.massless.disk_forced` — the forced rub of a (mistuned) disk, the harmonic load as a moving
+  clearance, each blade's settled peak contact force;
 - :mod:`~bladecase.nsm.massless.rub` — the rub response of a turning blade at one speed and over speeds
   (:func:`rub_response`, :func:`rub_sweep`);
 - :mod:`~bladecase.nsm.massless.forced` — forced and damped simulation (:func:`simulate_forced_massless`;

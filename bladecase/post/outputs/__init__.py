@@ -1,5 +1,14 @@
 """Output formats of a study run, one file per format and one registration each (see :mod:`.registry`).
 
+A format is a module with ``write(scene, folder, formats) -> dict`` (scope ``"run"``: a ``PlotScene``; scope
+``"orbit"``: an ``OrbitScene``) and one :func:`register` line below; the study schema's ``[output] formats``
+follow :data:`FORMATS`.
+
+- :mod:`~bladecase.post.outputs.registry` — the registry of formats, its scenes and scopes;
+- :mod:`~bladecase.post.outputs.animation` — ``gif`` and ``mp4``: each chosen orbit animated on the blade;
+- :mod:`~bladecase.post.outputs.vtu` — ``vtu``: ParaView time series and manifold samples;
+- :mod:`~bladecase.post.outputs.png` — ``png``: the frequency–energy plot of every model.
+
 >>> list(FORMATS)
 ['gif', 'mp4', 'vtu', 'png']
 >>> FORMATS.entry("vtu").scope

@@ -31,11 +31,16 @@
     a :class:`~bladecase.nsm.MasslessSystem` (:func:`bladecase.reduction.massless_model`, which checks ``size``
     itself: registered with ``sized=False``).
 
+:mod:`.common` holds what the methods share: the constraint vector, size checks, Galerkin projection,
+:data:`FULL_LIMIT`.
+
 Every method but ``"full"`` works on sparse matrices only (no dense
 ``n × n`` array), so the ~100k-dof blades of the FE front end reduce in
 seconds; see ``benchmarks/bench_reduction.py``.
 
-Adding a method = one new file here + one registration line below (see :mod:`bladecase.reduction.registry`).
+Adding a method = one new file here with ``build(model, contact, size, factor=None) -> ReducedModel`` + one
+registration line below (see :mod:`bladecase.reduction.registry`); the study schema's valid methods follow
+:data:`METHODS`. A method that takes a compliant casing is registered with ``casing=True``.
 This module also keeps the old import path ``bladecase.reduction.methods`` of :func:`reduce`,
 :class:`ReducedModel`, :data:`METHODS`, :data:`FULL_LIMIT`, :func:`save_reduced` and :func:`load_reduced`.
 """

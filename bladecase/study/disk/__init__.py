@@ -9,5 +9,8 @@ the key modules, so this package's ``__init__`` imports nothing.
 - :mod:`~bladecase.study.disk.cyclic_keys` — the ``[cyclic]`` section;
 - :mod:`~bladecase.study.disk.mistuning` — the reduced mistuning model from the study's own sector, samples through
   the executor, ``mistuning.csv``, ``mistuning.png``, Whitehead's bound;
-- :mod:`~bladecase.study.disk.mistuning_keys` — the ``[mistuning]`` section.
+- :mod:`~bladecase.study.disk.mistuning_keys` — the ``[mistuning]`` section;
+- :mod:`~bladecase.study.disk.nonsmooth` — ``[cyclic] nonsmooth``: the disk's travelling-wave nonsmooth modes,
+  ``disk_modes.csv``, their return and stability, the annulus animation;
+- :mod:`~bladecase.study.disk.mistuning_contact` — the mistuned disk's forced rub, ``mistuning_contact.csv``.
 """
