@@ -165,10 +165,11 @@ def test_bad_cyclic_keys(tmp_path, capsys, cyclic, words):
     assert words in err, err
 
 
-def test_an_element_based_tie_surface_needs_groups(tmp_path, capsys):
-    deck = sector_deck().replace("*SURFACE, NAME=SLEFT, TYPE=NODE\nLEFT", "*SURFACE, NAME=SLEFT\n1, S1")
+def test_an_analytical_tie_surface_needs_groups(tmp_path, capsys):
+    deck = sector_deck().replace("*SURFACE, NAME=SLEFT, TYPE=NODE\nLEFT", "*SURFACE, NAME=SLEFT, TYPE=SEGMENTS\n"
+                                 "START, 0, 0")  # element-based ones are read: tests/test_abaqus_element_surfaces.py
     err = _fails(tmp_path, capsys, deck)
-    assert "surface 'SLEFT' is element-based" in err and "[cyclic] left and right" in err, err
+    assert "surface 'SLEFT' is of TYPE=SEGMENTS" in err and "[cyclic] left and right" in err, err
 
 
 def test_an_empty_cyclic_section_needs_a_cyclic_deck(tmp_path, capsys):

@@ -18,6 +18,9 @@ only the last ``*NODE`` block and reads no ``*BOUNDARY``; :func:`read_abaqus` re
   fixed, by one line or several) and ``boundary_<first>_<last>`` per dof range as written (``boundary_1_3``;
   ``ENCASTRE`` is ``boundary_1_6``, ``PINNED`` ``boundary_1_3``, ``XSYMM`` ``boundary_xsymm``); a prescribed
   non-zero displacement is not a fixed dof.
+* ``*SURFACE, NAME=…``: node-based (``TYPE=NODE``: node numbers or node sets) and element-based (``TYPE=ELEMENT``,
+  the default: ``element or element set, S1 … S6``, :mod:`~bladecase.fe.abaqus_surfaces`) surfaces as node groups
+  of their name — every node of the faces, midside nodes included — e.g. the cyclic faces of a ``*TIE``.
 * ``*MATERIAL`` with its ``*ELASTIC`` (isotropic ``E, nu``) and ``*DENSITY``, and the ``*SOLID SECTION, ELSET=…,
   MATERIAL=…`` lines that give the elements their material: the material of the body's elements (the deck's only
   one when no section names one) is the mesh's ``info["material"]`` (:attr:`bladecase.fe.mesh.Mesh.material`, in
@@ -95,6 +98,7 @@ from .abaqus_sets import (
     node_surface,
 )
 from .abaqus_sets import at_line as _where
+from .abaqus_surfaces import record_surface, surface_nodes
 from .abaqus_write import ABAQUS_TYPES, abaqus_text, node_numbers  # noqa: F401  (public names of this module)
 from .groups import NODE_ID_KEY  # the point-data key of the file's node numbers (Mesh.node_ids)
 from .mesh_checks import SNIFFERS, check_input_file
@@ -259,6 +263,7 @@ class _Deck:
         self.materials: dict[str, dict] = {}  # upper-case name -> name, line, E, nu, rho (file units) or problem
         self.material_now: str | None = None  # the *MATERIAL that *ELASTIC and *DENSITY lines belong to
         self.sections: list[tuple[tuple[str, int], str, str]] = []  # line, ELSET, MATERIAL of each *SOLID SECTION
+        self.surfaces: dict[str, tuple[str, tuple[str, int], list]] = {}  # element-based *SURFACEs: name, line, data
 
     # -------------------------------------------------------------- keywords
     def node(self, place, params, data) -> None:
@@ -458,6 +463,7 @@ def read_abaqus(path: str | os.PathLike):
             deck.bc(place, params, data)
         elif keyword == "SURFACE":
             node_surface(deck, place, params, data)
+            record_surface(deck, place, params, data)
         if keyword in _NOT_MATERIAL_OPTIONS:
             deck.material_now = None
         if keyword == "MATERIAL":
@@ -513,6 +519,11 @@ def read_abaqus(path: str | os.PathLike):
     for key, (written, _) in deck.elsets.items():
         extra = point_sets.get(written, np.zeros(0, dtype=np.int64))
         point_sets[written] = np.union1d(extra, index(elset_nodes[key], f"*ELSET {written!r}", source))
+    for written, faces in surface_nodes(deck, numbers).items():
+        if written in point_sets:
+            log.info("Abaqus file %s: the group %s is the *SURFACE's face nodes (a set of that name is replaced)",
+                     source, written)
+        point_sets[written] = index(faces, f"*SURFACE {written!r}", source)
     if deck.bcs:
         fixed, full = boundary_groups(deck.bcs, numbers, nset_nodes, lambda n: index(n, "*BOUNDARY", source))
         point_sets.update(fixed)
@@ -525,7 +536,7 @@ def read_abaqus(path: str | os.PathLike):
 
 def read_cyclic(path: str | os.PathLike) -> dict | None:
     """The deck's ``*CYCLIC SYMMETRY MODEL`` and its ``*TIE, CYCLIC SYMMETRY`` (:func:`~.abaqus_sets.cyclic_records`;
-    ``None``: the deck has none).  The tie's node-based surfaces are groups of :func:`read_abaqus`'s mesh.
+    ``None``: the deck has none).  The tie's surfaces, node- or element-based, are groups of :func:`read_abaqus`'s mesh.
 
     >>> import tempfile, os
     >>> folder = tempfile.TemporaryDirectory()

@@ -161,9 +161,10 @@ def log_boundary(source: str, fixed: dict[str, np.ndarray], full: np.ndarray, id
 
 def node_surface(deck, place, params, data) -> None:
     """``*SURFACE, NAME=…, TYPE=NODE``: its nodes (node numbers or node sets, one a line, an optional weight after
-    them) become a node set of the surface's name — a group of the mesh, e.g. a cyclic face of a ``*TIE``. An
-    element-based surface (the default ``TYPE=ELEMENT``), one naming a set not defined before it, and a name
-    already taken by a ``*NSET`` (which keeps the set) are left out, with a log line for the last two."""
+    them) become a node set of the surface's name — a group of the mesh, e.g. a cyclic face of a ``*TIE``. One
+    naming a set not defined before it, and a name already taken by a ``*NSET`` (which keeps the set) are left
+    out, with a log line. (An element-based surface, the default ``TYPE=ELEMENT``, is read by
+    :mod:`~bladecase.fe.abaqus_surfaces`.)"""
     name = params.get("NAME")
     if (params.get("TYPE") or "ELEMENT").upper() != "NODE" or not name:
         return
@@ -249,9 +250,9 @@ def cyclic_records(blocks) -> dict | None:
         tie = next(iter(ties))
     _, (right, left), tol = ties[tie]
     problem = None
-    bad = [s for s in (right, left) if surfaces.get(s.upper(), "NODE") != "NODE"]
+    bad = [s for s in (right, left) if surfaces.get(s.upper(), "NODE") not in ("NODE", "ELEMENT")]
     if bad:
-        problem = (f"the *TIE's surface {bad[0]!r} is element-based: bladecase reads node-based cyclic faces "
-                   "(*SURFACE, TYPE=NODE), or give [cyclic] left and right node groups")
+        problem = (f"the *TIE's surface {bad[0]!r} is of TYPE={surfaces[bad[0].upper()]}: bladecase reads cyclic "
+                   "faces of TYPE=NODE or TYPE=ELEMENT, or give [cyclic] left and right node groups")
     return {"sectors": n, "axis": (a, b), "left": left, "right": right, "tol": tol,
             "where": f"{place[0]!r}, line {place[1]}", "problem": problem}

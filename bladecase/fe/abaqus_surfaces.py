@@ -1,0 +1,134 @@
+"""Element-based surfaces of an Abaqus/CalculiX deck (``*SURFACE, NAME=…, TYPE=ELEMENT``, the default type), read
+by :func:`bladecase.fe.abaqus.read_abaqus` as node groups: every node of the named element faces, corner and
+midside nodes, so that a cyclic face of a ``*TIE, CYCLIC SYMMETRY`` or a contact face written as element faces is
+used exactly as the same face written as a node set.
+
+A surface line is ``element or element set, face label``: ``12, S3`` or ``BLADE_LEFT, S1``.  The face labels and
+their nodes are those of the Abaqus and CalculiX manuals (CalculiX's own tables ``ifaceq``, ``ifacet``,
+``ifacew1``, ``ifacew2``, ``ifacequad``, ``ifacetria`` hold the same node sets), :data:`FACE_NODES`:
+
+* ``C3D4``/``C3D10`` (tetrahedra): S1 = 1-2-3, S2 = 1-4-2, S3 = 2-4-3, S4 = 3-4-1;
+* ``C3D6``/``C3D15`` (wedges): S1 = 1-2-3, S2 = 4-5-6, S3 = 1-2-5-4, S4 = 2-3-6-5, S5 = 3-1-4-6;
+* ``C3D8``/``C3D20`` (hexahedra): S1 = 1-2-3-4, S2 = 5-8-7-6, S3 = 1-5-6-2, S4 = 2-6-7-3, S5 = 3-7-8-4,
+  S6 = 4-8-5-1;
+* plane ``CPS``/``CPE`` 3, 4, 6, 8: the edges S1 = 1-2, S2 = 2-3, S3 = 3-1 (triangles) or 3-4, S4 = 4-1;
+
+and a quadratic element's face adds the midside nodes of its edges.  A face label the element type does not have,
+an element number the deck does not define, an element set it does not define, a line without a face label, and an
+element of a type bladecase leaves out (shells, beams) are errors naming the line and what is valid.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+
+from .. import log
+from .abaqus_sets import AbaqusError, at_line
+
+#: Nodes (1-based, in the element's node order as the deck writes it) of each face label, per element kind (the
+#: meshio type the reader gives the element): corners first, then the midside nodes of a quadratic element.
+FACE_NODES: dict[str, dict[str, tuple[int, ...]]] = {
+    "tetra": {"S1": (1, 2, 3), "S2": (1, 4, 2), "S3": (2, 4, 3), "S4": (3, 4, 1)},
+    "tetra10": {"S1": (1, 2, 3, 5, 6, 7), "S2": (1, 4, 2, 8, 9, 5), "S3": (2, 4, 3, 9, 10, 6),
+                "S4": (3, 4, 1, 10, 8, 7)},
+    "wedge": {"S1": (1, 2, 3), "S2": (4, 5, 6), "S3": (1, 2, 5, 4), "S4": (2, 3, 6, 5), "S5": (3, 1, 4, 6)},
+    "wedge15": {"S1": (1, 2, 3, 7, 8, 9), "S2": (4, 5, 6, 10, 11, 12), "S3": (1, 2, 5, 4, 7, 14, 10, 13),
+                "S4": (2, 3, 6, 5, 8, 15, 11, 14), "S5": (3, 1, 4, 6, 9, 13, 12, 15)},
+    "hexahedron": {"S1": (1, 2, 3, 4), "S2": (5, 8, 7, 6), "S3": (1, 5, 6, 2), "S4": (2, 6, 7, 3),
+                   "S5": (3, 7, 8, 4), "S6": (4, 8, 5, 1)},
+    "hexahedron20": {"S1": (1, 2, 3, 4, 9, 10, 11, 12), "S2": (5, 8, 7, 6, 16, 15, 14, 13),
+                     "S3": (1, 5, 6, 2, 17, 13, 18, 9), "S4": (2, 6, 7, 3, 18, 14, 19, 10),
+                     "S5": (3, 7, 8, 4, 19, 15, 20, 11), "S6": (4, 8, 5, 1, 20, 16, 17, 12)},
+    "triangle": {"S1": (1, 2), "S2": (2, 3), "S3": (3, 1)},
+    "triangle6": {"S1": (1, 2, 4), "S2": (2, 3, 5), "S3": (3, 1, 6)},
+    "quad": {"S1": (1, 2), "S2": (2, 3), "S3": (3, 4), "S4": (4, 1)},
+    "quad8": {"S1": (1, 2, 5), "S2": (2, 3, 6), "S3": (3, 4, 7), "S4": (4, 1, 8)},
+}
+
+#: The element family of each kind, for the messages.
+_FAMILY = {"tetra": "C3D4", "tetra10": "C3D10", "wedge": "C3D6", "wedge15": "C3D15", "hexahedron": "C3D8",
+           "hexahedron20": "C3D20", "triangle": "CPS3/CPE3", "triangle6": "CPS6/CPE6", "quad": "CPS4/CPE4",
+           "quad8": "CPS8/CPE8"}
+
+
+def face_nodes(kind: str, label: str) -> tuple[int, ...]:
+    """The nodes (1-based, in the element's node order) of face ``label`` of an element of meshio type ``kind``;
+    ``KeyError`` for a kind or label it does not have.
+
+    >>> face_nodes("hexahedron", "S2"), face_nodes("tetra10", "s4")
+    ((5, 8, 7, 6), (3, 4, 1, 10, 8, 7))
+    """
+    return FACE_NODES[kind][label.strip().upper()]
+
+
+def record_surface(deck, place, params, data) -> None:
+    """Keep the lines of an element-based ``*SURFACE`` (``TYPE=ELEMENT``, the default) for :func:`surface_nodes`,
+    once the whole deck is read (its elements and element sets may come later); a surface named twice gathers both
+    blocks.  A surface without ``NAME`` cannot be referred to: left out with a log line."""
+    if (params.get("TYPE") or "ELEMENT").upper() != "ELEMENT":
+        return
+    name = params.get("NAME")
+    if not name:
+        log.info("%s: *SURFACE without NAME=: left out (nothing can refer to it)", at_line(place))
+        return
+    deck.surfaces.setdefault(name.upper(), (name, place, []))[2].extend(data)
+
+
+def surface_nodes(deck, numbers) -> dict[str, np.ndarray]:
+    """``{surface name as written: its node numbers (sorted, unique)}`` of the deck's element-based surfaces
+    (:func:`record_surface`), every line checked against the deck's elements, element sets and face labels."""
+    owners = {kind: (np.array([e for e, _ in rows], dtype=np.int64), rows) for kind, rows in deck.elements.items()}
+    out: dict[str, np.ndarray] = {}
+    for name, _, lines in deck.surfaces.values():
+        parts = [np.zeros(0, dtype=np.int64)]
+        for where, text in lines:
+            elements, label = _line_elements(deck, numbers, name, where, text)
+            parts += _faces_of(owners, deck, name, where, elements, label)
+        out[name] = np.unique(np.concatenate(parts))
+    return out
+
+
+def _line_elements(deck, numbers, name: str, where, text: str) -> tuple[np.ndarray, str]:
+    """The element numbers and the face label of one surface line."""
+    fields = [f.strip() for f in text.split(",")]
+    owner = f"*SURFACE, NAME={name}"
+    if len(fields) < 2 or not fields[0] or not fields[1]:
+        raise AbaqusError(f"{at_line(where)}: {owner}: an element-based surface line is 'element or element set, "
+                          f"face label' (e.g. '12, S3'; S1 … S6 for a solid element), got {text!r}")
+    target, label = fields[0], fields[1].upper()
+    if re.fullmatch(r"[+-]?\d+", target):
+        return numbers.listed([int(target)], [where], "element", owner), label
+    if target.upper() not in deck.elsets:
+        have = ", ".join(sorted(v[0] for v in deck.elsets.values())[:20]) or "none"
+        raise AbaqusError(f"{at_line(where)}: {owner} names the element set {target!r}, which the deck does not "
+                          f"define (*ELSETs: {have})")
+    written, members = deck.elsets[target.upper()]
+    return numbers.elements(members, f"*ELSET {written!r}"), label
+
+
+def _faces_of(owners, deck, name: str, where, elements: np.ndarray, label: str) -> list[np.ndarray]:
+    """The node numbers of face ``label`` of each of ``elements``, grouped by element kind."""
+    found = np.zeros(elements.size, dtype=bool)
+    parts = []
+    for kind, (ids, rows) in owners.items():
+        inside = np.isin(elements, ids)
+        if not inside.any():
+            continue
+        found |= inside
+        faces = FACE_NODES[kind]
+        if label not in faces:
+            e = int(elements[inside][0])
+            raise AbaqusError(f"{at_line(where)}: *SURFACE, NAME={name}: element {e} is a {_FAMILY[kind]} "
+                              f"({kind}), whose faces are {', '.join(faces)}; got face label {label!r}")
+        order = np.argsort(ids)
+        k = order[np.searchsorted(ids, elements[inside], sorter=order)]
+        conn = np.array([rows[i][1] for i in k.tolist()], dtype=np.int64)
+        parts.append(conn[:, np.array(faces[label]) - 1].ravel())
+    if not found.all():
+        e = int(elements[~found][0])
+        raise AbaqusError(f"{at_line(where)}: *SURFACE, NAME={name}: element {e} is of a type bladecase leaves out "
+                          f"(left out: {', '.join(sorted(deck.left_out)) or 'none'}): faces are read of solid "
+                          "elements C3D4, C3D6, C3D8, C3D10, C3D15, C3D20 and plane CPS/CPE 3, 4, 6, 8")
+    return parts
