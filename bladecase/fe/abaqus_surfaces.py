@@ -63,10 +63,18 @@ def face_nodes(kind: str, label: str) -> tuple[int, ...]:
     return FACE_NODES[kind][label.strip().upper()]
 
 
-def record_surface(deck, place, params, data) -> None:
+def record_surface(deck, place: tuple[str, int], params: dict, data: list) -> None:
     """Keep the lines of an element-based ``*SURFACE`` (``TYPE=ELEMENT``, the default) for :func:`surface_nodes`,
     once the whole deck is read (its elements and element sets may come later); a surface named twice gathers both
-    blocks.  A surface without ``NAME`` cannot be referred to: left out with a log line."""
+    blocks.  A surface without ``NAME`` cannot be referred to: left out with a log line.
+
+    >>> from types import SimpleNamespace
+    >>> deck = SimpleNamespace(surfaces={})
+    >>> record_surface(deck, ("s.inp", 3), {"NAME": "Top"}, [(("s.inp", 4), "CUBE, S2")])
+    >>> record_surface(deck, ("s.inp", 5), {"NAME": "Side", "TYPE": "NODE"}, [(("s.inp", 6), "7")])  # not here
+    >>> deck.surfaces
+    {'TOP': ('Top', ('s.inp', 3), [(('s.inp', 4), 'CUBE, S2')])}
+    """
     if (params.get("TYPE") or "ELEMENT").upper() != "ELEMENT":
         return
     name = params.get("NAME")
@@ -78,7 +86,23 @@ def record_surface(deck, place, params, data) -> None:
 
 def surface_nodes(deck, numbers) -> dict[str, np.ndarray]:
     """``{surface name as written: its node numbers (sorted, unique)}`` of the deck's element-based surfaces
-    (:func:`record_surface`), every line checked against the deck's elements, element sets and face labels."""
+    (:func:`record_surface`), every line checked against the deck's elements, element sets and face labels
+    (``numbers``: the deck's :class:`~bladecase.fe.abaqus_sets.Numbers`).  :func:`~bladecase.fe.abaqus.read_abaqus`
+    makes them groups:
+
+    >>> import os, tempfile
+    >>> from bladecase.fe.abaqus import read_abaqus
+    >>> folder = tempfile.TemporaryDirectory()
+    >>> path = os.path.join(folder.name, "cube.inp")
+    >>> corners = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]
+    >>> _ = open(path, "w").write("*NODE\\n" + "".join(f"{10 + i}, {x}, {y}, {z}\\n" for i, (x, y, z) in
+    ...     enumerate(corners)) + "*ELEMENT, TYPE=C3D8R, ELSET=CUBE\\n7, 10, 11, 12, 13, 14, 15, 16, 17\\n"
+    ...     "*SURFACE, NAME=TOP\\nCUBE, S2\\n*SURFACE, NAME=FRONT\\n7, S3\\n")
+    >>> m = read_abaqus(path)
+    >>> m.point_sets["TOP"].tolist(), m.point_sets["FRONT"].tolist()  # z = 1; y = 0
+    ([4, 5, 6, 7], [0, 1, 4, 5])
+    >>> folder.cleanup()
+    """
     owners = {kind: (np.array([e for e, _ in rows], dtype=np.int64), rows) for kind, rows in deck.elements.items()}
     out: dict[str, np.ndarray] = {}
     for name, _, lines in deck.surfaces.values():
