@@ -182,7 +182,8 @@ def test_calculix_runs_the_element_surface_deck(tmp_path):
     ("1, S7", r"line \d+: \*SURFACE, NAME=SLEFT: element 1 is a C3D8 \(hexahedron\), whose faces are S1, S2, S3, "
               r"S4, S5, S6; got face label 'S7'"),
     ("99999, S1", r"line \d+: \*SURFACE, NAME=SLEFT names element 99999, which the file does not have \(the file "
-                  r"has 32 elements, numbered 1 to 32\)"),
+                  r"has 33 elements, numbered 1 to 99\)"),
+    ("99, S1", r"line \d+: \*SURFACE, NAME=SLEFT: element 99 is of a type bladecase leaves out \(left out: S4R\)"),
     ("NOSUCH, S1", r"line \d+: \*SURFACE, NAME=SLEFT names the element set 'NOSUCH', which the deck does not "
                    r"define \(\*ELSETs: EALL"),
     ("EALL", r"line \d+: \*SURFACE, NAME=SLEFT: an element-based surface line is 'element or element set, face "
@@ -190,6 +191,7 @@ def test_calculix_runs_the_element_surface_deck(tmp_path):
 ])
 def test_bad_surface_lines_are_named(tmp_path, line, words):
     deck = sector_deck().replace("*SURFACE, NAME=SLEFT, TYPE=NODE\nLEFT\n", f"*SURFACE, NAME=SLEFT\n{line}\n")
+    deck = deck.replace("*STEP", "*ELEMENT, TYPE=S4R\n99, 1, 2, 3, 4\n*STEP", 1)  # a shell: element 99
     (tmp_path / "s.inp").write_text(deck)
     with pytest.raises(AbaqusError, match=words):
         read_abaqus(tmp_path / "s.inp")

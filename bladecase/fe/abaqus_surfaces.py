@@ -103,13 +103,24 @@ def surface_nodes(deck, numbers) -> dict[str, np.ndarray]:
     ([4, 5, 6, 7], [0, 1, 4, 5])
     >>> folder.cleanup()
     """
-    owners = {kind: (np.array([e for e, _ in rows], dtype=np.int64), rows) for kind, rows in deck.elements.items()}
+    if not deck.surfaces:
+        return {}
+    owners = {}  # kind -> (its element numbers sorted, their node numbers)
+    for kind, rows in deck.elements.items():
+        ids = np.array([e for e, _ in rows], dtype=np.int64)
+        order = np.argsort(ids, kind="stable")
+        owners[kind] = (ids[order], np.array([r for _, r in rows], dtype=np.int64)[order])
     out: dict[str, np.ndarray] = {}
     for name, _, lines in deck.surfaces.values():
-        parts = [np.zeros(0, dtype=np.int64)]
+        labels: dict[str, tuple[list, list]] = {}  # face label -> the elements of its lines, each with its line
         for where, text in lines:
             elements, label = _line_elements(deck, numbers, name, where, text)
-            parts += _faces_of(owners, deck, name, where, elements, label)
+            listed, places = labels.setdefault(label, ([], []))
+            listed.append(elements)
+            places += [where] * elements.size
+        parts = [np.zeros(0, dtype=np.int64)]
+        for label, (listed, places) in labels.items():
+            parts += _faces_of(owners, deck, name, places, np.concatenate(listed), label)
         out[name] = np.unique(np.concatenate(parts))
     return out
 
@@ -132,27 +143,27 @@ def _line_elements(deck, numbers, name: str, where, text: str) -> tuple[np.ndarr
     return numbers.elements(members, f"*ELSET {written!r}"), label
 
 
-def _faces_of(owners, deck, name: str, where, elements: np.ndarray, label: str) -> list[np.ndarray]:
-    """The node numbers of face ``label`` of each of ``elements``, grouped by element kind."""
+def _faces_of(owners, deck, name: str, places: list, elements: np.ndarray, label: str) -> list[np.ndarray]:
+    """The node numbers of face ``label`` of each of ``elements`` (``places``: the line naming each), by kind."""
     found = np.zeros(elements.size, dtype=bool)
     parts = []
-    for kind, (ids, rows) in owners.items():
-        inside = np.isin(elements, ids)
+    for kind, (ids, conn) in owners.items():
+        k = np.minimum(np.searchsorted(ids, elements), ids.size - 1)
+        inside = ids[k] == elements
         if not inside.any():
             continue
         found |= inside
         faces = FACE_NODES[kind]
         if label not in faces:
-            e = int(elements[inside][0])
-            raise AbaqusError(f"{at_line(where)}: *SURFACE, NAME={name}: element {e} is a {_FAMILY[kind]} "
-                              f"({kind}), whose faces are {', '.join(faces)}; got face label {label!r}")
-        order = np.argsort(ids)
-        k = order[np.searchsorted(ids, elements[inside], sorter=order)]
-        conn = np.array([rows[i][1] for i in k.tolist()], dtype=np.int64)
-        parts.append(conn[:, np.array(faces[label]) - 1].ravel())
+            first = int(np.flatnonzero(inside)[0])
+            raise AbaqusError(f"{at_line(places[first])}: *SURFACE, NAME={name}: element {elements[first]} is a "
+                              f"{_FAMILY[kind]} ({kind}), whose faces are {', '.join(faces)}; got face label "
+                              f"{label!r}")
+        parts.append(conn[k[inside]][:, np.array(faces[label]) - 1].ravel())
     if not found.all():
-        e = int(elements[~found][0])
-        raise AbaqusError(f"{at_line(where)}: *SURFACE, NAME={name}: element {e} is of a type bladecase leaves out "
-                          f"(left out: {', '.join(sorted(deck.left_out)) or 'none'}): faces are read of solid "
-                          "elements C3D4, C3D6, C3D8, C3D10, C3D15, C3D20 and plane CPS/CPE 3, 4, 6, 8")
+        first = int(np.flatnonzero(~found)[0])
+        raise AbaqusError(f"{at_line(places[first])}: *SURFACE, NAME={name}: element {elements[first]} is of a type "
+                          f"bladecase leaves out (left out: {', '.join(sorted(deck.left_out)) or 'none'}): faces "
+                          "are read of solid elements C3D4, C3D6, C3D8, C3D10, C3D15, C3D20 and plane CPS/CPE 3, 4, "
+                          "6, 8")
     return parts
