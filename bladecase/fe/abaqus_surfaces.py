@@ -112,21 +112,27 @@ def surface_nodes(deck, numbers) -> dict[str, np.ndarray]:
         owners[kind] = (ids[order], np.array([r for _, r in rows], dtype=np.int64)[order])
     out: dict[str, np.ndarray] = {}
     for name, _, lines in deck.surfaces.values():
-        labels: dict[str, tuple[list, list]] = {}  # face label -> the elements of its lines, each with its line
-        for where, text in lines:
+        labels: dict[str, tuple[list, list, list, list]] = {}  # face label -> its elements, each with its line:
+        for where, text in lines:                                  # of its sets, then its numbers (checked at once)
             elements, label = _line_elements(deck, numbers, name, where, text)
-            listed, places = labels.setdefault(label, ([], []))
-            listed.append(elements)
-            places += [where] * elements.size
+            sets, set_places, listed, places = labels.setdefault(label, ([], [], [], []))
+            if isinstance(elements, int):
+                listed.append(elements)
+                places.append(where)
+            else:
+                sets.append(elements)
+                set_places += [where] * elements.size
         parts = [np.zeros(0, dtype=np.int64)]
-        for label, (listed, places) in labels.items():
-            parts += _faces_of(owners, deck, name, places, np.concatenate(listed), label)
+        for label, (sets, set_places, listed, places) in labels.items():
+            if listed:
+                sets.append(numbers.listed(listed, places, "element", f"*SURFACE, NAME={name}"))
+            parts += _faces_of(owners, deck, name, set_places + places, np.concatenate(sets), label)
         out[name] = np.unique(np.concatenate(parts))
     return out
 
 
-def _line_elements(deck, numbers, name: str, where, text: str) -> tuple[np.ndarray, str]:
-    """The element numbers and the face label of one surface line."""
+def _line_elements(deck, numbers, name: str, where, text: str) -> tuple[np.ndarray | int, str]:
+    """The element numbers (of a set; one number, not checked yet) and the face label of one surface line."""
     fields = [f.strip() for f in text.split(",")]
     owner = f"*SURFACE, NAME={name}"
     if len(fields) < 2 or not fields[0] or not fields[1]:
@@ -134,7 +140,7 @@ def _line_elements(deck, numbers, name: str, where, text: str) -> tuple[np.ndarr
                           f"face label' (e.g. '12, S3'; S1 … S6 for a solid element), got {text!r}")
     target, label = fields[0], fields[1].upper()
     if re.fullmatch(r"[+-]?\d+", target):
-        return numbers.listed([int(target)], [where], "element", owner), label
+        return int(target), label
     if target.upper() not in deck.elsets:
         have = ", ".join(sorted(v[0] for v in deck.elsets.values())[:20]) or "none"
         raise AbaqusError(f"{at_line(where)}: {owner} names the element set {target!r}, which the deck does not "
