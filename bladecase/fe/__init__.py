@@ -22,6 +22,8 @@ Module map, one entry per module (the details are in each module's own docstring
   node lists as groups, the file's node numbers kept);
 - :mod:`~bladecase.fe.abaqus_sets` — what a deck's records mean: its numbering, the ``*BOUNDARY`` groups, the
   body's material;
+- :mod:`~bladecase.fe.abaqus_surfaces` — element-based ``*SURFACE``s (faces ``S1``…``S6`` of each element type, as
+  CalculiX numbers them) read as node groups;
 - :mod:`~bladecase.fe.abaqus_write` — decks written for CalculiX;
 - :mod:`~bladecase.fe.calculix` — the model as a CalculiX deck, its frequencies back;
 - :mod:`~bladecase.fe.groups` — named node groups of each format;
