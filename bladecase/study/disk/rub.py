@@ -59,7 +59,7 @@ def compute_disk_rub(study: Study, staging: Path, files: dict, *, model, sector,
     whose simulation fails."""
     from ...nsm.damping import Damping
     from ...reduction.disk import disk_model, massless_sector
-    from ..rub.stage import max_revolutions, node_angles
+    from ..rub.stage import _node_stiffness, max_revolutions, node_angles
 
     if not study.has_contact:
         raise StudyError("[rub] speeds: the disk's rub needs each blade's contact: add [contact] with its face "
@@ -68,9 +68,13 @@ def compute_disk_rub(study: Study, staging: Path, files: dict, *, model, sector,
     start = time.perf_counter()
     contact = build_contact(study, model)
     nodes = study["contact"].get("points") == "nodes"
+    if nodes:  # each node its share of the casing's stiffness (by tributary area), as the single blade's rub
+        casing = _node_stiffness(study, model, contact)
+    else:
+        casing = contact.casing
     try:
         ms, W, gap = massless_sector(model, sector, contact, nodes=nodes)
-        disk = disk_model(ms, W, gap, count=r["size"], casing=None if np.isinf(contact.casing) else contact.casing)
+        disk = disk_model(ms, W, gap, count=r["size"], casing=None if np.all(np.isinf(casing)) else casing)
     except ValueError as exc:
         raise StudyError(f"[contact]: {exc}") from None
     axis = RotationAxis(k["axis"]["origin"], k["axis"]["direction"])
