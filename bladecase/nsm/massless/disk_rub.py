@@ -202,12 +202,14 @@ def disk_rub_sweep(disk, speeds, lobes: int, amplitude: float, damping=None, *, 
 
     >>> import scipy.sparse as sp
     >>> from bladecase.fe.cyclic import CyclicSector
+    >>> from bladecase.nsm import Damping
     >>> from bladecase.reduction.disk import disk_model
     >>> K = np.array([[4.7, -1.0, 0.0, -0.7], [-1.0, 3.0, -2.0, 0.0], [0.0, -2.0, 2.0, 0.0], [-0.7, 0, 0, 0.7]])
     >>> ring = CyclicSector(sp.csr_array(K), sp.csr_array(np.diag([2.0, 0.5, 0.0, 0.0])), 4, left=[0], right=[3])
     >>> disk = disk_model(ring, [[0.0], [0.0], [1.0], [0.0]], 0.1, count=2)
-    >>> [r.dominant for r in disk_rub_sweep(disk, [0.2, 0.3], 1, 0.12, revolutions=4, window=1)]
-    [1, 1]
+    >>> out = disk_rub_sweep(disk, [0.9, 1.1], 1, 0.12, Damping(zeta=0.2), revolutions=4, window=1)
+    >>> [(r.response, r.dominant) for r in out]
+    [('settled', 1), ('settled', 1)]
     """
     speeds = np.asarray(speeds, dtype=float).reshape(-1)
     if speeds.size == 0 or not np.all(np.isfinite(speeds)) or np.any(speeds <= 0):
