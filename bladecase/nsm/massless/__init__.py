@@ -47,8 +47,11 @@ has contact phases of finite duration instead of impacts. One module per step:
   Floquet multipliers;
 - :mod:`~bladecase.nsm.massless.disk_forced` — the forced rub of a (mistuned) disk, the harmonic load as a moving
   clearance, each blade's settled peak contact force;
+- :mod:`~bladecase.nsm.massless.disk_rub` — the whole disk's rub in an out-of-round casing, each blade at its own
+  angle: per blade its peak force, penetration and contact share, the response's nodal-diameter content
+  (:func:`disk_rub`, :func:`disk_rub_sweep`);
 - :mod:`~bladecase.nsm.massless.rub` — the rub response of a turning blade at one speed and over speeds
-  (:func:`rub_response`, :func:`rub_sweep`);
+  (:func:`rub_response`, :func:`rub_sweep`; :func:`rub_run` with its trajectory);
 - :mod:`~bladecase.nsm.massless.forced` — forced and damped simulation (:func:`simulate_forced_massless`;
   damping and the energy balance are shared: :mod:`bladecase.nsm.damping`);
 - :mod:`~bladecase.nsm.massless.bar` — the 1-D benchmark bar (either contact model) and its continuum solution

@@ -46,7 +46,7 @@ from .friction import friction_flight, sliding_check
 from .friction_energy import energy_balance
 from .nodes import NodalFlight, NodalSystem, NodalTrajectory, Rub, simulate_nodes
 
-__all__ = ["Character", "RubResponse", "characterise", "rub_response", "rub_sweep", "zero_one_test"]
+__all__ = ["Character", "RubResponse", "characterise", "rub_response", "rub_run", "rub_sweep", "zero_one_test"]
 
 #: Relative change of the window's peaks against the previous window's below which the response has settled; also
 #: the return map's recurrence error (relative to the state's size) below which it repeats.
@@ -366,6 +366,24 @@ def rub_response(system: NodalSystem, speed: float, lobes: int, amplitude: float
     :class:`~bladecase.nsm.massless.friction.Friction` at the contact nodes (``None`` or ``μ = 0``: none, the
     results bit for bit those without); ``flight``: the flight to fly (its phases reused: it must be of this
     system, damping, casing and friction; default: a new one)."""
+    return rub_run(system, speed, lobes, amplitude, angles, damping, revolutions, window, max_switches, areas,
+                   max_revolutions, friction, flight)[0]
+
+
+def rub_run(system: NodalSystem, speed: float, lobes: int, amplitude: float, angles, damping=None,
+            revolutions: int = 40, window: int = 10, max_switches: int = 2_000_000,
+            areas=None, max_revolutions: int | None = None, friction=None,
+            flight: NodalFlight | None = None) -> tuple[RubResponse, NodalTrajectory]:
+    """:func:`rub_response` with the trajectory it read its figures on (at least its last two windows, the clock
+    from the start of the run: the figures' span ends at its ``t_end``) — for what a caller reads on top of the
+    figures (e.g. a bladed disk's nodal diameters, :mod:`bladecase.nsm.massless.disk_rub`).
+
+    >>> import numpy as np
+    >>> s = NodalSystem(np.eye(1), np.eye(1), np.eye(1), np.eye(1), gap=[0.5])
+    >>> r, tr = rub_run(s, speed=0.3, lobes=2, amplitude=0.8, angles=[0.0], revolutions=4, window=1)
+    >>> bool(np.isclose(tr.t_end, r.revolutions_run * 2 * np.pi / 0.3))
+    True
+    """
     cap, speed = _checked(revolutions, window, max_revolutions, speed)
     if areas is not None:
         areas = np.asarray(areas, dtype=float)
@@ -434,7 +452,7 @@ def rub_response(system: NodalSystem, speed: float, lobes: int, amplitude: float
     rubbed = _friction_figures(tail, speed, window) if getattr(fl, "friction", None) is not None else {}
     return RubResponse(speed, int(lobes), float(amplitude), int(revolutions), int(window), system.nodes, now[0],
                        now[1], fraction, now[2], switches, settled, change, float(now[3].sum()), now[3], loaded,
-                       character.label, period, int(done), span / lobes, cap, detail, rubbed)
+                       character.label, period, int(done), span / lobes, cap, detail, rubbed), tail
 
 
 def _friction_figures(tail: NodalTrajectory, speed: float, window: int) -> dict:

@@ -7,5 +7,7 @@
 - :mod:`~bladecase.post.disk.mistuning_report` — the mistuned samples in words;
 - :mod:`~bladecase.post.disk.mistuning_plot` — the amplification factors' histogram against Whitehead's bound;
 - :mod:`~bladecase.post.disk.annulus_orbit` — a travelling-wave nonsmooth orbit flown over the whole annulus: VTK
-  frames with each tip's gap, force and casing yield, GIF/MP4.
+  frames with each tip's gap, force and casing yield, GIF/MP4;
+- :mod:`~bladecase.post.disk.rub_plot` — the whole disk's rub over speeds: each blade's peak force, the
+  nodal-diameter content, and the report's section.
 """

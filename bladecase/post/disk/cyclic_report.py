@@ -22,6 +22,7 @@ True
 from __future__ import annotations
 
 from .mistuning_report import mistuning_lines, mistuning_sentence
+from .rub_plot import rub_lines
 
 __all__ = ["cyclic_report", "cyclic_verdict", "engine_order_words", "nonsmooth_lines", "nonsmooth_sentence"]
 
@@ -146,6 +147,7 @@ def cyclic_report(summary: dict) -> str:
                   f"- {len(c['campbell']['speeds_rad_s'])} speeds, every nodal diameter's modes about the disk's "
                   "centrifugal state (the sector's faces tied): `campbell_nd.png`."]
     lines += nonsmooth_lines(c.get("nonsmooth"))
+    lines += rub_lines(c.get("rub"))
     lines += mistuning_lines(summary.get("mistuning"))
     files = summary.get("files") or {}
     lines += ["", "## Files", ""] + [f"- `{x}`" for k, x in files.items() if isinstance(x, str)]

@@ -12,5 +12,7 @@ the key modules, so this package's ``__init__`` imports nothing.
 - :mod:`~bladecase.study.disk.mistuning_keys` — the ``[mistuning]`` section;
 - :mod:`~bladecase.study.disk.nonsmooth` — ``[cyclic] nonsmooth``: the disk's travelling-wave nonsmooth modes,
   ``disk_modes.csv``, their return and stability, the annulus animation;
-- :mod:`~bladecase.study.disk.mistuning_contact` — the mistuned disk's forced rub, ``mistuning_contact.csv``.
+- :mod:`~bladecase.study.disk.mistuning_contact` — the mistuned disk's forced rub, ``mistuning_contact.csv``;
+- :mod:`~bladecase.study.disk.rub` — ``[rub] speeds`` in a cyclic study: the whole disk's rub in the out-of-round
+  ``[casing]``, one task per speed, ``disk_rub.csv``, ``disk_rub.png``.
 """

@@ -335,6 +335,13 @@ def compute_cyclic(study: Study, staging: Path, stage, progress: bool, executor:
 
         with stage("nonsmooth"):
             nonsmooth = compute_disk_modes(study, staging, files, model=model, sector=solved)
+    disk_rub = None
+    if (study.config.get("rub") or {}).get("speeds"):
+        from .rub import compute_disk_rub
+
+        with stage("rub"):
+            disk_rub = compute_disk_rub(study, staging, files, model=model, sector=solved, executor=executor,
+                                        progress=progress)
     mistuning = None
     if mistuning_requested(study.config):
         from .mistuning import compute_mistuning
@@ -361,6 +368,7 @@ def compute_cyclic(study: Study, staging: Path, stage, progress: bool, executor:
         "diameters": [{"nd": k, "frequencies_hz": m.frequencies.tolist(), "multiplicity": m.multiplicity,
                        "unknowns": m.size, "seconds": m.seconds} for k, m in spectrum.items()],
         "engine_orders": table, "expanded": expanded, "campbell": campbell, "nonsmooth": nonsmooth,
+        "rub": disk_rub,
     }
     summary = {
         "study": study.name, "source": study.source, "bladecase_version": __version__,
