@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import csv
 import json
+import re
 
 import numpy as np
 import pytest
@@ -14,6 +15,7 @@ from _cyclic_util import hex_sector
 from bladecase.cli import main
 from bladecase.fe import save_mesh
 from bladecase.study.disk.rub import COLUMNS
+from bladecase.study.schema import StudyError, loads
 
 N = 12
 CONTACT = ('contact = {face = "tip", model = "massless", casing_stiffness = 5e6}\n'
@@ -61,3 +63,15 @@ def test_every_blade_rubs_alike_on_the_lobes_diameter(run):
 def test_a_disk_rub_without_a_contact_is_an_error(tmp_path, capsys):
     assert main(["run", _study(tmp_path, contact=""), "--out", str(tmp_path / "out"), "--quiet"]) == 2
     assert "set [contact] face" in capsys.readouterr().err and not (tmp_path / "out").exists()
+
+
+def test_a_cyclic_contact_that_nothing_uses_is_refused(tmp_path):
+    """A cyclic study with a contact face and a casing but neither ``[cyclic] nonsmooth`` nor ``[rub] speeds``
+    would ignore the contact: refused, naming what would use it (exit code 2 on the command line)."""
+    text = re.sub(r"^rub = .*\n", "", open(_study(tmp_path)).read(), flags=re.M)
+    path = tmp_path / "unused.toml"
+    path.write_text(text)
+    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    with pytest.raises(StudyError, match=r"neither is asked, so the contact would be ignored"):
+        loads(text.replace('mesh = {path = "sector.vtu"}', f'mesh = {{path = "{tmp_path / "sector.vtu"}"}}'))
+    assert not (tmp_path / "out").exists()

@@ -180,6 +180,12 @@ def cyclic_checks(c: dict) -> None:
                          "of the bladed disk by nodal diameter; its contact is for the whole disk's nonsmooth mode: "
                          "add [cyclic] nonsmooth = {diameter = k} (or remove [contact], or study one blade without "
                          "[cyclic])")
+    located = any(contact.get(k) is not None for k in ("face", "group", "node", "nodes", "farthest", "nearest"))
+    if located and not cy.get("nonsmooth") and not (c.get("rub") or {}).get("speeds"):
+        raise StudyError("[contact]: a cyclic study uses its contact for the whole disk's nonsmooth mode ([cyclic] "
+                         "nonsmooth = {diameter = k}, with [contact] clearance) or for the whole disk's rub ([rub] "
+                         "speeds with an out-of-round [casing]); neither is asked, so the contact would be ignored: "
+                         "add one of them, or remove [contact]")
     if cy.get("nonsmooth"):
         nonsmooth_checks(cy, contact, n)
 
