@@ -258,38 +258,43 @@ def fig8_example():
 
 # ----------------------------------------------------------------------------- scheduling (pytest-xdist)
 
-#: Test files, longest first (per-file totals of ``--durations=0``, measured on 2 cores).  ``make test`` runs
-#: ``--dist loadfile``: these go to the workers first, heaviest first, and the files not listed (each a few
-#: seconds or less) fill in at the end, so that the two workers finish together.  (xdist's own order is by the
-#: number of tests per file, which left a few slow files of 1–5 tests for the end.)  An out-of-date list only
-#: costs balance, never a test.
+#: Test files (or the first file of a :data:`SAME_WORKER` group), longest first (per-file CPU totals of a run on 2
+#: cores).  ``make test`` runs ``--dist loadfile``: these go to the workers first, heaviest first, and the files not
+#: listed (each a few seconds or less) fill in at the end, so that the two workers finish together.  (xdist's own
+#: order is by the number of tests per file, which left a few slow files of 1–5 tests for the end.)  An out-of-date
+#: list only costs balance, never a test.
 HEAVIEST_FIRST = [
     "tests/test_docs_run.py",  # the README's commands in order (its critical path) beside the docs' Python; with
     # test_readme.py (SAME_WORKER)
-    "tests/test_executor.py",  # with test_comparison_study.py (SAME_WORKER)
+    "tests/test_executor.py",  # with test_comparison_study.py and test_mistuning_stats.py (SAME_WORKER)
     "tests/test_search_speed.py",  # with test_kipp.py (SAME_WORKER)
-    "tests/test_engineering_outputs.py",  # with the other MASSLESS_MODE_FILES (SAME_WORKER)
     "tests/test_examples.py",  # with test_fig8.py (SAME_WORKER)
     "tests/test_pipeline.py",
     "tests/test_rub_study.py",
-    "tests/test_scan.py",  # with test_orbits.py and test_simulate.py (SAME_WORKER)
     "tests/test_nodal_modes.py",
-    "tests/test_fem.py",
-    "tests/test_viz.py",  # with test_export.py (SAME_WORKER)
-    "tests/test_compare_decides.py",
-    "tests/test_nodes.py",
-    "tests/test_forcing_stage.py",
+    "tests/test_engineering_outputs.py",  # with the other MASSLESS_MODE_FILES (SAME_WORKER)
     "tests/test_nodal_study.py",
-    "tests/test_forced_massless.py",
-    "tests/test_calculix.py",
+    "tests/test_scan.py",  # with test_orbits.py and test_simulate.py (SAME_WORKER)
+    "tests/test_compare_decides.py",
+    "tests/test_fem.py",
+    "tests/test_friction_study.py",
+    "tests/test_forcing_stage.py",
+    "tests/test_nodes.py",
+    "tests/test_viz.py",  # with test_export.py (SAME_WORKER)
     "tests/test_casing_sweep.py",
-    "tests/test_isoparametric.py",
-    "tests/test_hex_blade.py",
+    "tests/test_verdict.py",
+    "tests/test_failure_paths.py",
     "tests/test_tip_excursion.py",
     "tests/test_massless.py",
-    "tests/test_rotation_study.py",
+    "tests/test_isoparametric.py",
+    "tests/test_calculix.py",
+    "tests/test_hex_blade.py",
     "tests/test_rotation.py",
-    "tests/test_ownership.py",
+    "tests/test_reference.py",
+    "tests/test_forced_massless.py",
+    "tests/test_geometry.py",
+    "tests/test_rotation_study.py",
+    "tests/test_rub_line.py",
 ]
 
 #: The files that use ``dask_executor`` (one work unit of :data:`SAME_WORKER`) and the session's executor while it
