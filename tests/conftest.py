@@ -24,6 +24,15 @@ Threaded OpenBLAS in two workers on two cores oversubscribes the machine: its th
 and the many small dense solves of the tests (4×4 ``expm``, Newton steps) ran up to 10× slower
 under that contention.  The thread count changes no claim of a test.  (tests/test_executor.py's check that
 executor workers get one BLAS thread removes the variable first; Dask's nanny sets it for its workers anyway.)
+
+Animation frames
+----------------
+The frames are rendered off-screen by Mesa's software rasteriser (llvmpipe), where pyvista's default 8× multi-sample
+anti-aliasing is most of a frame's cost: ``PYVISTA_MULTI_SAMPLES=0`` (unless the caller set it; pyvista's own
+variable, read when a plotter's theme is made, and inherited by the scripts and commands the tests start) renders
+the same frames with hard edges at about a quarter of the CPU (measured: 20 frames of an 80k-point surface at
+800×600, 7.0 s → 1.5 s).  What the tests check of a frame (its size, that it is not blank, that the blade moves,
+the red casing on impact frames) does not depend on smoothed edges.
 """
 
 from __future__ import annotations
@@ -36,6 +45,7 @@ import threading
 from pathlib import Path
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # before numpy's first import (see "BLAS threads" above)
+os.environ.setdefault("PYVISTA_MULTI_SAMPLES", "0")  # before pyvista's (see "Animation frames" above)
 
 import matplotlib
 
@@ -248,38 +258,43 @@ def fig8_example():
 
 # ----------------------------------------------------------------------------- scheduling (pytest-xdist)
 
-#: Test files, longest first (per-file totals of ``--durations=0``, measured on 2 cores).  ``make test`` runs
-#: ``--dist loadfile``: these go to the workers first, heaviest first, and the files not listed (each a few
-#: seconds or less) fill in at the end, so that the two workers finish together.  (xdist's own order is by the
-#: number of tests per file, which left a few slow files of 1–5 tests for the end.)  An out-of-date list only
-#: costs balance, never a test.
+#: Test files (or the first file of a :data:`SAME_WORKER` group), longest first (per-file CPU totals of a run on 2
+#: cores).  ``make test`` runs ``--dist loadfile``: these go to the workers first, heaviest first, and the files not
+#: listed (each a few seconds or less) fill in at the end, so that the two workers finish together.  (xdist's own
+#: order is by the number of tests per file, which left a few slow files of 1–5 tests for the end.)  An out-of-date
+#: list only costs balance, never a test.
 HEAVIEST_FIRST = [
     "tests/test_docs_run.py",  # the README's commands in order (its critical path) beside the docs' Python; with
     # test_readme.py (SAME_WORKER)
-    "tests/test_executor.py",  # with test_comparison_study.py (SAME_WORKER)
+    "tests/test_executor.py",  # with test_comparison_study.py and test_mistuning_stats.py (SAME_WORKER)
     "tests/test_search_speed.py",  # with test_kipp.py (SAME_WORKER)
-    "tests/test_engineering_outputs.py",  # with the other MASSLESS_MODE_FILES (SAME_WORKER)
     "tests/test_examples.py",  # with test_fig8.py (SAME_WORKER)
     "tests/test_pipeline.py",
     "tests/test_rub_study.py",
-    "tests/test_scan.py",  # with test_orbits.py and test_simulate.py (SAME_WORKER)
     "tests/test_nodal_modes.py",
-    "tests/test_fem.py",
-    "tests/test_viz.py",  # with test_export.py (SAME_WORKER)
-    "tests/test_compare_decides.py",
-    "tests/test_nodes.py",
-    "tests/test_forcing_stage.py",
+    "tests/test_engineering_outputs.py",  # with the other MASSLESS_MODE_FILES (SAME_WORKER)
     "tests/test_nodal_study.py",
-    "tests/test_forced_massless.py",
-    "tests/test_calculix.py",
+    "tests/test_scan.py",  # with test_orbits.py and test_simulate.py (SAME_WORKER)
+    "tests/test_compare_decides.py",
+    "tests/test_fem.py",
+    "tests/test_friction_study.py",
+    "tests/test_forcing_stage.py",
+    "tests/test_nodes.py",
+    "tests/test_viz.py",  # with test_export.py (SAME_WORKER)
     "tests/test_casing_sweep.py",
-    "tests/test_isoparametric.py",
-    "tests/test_hex_blade.py",
+    "tests/test_verdict.py",
+    "tests/test_failure_paths.py",
     "tests/test_tip_excursion.py",
     "tests/test_massless.py",
-    "tests/test_rotation_study.py",
+    "tests/test_isoparametric.py",
+    "tests/test_calculix.py",
+    "tests/test_hex_blade.py",
     "tests/test_rotation.py",
-    "tests/test_ownership.py",
+    "tests/test_reference.py",
+    "tests/test_forced_massless.py",
+    "tests/test_geometry.py",
+    "tests/test_rotation_study.py",
+    "tests/test_rub_line.py",
 ]
 
 #: The files that use ``dask_executor`` (one work unit of :data:`SAME_WORKER`) and the session's executor while it

@@ -5,6 +5,7 @@ the imports inside functions), no module over 600 lines, and no downstream packa
 from __future__ import annotations
 
 import ast
+import functools
 from pathlib import Path
 
 import bladecase
@@ -13,6 +14,14 @@ ROOT = Path(bladecase.__file__).parent
 
 #: The most lines a module may have (docs/architecture.md).
 MAX_LINES = 600
+
+
+@functools.cache
+def _imports(path: Path) -> tuple[ast.Import | ast.ImportFrom, ...]:
+    """The import statements of ``path`` (anywhere in it), parsed once for the file's tests (each reads the same
+    package: parsing it is most of their time)."""
+    return tuple(node for node in ast.walk(ast.parse(path.read_text(encoding="utf-8")))
+                 if isinstance(node, ast.Import | ast.ImportFrom))
 
 
 def _modules() -> dict[str, Path]:
@@ -29,7 +38,7 @@ def _graph(mods: dict[str, Path]) -> dict[str, set[str]]:
     edges: dict[str, set[str]] = {m: set() for m in mods}
     for name, path in mods.items():
         package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        for node in _imports(path):
             targets = []
             if isinstance(node, ast.ImportFrom):
                 if node.level:
@@ -79,8 +88,14 @@ def _cycles(edges: dict[str, set[str]]) -> list[list[str]]:
     return out
 
 
+@functools.cache
+def _package_graph() -> dict[str, set[str]]:
+    """:func:`_graph` of the package (read, not changed, by the tests)."""
+    return _graph(_modules())
+
+
 def test_no_import_circles():
-    assert _cycles(_graph(_modules())) == []
+    assert _cycles(_package_graph()) == []
 
 
 def test_the_circle_finder_finds_a_circle():
@@ -95,7 +110,7 @@ def test_no_module_is_over_600_lines():
 def test_imports_flow_downstream():
     """fe → reduction → nsm → post: ``nsm`` imports neither ``fe`` nor ``reduction`` nor ``study``; ``fe`` none of
     the packages after it."""
-    edges = _graph(_modules())
+    edges = _package_graph()
     later = {"bladecase.fe": ("bladecase.reduction", "bladecase.nsm", "bladecase.study", "bladecase.cli"),
              "bladecase.nsm": ("bladecase.fe", "bladecase.reduction", "bladecase.post", "bladecase.study",
                                "bladecase.cli"),
@@ -114,7 +129,7 @@ def test_relative_imports_name_modules_that_exist():
     wrong = []
     for name, path in mods.items():
         package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        for node in _imports(path):
             if isinstance(node, ast.ImportFrom) and node.level and node.module:
                 base = package.split(".")[: len(package.split(".")) - node.level + 1]
                 target = ".".join(base + [node.module])
