@@ -117,7 +117,8 @@ def _massless_eigs(Kk, Mk, count: int, factor) -> tuple[np.ndarray, np.ndarray]:
         return lam, V
     wanted = min(count, size - int(zero.sum()) - 2)
     op = LinearOperator(Kk.shape, matvec=factor.solve, dtype=float)
-    lam, V = eigsh(Kk, k=wanted, M=Mk, sigma=0.0, OPinv=op, which="LM")
+    v0 = np.random.default_rng(0).standard_normal(size)  # a fixed start: the same modes on every run
+    lam, V = eigsh(Kk, k=wanted, M=Mk, sigma=0.0, OPinv=op, which="LM", v0=v0)
     order = np.argsort(lam)
     lam, V = lam[order], V[:, order]
     V = V / np.sqrt(np.einsum("ij,ij->j", V, Mk @ V))
