@@ -296,9 +296,11 @@ class NodalFlight:
     def decode(self, q, p) -> tuple[np.ndarray, np.ndarray]:
         return self.phi @ q, self.phi @ p
 
-    def active_set(self, q, p, t: float) -> np.ndarray:
+    def active_set(self, q, p, t: float, on: np.ndarray | None = None) -> np.ndarray:
         """The closed contacts from the state: the complementarity problem, at the rate level where a contact is
-        on its surface (both its force and its remaining clearance zero)."""
+        on its surface (both its force and its remaining clearance zero). ``on``: contacts known to be on their
+        surfaces (a switch just found them there, each to its own signal's tolerance): decided at the rate level
+        whatever their force's round-off."""
         s = self.system
         H = s.H
         g = self.gap(t)
@@ -309,6 +311,8 @@ class NodalFlight:
         tol_l = tol_s / float(np.abs(H).max())
         A = lam > tol_l
         Dset = ~A & (slack <= tol_s)
+        if on is not None:
+            A, Dset = A & ~on, Dset | on
         if not Dset.any():
             return A
         B, Dn = np.flatnonzero(A), np.flatnonzero(Dset)
@@ -421,12 +425,23 @@ def simulate_nodes(system: NodalSystem, x0, v0, t_end: float, damping=None, rub:
     t = 0.0
     A = fl.active_set(q, p, t)
     on = np.zeros(system.m, dtype=bool)
+    toggled = False  # the last switch changed one contact's status without the complementarity problem
     starts, actives, qs, ps, amps = [0.0], [A], [q], [p], []
     while len(starts) <= max_switches:
         ph = fl.phase(A, t)
         a = ph.amplitudes(q, p, t)
-        amps.append(a)
         signals = ph.signals(a, t)
+        if toggled:
+            toggled = False
+            f0, d0 = signals.values(0.0)
+            if np.any(on & (d0[0] <= 0)):  # the toggled contact does not leave its surface in the new phase (its
+                # neighbours' forces, through the blade, turned it back): the rate-level complementarity decides
+                A_lcp = fl.active_set(q, p, t, on)
+                if not np.array_equal(A_lcp, A):
+                    A = A_lcp
+                    actives[-1] = A
+                    continue
+        amps.append(a)
         step = fl.next_break(t)
         hit = first_switch(signals, (t_end if step >= t_end else step) - t, on)
         if hit is None and step < t_end:  # the profile steps: the closed contacts from the new clearances
@@ -452,8 +467,9 @@ def simulate_nodes(system: NodalSystem, x0, v0, t_end: float, damping=None, rub:
         if on.sum() == 1:  # one contact switches: it changes status (the next flight checks it leaves its surface)
             A = A.copy()
             A[j] = not A[j]
+            toggled = True
         else:  # several on their surfaces at once: the rate-level complementarity problem decides
-            A_new = fl.active_set(q, p, t)
+            A_new = fl.active_set(q, p, t, on)
             if np.array_equal(A_new, A):
                 A_new = A.copy()
                 A_new[j] = not A[j]
