@@ -99,7 +99,7 @@ class _Phase:
 
     def __init__(self, fl: NodalFlight, A: np.ndarray):
         s = fl.system
-        self.A = A
+        self.A, self._fl, self._P = A, fl, None
         m, n = s.m, fl.n
         Wq, H = fl.Wq, s.H
         idx = np.flatnonzero(A)
@@ -109,7 +109,8 @@ class _Phase:
             G = np.linalg.inv(H[np.ix_(idx, idx)])
             G = 0.5 * (G + G.T)
             K = K + WA @ G @ WA.T
-        self.L, self.P = L, P = phase_signals(Wq, H, A, G if idx.size else None)  # switching signals: L q + P g(t)
+        L, P = phase_signals(Wq, H, A, G if idx.size else None)  # switching signals: L q + P g(t)
+        self.L = L  # P (m × m) is not kept: with many contact nodes it would be most of the phases' memory
         self.idx = idx
         self.GWt = G @ WA.T if idx.size else np.zeros((0, n))  # λ_A = G_A(W_Aᵀq − g_A(t))
         self.G = G if idx.size else np.zeros((0, 0))
@@ -151,6 +152,18 @@ class _Phase:
         self.const = L @ self.q_eq + P @ s.gap
         self.E0 = (L @ self.X + (P @ fl.D if fl.D is not None else 0)) if nu > 0 else np.zeros(m, complex)
         self.lam2 = np.abs(self.lam) ** 2
+
+    @property
+    def P(self) -> np.ndarray:
+        """The switching signals' clearance matrix (``L q + P g(t)``), made again when asked (:func:`phase_signals`,
+        the same numbers bit for bit): a phase keeps ``P g₀`` and ``P D`` only, not this ``m × m`` matrix."""
+        if self._P is not None:
+            return self._P
+        return phase_signals(self._fl.Wq, self._fl.system.H, self.A, self.G if self.idx.size else None)[1]
+
+    @P.setter
+    def P(self, value: np.ndarray) -> None:  # a phase that keeps its own (friction's)
+        self._P = value
 
     def shifted(self, delta: np.ndarray) -> _Phase:
         """The same phase with every clearance ``delta`` (``(m,)``, m) wider: its equilibrium and switching
