@@ -126,10 +126,9 @@ def build(deck: Path, speeds, args):
 
     t = time.perf_counter()
     first = loads(study_text(deck, [1], speeds, args).replace("nodes = [1]", "nodes = [188, 190]"), source=str(deck))
-    mesh = build_mesh(first)
-    model = build_model(first, mesh)
-    nodes = tip_face(model)
+    nodes = tip_face(build_model(first, build_mesh(first)))  # the mesh keeps its contact face: built again below
     study = loads(study_text(deck, nodes, speeds, args), source=str(deck))
+    model = build_model(study, build_mesh(study))
     contact = build_contact(study, model)
     print(f"model: {model!r}, {len(nodes)} tip-face contact nodes ({time.perf_counter() - t:.1f} s)", flush=True)
     return study, model, contact
