@@ -25,8 +25,8 @@ __all__ = ["EIGVEC_COND_LIMIT", "PHASE_CACHE", "phase_signals"]
 #: Largest condition number of a damped phase's state-space eigenvectors (near-defective: refused).
 EIGVEC_COND_LIMIT = 1e10
 
-#: Phases a flight keeps (the least recently used dropped past it): a rub of 134 nodes makes a new set of closed
-#: contacts at most switches, each phase some 50 kB.
+#: Phases a flight keeps (the least recently used dropped past it): a rub of 134 nodes can make a new set of closed
+#: contacts at most of its switches, each phase some 70 kB with 8 modes (at most about 300 MB kept).
 PHASE_CACHE = 4096
 
 
