@@ -37,8 +37,8 @@ def phase_signals(Wq: np.ndarray, H: np.ndarray, A: np.ndarray, G: np.ndarray | 
     symmetric or, with friction, not (its stiffness differs, not its signals).
 
     >>> L, P = phase_signals(np.eye(2), 0.5 * np.eye(2), np.array([True, False]), np.array([[2.0]]))
-    >>> L.tolist(), P.tolist()          # node 0 closed: its force 2(q₀ − g₀); node 1 open: its gap g₁ − q₁
-    ([[2.0, 0.0], [-0.0, -1.0]], [[-2.0, 0.0], [-0.0, 1.0]])
+    >>> (L + 0.0).tolist(), (P + 0.0).tolist()   # node 0 closed: its force 2(q₀ − g₀); node 1 open: g₁ − q₁
+    ([[2.0, 0.0], [0.0, -1.0]], [[-2.0, 0.0], [0.0, 1.0]])
     """
     m = Wq.shape[1]
     L, P = -Wq.T.copy(), np.eye(m)
