@@ -202,6 +202,8 @@ mass = "consistent"
 clamp = "boundary"
 [contact]
 nodes = [188, 190]
+normal = [1.0, 0.0, 0.0]
+clearance = 3.56e-4
 [rotation]
 speeds = {speeds}
 speed_unit = "rad/s"
