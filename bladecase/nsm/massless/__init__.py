@@ -19,7 +19,8 @@ has contact phases of finite duration instead of impacts. One module per step:
   the complementarity of their forces (:func:`lcp`), the clearances of an out-of-round casing (:class:`Rub`), a
   worn casing's clearance profile whose steps the flights cut at (:class:`Profile`);
 - :mod:`~bladecase.nsm.massless.nodes` — its phases (sets of closed contacts) and the exact event-driven simulator
-  (:func:`simulate_nodes`), damped, each phase's first switch found by :mod:`~bladecase.nsm.massless.nodal_switches`;
+  (:func:`simulate_nodes`), damped, each phase's first switch found by :mod:`~bladecase.nsm.massless.nodal_switches`
+  (a phase from one Cholesky solve of its closed block, cached per set: :mod:`~bladecase.nsm.massless.nodes_phase`);
 - :mod:`~bladecase.nsm.massless.nodal_orbit` — a period's flow of a :class:`NodalSystem` with its exact Jacobian
   (:func:`flow_map`) and the periodic orbits it closes, with their Floquet multipliers (:class:`NodalOrbit`);
 - :mod:`~bladecase.nsm.massless.nodal_modes` — the nonsmooth modes of a :class:`NodalSystem`: periodic orbits by

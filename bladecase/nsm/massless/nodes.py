@@ -45,159 +45,24 @@ True
 
 from __future__ import annotations
 
-import copy
+from collections import OrderedDict
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg as sla
 
-from .nodal_switches import _Signals, first_switch
+from . import nodes_phase
+from .nodal_switches import first_switch
 from .nodal_system import NODES_DENSE_LIMIT, NodalSystem, Profile, Rub, lcp
+from .nodes_phase import EIGVEC_COND_LIMIT, _Phase, phase_signals  # noqa: F401  (friction builds on them)
 
 __all__ = ["NODES_DENSE_LIMIT", "NodalFlight", "NodalSystem", "NodalTrajectory", "Profile", "Rub", "lcp",
            "simulate_nodes"]
-
-#: Largest condition number of a damped phase's state-space eigenvectors (near-defective: refused).
-EIGVEC_COND_LIMIT = 1e10
 
 #: Default ``max_switches`` of :func:`simulate_nodes`.
 MAX_SWITCHES = 1_000_000
 
 #: Relative size below which a switching signal counts as ON its surface at a switch.
 SURFACE_RTOL = 1e-9
-
-
-# ----------------------------------------------------------------------------- phases
-
-
-def phase_signals(Wq: np.ndarray, H: np.ndarray, A: np.ndarray, G: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
-    """The switching signals ``L q + P g(t)`` of the phase whose closed contacts are ``A`` (a boolean mask):
-    the closed contacts' forces ``G (W_Aᵀ q − g_A)`` and the open ones' gaps, with ``G`` the inverse of ``H`` on
-    ``A`` (``None`` when no contact is closed: the gaps ``g − Wᵀq`` alone). The same signals whether the phase is
-    symmetric or, with friction, not (its stiffness differs, not its signals)."""
-    m = Wq.shape[1]
-    L, P = -Wq.T.copy(), np.eye(m)
-    idx = np.flatnonzero(A)
-    if idx.size:
-        WA = Wq[:, idx]
-        L[idx] = G @ WA.T
-        P[idx] = 0.0
-        P[np.ix_(idx, idx)] = -G
-        out = np.flatnonzero(~A)
-        HG = H[np.ix_(out, idx)] @ G
-        L[out] = -Wq[:, out].T + HG @ WA.T
-        P[np.ix_(out, idx)] = -HG
-    return L, P
-
-
-class _Phase:
-    """One set ``A`` of closed contacts, in the open-phase modal coordinates ``(q, p)`` (``M = I``).
-
-    ``q(t₀+τ) = q_p(t₀+τ) + Re(Vx (a ∘ e^{Λτ}))`` with ``a`` the complex amplitudes of the homogeneous part and
-    ``q_p(t) = q_eq + Re(X e^{iνt})`` the phase's particular solution.
-    """
-
-    def __init__(self, fl: NodalFlight, A: np.ndarray):
-        s = fl.system
-        self.A = A
-        m, n = s.m, fl.n
-        Wq, H = fl.Wq, s.H
-        idx = np.flatnonzero(A)
-        K = np.diag(fl.omega**2)
-        if idx.size:
-            WA = Wq[:, idx]
-            G = np.linalg.inv(H[np.ix_(idx, idx)])
-            G = 0.5 * (G + G.T)
-            K = K + WA @ G @ WA.T
-        self.L, self.P = L, P = phase_signals(Wq, H, A, G if idx.size else None)  # switching signals: L q + P g(t)
-        self.idx = idx
-        self.GWt = G @ WA.T if idx.size else np.zeros((0, n))  # λ_A = G_A(W_Aᵀq − g_A(t))
-        self.G = G if idx.size else np.zeros((0, 0))
-        self.eq_map = np.linalg.solve(K, WA @ G) if idx.size else np.zeros((n, 0))  # q_eq per unit gap_A
-        f0 = WA @ (G @ s.gap[idx]) if idx.size else np.zeros(n)
-        self.q_eq = np.linalg.solve(K, f0)
-        nu = fl.nu
-        if idx.size and nu > 0 and fl.D is not None:
-            F = WA @ (G @ fl.D[idx])
-            Z = K - nu**2 * np.eye(n) + (1j * nu * fl.Cq if fl.Cq is not None else 0)
-            try:
-                self.X = np.linalg.solve(Z, F)
-            except np.linalg.LinAlgError:
-                raise ValueError(f"the casing's excitation at {nu / 2 / np.pi:.6g} Hz is at an undamped resonance "
-                                 "of a contact phase: add damping or change the speed") from None
-        else:
-            self.X = np.zeros(n, complex)
-        if fl.Cq is None:
-            lam2, psi = np.linalg.eigh(K)
-            if lam2.min() <= 0:
-                raise ValueError("a contact phase's stiffness is not positive definite")
-            w = np.sqrt(lam2)
-            self.lam = 1j * w
-            self.Vx, self.Vv = psi.astype(complex), psi * (1j * w)
-            self._psi, self._w = psi, w
-        else:
-            Ass = np.block([[np.zeros((n, n)), np.eye(n)], [-K, -fl.Cq]])
-            lam, V = np.linalg.eig(Ass)
-            self._lu = sla.lu_factor(V)
-            rcond = sla.lapack.zgecon(self._lu[0], np.abs(V).sum(axis=0).max())[0]
-            if not rcond * EIGVEC_COND_LIMIT > 1:
-                raise ValueError("a damped contact phase is nearly defective (critically damped mode): change the "
-                                 "damping slightly")
-            self.lam, self.Vx, self.Vv = np.minimum(lam.real, 0.0) + 1j * lam.imag, V[:n], V[n:]
-            self._Vinv = sla.lu_solve(self._lu, np.eye(2 * n, dtype=complex))  # amplitudes by one small product
-            self._psi = None
-        self.LVx = L @ self.Vx
-        self.nu = nu
-        self.const = L @ self.q_eq + P @ s.gap
-        self.E0 = (L @ self.X + (P @ fl.D if fl.D is not None else 0)) if nu > 0 else np.zeros(m, complex)
-        self.lam2 = np.abs(self.lam) ** 2
-
-    def shifted(self, delta: np.ndarray) -> _Phase:
-        """The same phase with every clearance ``delta`` (``(m,)``, m) wider: its equilibrium and switching
-        signals' constants moved, its modes shared (a worn casing's piece between two steps of its profile)."""
-        out = copy.copy(self)
-        dq = self.eq_map @ delta[self.idx]
-        out.q_eq = self.q_eq + dq
-        out.const = self.const + self.L @ dq + self.P @ delta
-        return out
-
-    def signals_at(self, q: np.ndarray, gap: np.ndarray) -> np.ndarray:
-        """The ``m`` switching signals (``λ`` of the closed contacts, the clearance left of the open ones) of the
-        modal displacement ``q`` against the clearances ``gap``."""
-        return self.L @ q + self.P @ gap
-
-    def particular(self, t: float) -> tuple[np.ndarray, np.ndarray]:
-        if self.nu == 0:
-            return self.q_eq, np.zeros_like(self.q_eq)
-        e = self.X * np.exp(1j * self.nu * t)
-        return self.q_eq + e.real, (1j * self.nu * e).real
-
-    def amplitudes(self, q, p, t0: float) -> np.ndarray:
-        qp, pp = self.particular(t0)
-        r, s = q - qp, p - pp
-        if self._psi is not None:
-            return self._psi.T @ r - 1j * (self._psi.T @ s) / self._w
-        return self._Vinv @ np.concatenate([r, s])
-
-    def advance(self, a: np.ndarray, t0: float, tau) -> tuple[np.ndarray, np.ndarray]:
-        """States at ``t₀ + τ`` (``tau`` scalar or ``(k,)``: columns)."""
-        tau = np.asarray(tau, dtype=float)
-        e = np.exp(np.multiply.outer(self.lam, tau)) * (a if tau.ndim == 0 else a[:, None])
-        qp, pp = self.particular(t0 + tau) if tau.ndim == 0 else self._particular_cols(t0 + tau)
-        return qp + (self.Vx @ e).real, pp + (self.Vv @ e).real
-
-    def _particular_cols(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        if self.nu == 0:
-            return np.repeat(self.q_eq[:, None], t.size, 1), np.zeros((self.q_eq.size, t.size))
-        e = np.multiply.outer(self.X, np.exp(1j * self.nu * t))
-        return self.q_eq[:, None] + e.real, (1j * self.nu * e).real
-
-    def signals(self, a: np.ndarray, t0: float) -> _Signals:
-        """The ``m`` switching signals of a flight starting at ``t₀`` with amplitudes ``a``."""
-        E = self.E0 * np.exp(1j * self.nu * t0) if self.nu > 0 else self.E0
-        return _Signals(self.lam, self.LVx * a, E, self.nu, self.const, self.lam2)
-
-
 
 
 class NodalFlight:
@@ -222,7 +87,7 @@ class NodalFlight:
             self.nu, self.D = rub.nu, rub.D
         else:
             self.nu, self.D = 0.0, None
-        self._phases: dict[bytes, _Phase] = {}
+        self._phases: OrderedDict[bytes, _Phase] = OrderedDict()  # the least recently used first
         self.profile = None
         if profile is not None:
             self.set_profile(profile, 0.0, 0.0)
@@ -259,11 +124,17 @@ class NodalFlight:
         ph = self._phases.get(key)
         if ph is None:
             ph = self._phases[key] = self._new_phase(A.copy())
+            if len(self._phases) > nodes_phase.PHASE_CACHE:  # made again if needed: the same numbers bit for bit
+                self._phases.popitem(last=False)
+        else:
+            self._phases.move_to_end(key)
         if self.profile is None or t is None:
             return ph
         i = int(self._piece(t))
         out = self._shifted.get((key, i))
         if out is None:
+            if len(self._shifted) >= nodes_phase.PHASE_CACHE:  # made again if needed, as the phases
+                self._shifted.clear()
             out = self._shifted[(key, i)] = ph.shifted(self.pieces[:, i])
         return out
 
@@ -373,7 +244,7 @@ class NodalTrajectory:
                                                                                       self.starts[i])
             Q[:, sel], P[:, sel] = ph.advance(a, self.starts[i], t[sel] - self.starts[i])
             if ph.idx.size:
-                lam[np.ix_(ph.idx, sel)] = np.maximum(ph.GWt @ Q[:, sel] - ph.G @ fl.gap(t[sel])[ph.idx], 0.0)
+                lam[np.ix_(ph.idx, sel)] = np.maximum(ph.closed_forces(Q[:, sel], t[sel], fl.gap), 0.0)
         x, v = fl.decode(Q, P)
         return x, v, lam
 

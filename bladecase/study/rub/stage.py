@@ -26,6 +26,7 @@ area under refinement: it stays in ``rub_nodes.csv`` and ``rub.vtu`` as data, no
 
 from __future__ import annotations
 
+import time
 from pathlib import Path
 
 import numpy as np
@@ -146,17 +147,40 @@ def _running(model, contact: Contact, u: np.ndarray, speed: float) -> Contact:
     return contact.closed_by(model, u)
 
 
-def _rub_point(speed: float, *, model, contact: Contact, interior: np.ndarray, size: int, casing: np.ndarray,
-               angles: np.ndarray, axis: RotationAxis, static: str, lobes: int, amplitude: float, damping: Damping,
-               revolutions: int, window: int, max_revolutions: int, friction: dict | None = None,
+class _Interior:
+    """The interior basis of the nodal models at the ``middle`` speed (rad/s), solved once per process where a speed
+    first needs it (shipped to the workers unsolved)."""
+
+    def __init__(self, middle: float):
+        self.middle, self.basis = middle, None
+
+    def __getstate__(self) -> dict:
+        return {"middle": self.middle, "basis": None}
+
+    def of(self, model, contact: Contact, size: int, casing: np.ndarray, axis: RotationAxis, static: str) -> np.ndarray:
+        if self.basis is None:
+            base = spin(model, self.middle, axis, static=static)
+            hot = _running(model, contact, base.displacement, self.middle)
+            self.basis = nodal_model(base.model, hot, size, factor=base.factor, casing=casing, residual=True).interior
+        return self.basis
+
+
+def _rub_point(speed: float, *, model, contact: Contact, interior: np.ndarray | _Interior, size: int,
+               casing: np.ndarray, angles: np.ndarray, axis: RotationAxis, static: str, lobes: int, amplitude: float,
+               damping: Damping, revolutions: int, window: int, max_revolutions: int, friction: dict | None = None,
                coating=None) -> dict:
-    """One speed (module level: an executor ships it to its workers)."""
+    """One speed (module level: an executor ships it to its workers). Its CPU seconds (``seconds``: the centrifugal
+    state, the reduction, the simulation) are logged in one line when it ends."""
+    clock = [time.process_time()]
     state = spin(model, speed, axis, static=static)
     hot = _running(model, contact, state.displacement, speed)
+    clock.append(time.process_time())
     # about a geometrically nonlinear state the modes turn with the deformed blade: another speed's interior basis
     # would carry spurious stretching (f1 +1.4 % at 1450 rpm from a 1547 rpm basis): each speed takes its own
-    own = interior if state.static != "nonlinear" else None
+    own = None if state.static == "nonlinear" else interior if isinstance(interior, np.ndarray) else interior.of(
+        model, contact, size, casing, axis, static)
     reduced = nodal_model(state.model, hot, size, factor=state.factor, casing=casing, interior=own, residual=True)
+    clock.append(time.process_time())
     try:
         fr, flight, response = friction_response(reduced, friction, axis, state.factor, speed, lobes, amplitude,
                                                  angles, damping, revolutions, window, max_revolutions,
@@ -175,7 +199,19 @@ def _rub_point(speed: float, *, model, contact: Contact, interior: np.ndarray, s
         out["peak_pressure"] = np.nan_to_num(contact_pressure(response.peak_force, reduced.areas)).tolist()
     out["open_hz"] = (reduced.system.modes[0][:6] / (2 * np.pi)).tolist()
     out["clearances_m"] = reduced.system.gap.tolist()
+    clock.append(time.process_time())
+    out["seconds"] = dict(zip(("state", "reduction", "simulation"), np.diff(clock).tolist()))
+    _log_point(speed, out)
     return out
+
+
+def _log_point(speed: float, out: dict) -> None:
+    """One line per speed as it ends (a long sweep logs its progress even without a progress bar)."""
+    sec = out["seconds"]
+    what = (f"refused ({out['error'][:80]})" if "error" in out else
+            f"{out['switches']} switches over {out['revolutions_run']} revolutions, {out['response']}")
+    log.info("rub: %.6g rad/s: %s; %.1f s (centrifugal state %.1f s, reduction %.1f s, simulation %.1f s)", speed,
+             what, sum(sec.values()), sec["state"], sec["reduction"], sec["simulation"])
 
 
 def _meet(X: np.ndarray, F: np.ndarray, c2: float) -> float | None:
@@ -269,13 +305,9 @@ def rub_stage(study, model, contact: Contact, *, families=None, executor=None, p
                  "tributary length along it (%.4g to %.4g mm of %.4g mm); no contact pressure or loaded area (a "
                  "line has no area): the forces are read", len(nodes), shares.min() * 1e3, shares.max() * 1e3,
                  shares.sum() * 1e3)
-    middle = float(np.sqrt(speeds.min() * speeds.max()))
-    try:
-        base = spin(model, middle, axis, static=static)
-        hot = _running(model, contact, base.displacement, middle)
-        interior = nodal_model(base.model, hot, r["size"], factor=base.factor, casing=casing, residual=True).interior
-    except ValueError as exc:
-        raise StudyError(f"[rub] {exc}") from None
+    # the interior basis at the middle of the range, computed where a speed first needs it (a speed about a
+    # geometrically nonlinear state takes its own: a sweep of such speeds never solves the middle one)
+    interior = _Interior(float(np.sqrt(speeds.min() * speeds.max())))
     damping = _damping(r)
     cap = max_revolutions(r)
     friction = study["contact"].get("friction")
