@@ -48,7 +48,6 @@ import scipy.linalg as sla
 
 from .nodes import (
     EIGVEC_COND_LIMIT,
-    SURFACE_RTOL,
     NodalFlight,
     NodalSystem,
     NodalTrajectory,
@@ -272,29 +271,10 @@ class FrictionFlight(NodalFlight):
     def _new_phase(self, A: np.ndarray) -> _Phase:
         return _FrictionPhase(self, A)
 
-    def active_set(self, q, p, t: float) -> np.ndarray:
+    def active_set(self, q, p, t: float, on: np.ndarray | None = None) -> np.ndarray:
         """The closed contacts from the state: the complementarity problem with ``H_μ``, at the rate level where a
-        contact is on its surface (as :meth:`NodalFlight.active_set`)."""
-        H = self.H_mu
-        g = self.gap(t)
-        y = self.Wq.T @ q
-        lam = lemke(g - y, H)
-        slack = g - y + H @ lam
-        tol_s = SURFACE_RTOL * max(float(np.abs(g).max()), float(np.abs(y).max()))
-        A = lam > tol_s / float(np.abs(H).max())
-        Dset = ~A & (slack <= tol_s)
-        if not Dset.any():
-            return A
-        B, Dn = np.flatnonzero(A), np.flatnonzero(Dset)
-        u = self.gap_rate(t) - self.Wq.T @ p
-        if B.size:
-            X = np.linalg.solve(H[np.ix_(B, B)], np.column_stack([u[B], H[np.ix_(B, Dn)]]))
-            qD = u[Dn] - H[np.ix_(Dn, B)] @ X[:, 0]
-            HD = H[np.ix_(Dn, Dn)] - H[np.ix_(Dn, B)] @ X[:, 1:]
-        else:
-            qD, HD = u[Dn], H[np.ix_(Dn, Dn)]
-        A[Dn] = lemke(qD, HD) > 0
-        return A
+        contact is on its surface (as :meth:`NodalFlight.active_set`, Lemke's method for the non-symmetric ``H_μ``)."""
+        return self.closed_set(self.H_mu, q, p, t, on, lemke, lemke)
 
 
 def friction_flight(system: NodalSystem, friction: Friction | None, damping=None,

@@ -172,15 +172,17 @@ class NodalFlight:
         on its surface (both its force and its remaining clearance zero). ``on``: contacts known to be on their
         surfaces (a switch just found them there, each to its own signal's tolerance): decided at the rate level
         whatever their force's round-off."""
-        s = self.system
-        H = s.H
+        return self.closed_set(self.system.H, q, p, t, on, lambda r, H: lcp(r, 0.5 * (H + H.T)), lcp)
+
+    def closed_set(self, H: np.ndarray, q, p, t: float, on: np.ndarray | None, rate_solver, solver) -> np.ndarray:
+        """:meth:`active_set` with the contacts' flexibility ``H`` (non-symmetric with friction) and the
+        complementarity solvers of the position level (``solver``) and of the rate level (``rate_solver``)."""
         g = self.gap(t)
         y = self.Wq.T @ q
-        lam = lcp(g - y, H)
+        lam = solver(g - y, H)
         slack = g - y + H @ lam
         tol_s = SURFACE_RTOL * max(float(np.abs(g).max()), float(np.abs(y).max()))
-        tol_l = tol_s / float(np.abs(H).max())
-        A = lam > tol_l
+        A = lam > tol_s / float(np.abs(H).max())
         Dset = ~A & (slack <= tol_s)
         if on is not None:
             A, Dset = A & ~on, Dset | on
@@ -189,14 +191,12 @@ class NodalFlight:
         B, Dn = np.flatnonzero(A), np.flatnonzero(Dset)
         u = self.gap_rate(t) - self.Wq.T @ p
         if B.size:
-            HBB = H[np.ix_(B, B)]
-            X = np.linalg.solve(HBB, np.column_stack([u[B], H[np.ix_(B, Dn)]]))
+            X = np.linalg.solve(H[np.ix_(B, B)], np.column_stack([u[B], H[np.ix_(B, Dn)]]))
             qD = u[Dn] - H[np.ix_(Dn, B)] @ X[:, 0]
             HD = H[np.ix_(Dn, Dn)] - H[np.ix_(Dn, B)] @ X[:, 1:]
         else:
             qD, HD = u[Dn], H[np.ix_(Dn, Dn)]
-        rate = lcp(qD, 0.5 * (HD + HD.T))
-        A[Dn] = rate > 0
+        A[Dn] = rate_solver(qD, HD) > 0
         return A
 
 
