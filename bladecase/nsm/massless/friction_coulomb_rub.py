@@ -27,12 +27,11 @@ each phase's pieces (one period of that phase's fastest term), at two orders: th
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from .friction import Friction
 from .friction_coulomb import CoulombFlight, CoulombTrajectory
+from .friction_energy import FrictionEnergy
 from .nodes import NodalSystem, Rub
 from .rub import SAMPLES_PER_PERIOD, SETTLED_RTOL, RubResponse, _change, _checked, _loaded_area
 
@@ -46,20 +45,9 @@ ORDERS = (10, 20)
 PIECES_PER_PERIOD = 1
 
 
-@dataclass(frozen=True)
-class CoulombEnergy:
-    """The energy balance over ``[t0, t1]`` (J): ``stored_change = casing + friction − damping`` up to ``residual``;
-    ``relative``: ``residual`` over the largest term; ``quadrature_error``: the two quadratures' difference."""
-
-    t0: float
-    t1: float
-    casing: float
-    friction: float
-    damping: float
-    stored_change: float
-    residual: float
-    relative: float
-    quadrature_error: float
+#: The energy balance of a stick–slip run: the same terms as the rotation model's (casing input, friction, damping,
+#: stored energy, residual, the two quadratures' difference).
+CoulombEnergy = FrictionEnergy
 
 
 def _stored(tr: CoulombTrajectory, t) -> np.ndarray:
