@@ -53,7 +53,7 @@ import numpy as np
 from .friction import Friction
 from .friction_coulomb_phase import OPEN, SLIP_NEG, SLIP_POS, STICK, CoulombPhase, RampSignals
 from .nodal_switches import first_switch
-from .nodes import MAX_SWITCHES, SURFACE_RTOL, NodalSystem, Rub, lcp
+from .nodes import MAX_SWITCHES, SURFACE_RTOL, NodalSystem, Rub, casing_gap, lcp
 
 __all__ = ["CODES", "CoulombFlight", "CoulombTrajectory", "simulate_coulomb"]
 
@@ -126,12 +126,7 @@ class CoulombFlight:
 
     def gap(self, t) -> np.ndarray:
         """The clearances at the times ``t``: ``(m,)`` or ``(m, k)``."""
-        d = self.system.gap
-        if self.D is None:
-            return d if np.ndim(t) == 0 else np.repeat(d[:, None], np.size(t), 1)
-        if np.ndim(t) == 0:
-            return d + (self.D * np.exp(1j * self.nu * t)).real
-        return d[:, None] + np.multiply.outer(self.D, np.exp(1j * self.nu * np.atleast_1d(t))).real
+        return casing_gap(self.system.gap, self.D, self.nu, t)
 
     def rho_rate(self, t) -> np.ndarray:
         """``ρ'(t) = (g'(t), V)``: ``(2m, k)``."""

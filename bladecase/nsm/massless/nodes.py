@@ -65,6 +65,16 @@ MAX_SWITCHES = 1_000_000
 SURFACE_RTOL = 1e-9
 
 
+def casing_gap(d: np.ndarray, D: np.ndarray | None, nu: float, t) -> np.ndarray:
+    """The clearances ``d + Re(D e^{iνt})`` of an out-of-round casing seen at speed (``D`` ``None``: a round one,
+    ``d``) at the times ``t``: ``(m,)`` for a scalar ``t``, else ``(m, k)``."""
+    if D is None:
+        return d if np.ndim(t) == 0 else np.repeat(d[:, None], np.size(t), 1)
+    if np.ndim(t) == 0:
+        return d + (D * np.exp(1j * nu * t)).real
+    return d[:, None] + np.multiply.outer(D, np.exp(1j * nu * np.atleast_1d(t))).real
+
+
 class NodalFlight:
     """Exact flights of a :class:`NodalSystem`: its phases (cached per set of closed contacts), optional
     damping (:class:`~bladecase.nsm.damping.Damping` of the open-phase modes) and an out-of-round casing
@@ -148,12 +158,7 @@ class NodalFlight:
         return self._base_gap(t)
 
     def _base_gap(self, t) -> np.ndarray:
-        d = self.system.gap
-        if self.D is None:
-            return d if np.ndim(t) == 0 else np.repeat(d[:, None], np.size(t), 1)
-        if np.ndim(t) == 0:
-            return d + (self.D * np.exp(1j * self.nu * t)).real
-        return d[:, None] + np.multiply.outer(self.D, np.exp(1j * self.nu * np.atleast_1d(t))).real
+        return casing_gap(self.system.gap, self.D, self.nu, t)
 
     def gap_rate(self, t: float) -> np.ndarray:
         if self.D is None:
