@@ -5,9 +5,10 @@
 A harmonic force ``F cos Ωt`` along ``shape`` (interior, N) drives the :class:`NodalSystem` with stick–slip friction;
 the exact event-driven simulator of :mod:`~bladecase.nsm.massless.friction_coulomb` flies it (the force enters each
 phase's particular solution ``Re(X e^{iΩt})``, ``X = (K − Ω² + iΩC)⁻¹ φᵀF``, as the out-of-round casing does) to a
-steady state: whole forcing periods until the followed mode's amplitude (the largest ``|q|`` of its open-phase
-modal coordinate over a period) changes by less than ``rtol`` from one period to the next. A sweep continues each
-frequency from the previous one's end state (its nodes' stick state too).
+steady state: whole forcing periods until the followed mode's amplitude (the largest value of its open-phase
+modal coordinate over a period: the turning point, as the mode's ``amplitude``) changes by less than ``rtol``
+from one period to the next. A sweep continues each frequency from the previous one's end state (its nodes' stick
+state too).
 
 The resonance is read two ways. **Phase resonance** (a single nonlinear mode driven at its own frequency): the
 force balances the mode's damping, ``F_q = 2ζ(a)ω(a)²a`` (``F_q = φᵀF``, the modal force), so the forced peak
@@ -23,7 +24,7 @@ flanks sit at a lower amplitude, where the mode's frequency and damping differ).
 >>> f = Friction(0.4, T=[[1.0], [0.0]], C_tt=[[0.5]], model="coulomb")
 >>> p = forced_point(s, f, [0.3, 0.0], 1.0, Damping(zeta=0.02), load=[0.0, 1.404])
 >>> bool(p.settled), round(float(p.amplitude), 3)
-(True, 0.15)
+(True, 0.139)
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ from .friction_coulomb import CoulombFlight, CoulombTrajectory
 from .friction_coulomb_phase import CoulombPhase
 from .nodes import NodalSystem, lcp
 
-__all__ = ["ForcedPoint", "Resonance", "forced_point", "forced_sweep", "resonance"]
+__all__ = ["ForcedPoint", "Resonance", "forced_point", "forced_sweep", "half_power", "resonance"]
 
 #: Samples per forcing period at which the amplitude is read (the phases' starts added).
 SAMPLES = 400
@@ -96,18 +97,21 @@ def _amplitude(tr: CoulombTrajectory, mode: int, t0: float, t1: float) -> float:
     t = np.unique(np.r_[np.linspace(t0, t1, SAMPLES + 1), tr.starts[(tr.starts > t0) & (tr.starts < t1)]])
     x, _ = tr.state(t)
     q = s.modes[1][:, mode] @ (s.M @ x)
-    return float(0.5 * (q.max() - q.min()))
+    return float(q.max())
 
 
 def forced_point(system: NodalSystem, friction: Friction, shape, frequency: float, damping=None, load=None,
                  sliding=0.0, mode: int = 0, start: ForcedPoint | None = None, rtol: float = 1e-6,
-                 max_periods: int = 400, chunk: int = 10) -> ForcedPoint:
+                 max_periods: int = 400, chunk: int = 10, state=None) -> ForcedPoint:
     """The steady state under ``Re(shape · e^{iΩt})`` at ``Ω = frequency`` (module docstring), from ``start``'s
-    end state (default: the static state under ``load``, at rest), flown ``chunk`` periods at a time."""
+    end state, or ``state`` = ``(x0, v0, codes, anchors)`` (a mode's start: ``shape`` times ``1j`` then drives it in
+    phase resonance), default the static state under ``load``, at rest; flown ``chunk`` periods at a time."""
     if not (np.isfinite(frequency) and frequency > 0):
         raise ValueError(f"frequency must be a finite number > 0 (rad/s), got {frequency!r}")
     T = 2 * np.pi / frequency
-    if start is None:
+    if state is not None:
+        x0, v0, codes, anchors = state
+    elif start is None:
         x0, v0, codes, anchors = _static(system, load), np.zeros(system.n), None, None
     else:
         tr = start.trajectory
@@ -131,13 +135,30 @@ def forced_point(system: NodalSystem, friction: Friction, shape, frequency: floa
 
 
 def forced_sweep(system: NodalSystem, friction: Friction, shape, frequencies, damping=None, load=None,
-                 sliding=0.0, mode: int = 0, rtol: float = 1e-6) -> list[ForcedPoint]:
-    """:func:`forced_point` at each of ``frequencies`` in turn, each from the previous one's end state."""
+                 sliding=0.0, mode: int = 0, rtol: float = 1e-6, state=None) -> list[ForcedPoint]:
+    """:func:`forced_point` at each of ``frequencies`` in turn, each from the previous one's end state (the first
+    from ``state``, as :func:`forced_point`)."""
     out, prev = [], None
     for w in np.asarray(frequencies, dtype=float):
-        prev = forced_point(system, friction, shape, w, damping, load, sliding, mode, prev, rtol)
+        prev = forced_point(system, friction, shape, w, damping, load, sliding, mode, prev, rtol,
+                            state=state if prev is None else None)
         out.append(prev)
     return out
+
+
+def half_power(force: float, frequency: float, zeta: float, amplitude: float) -> tuple[float, float]:
+    """The two forcing frequencies at which a single nonlinear mode of frequency ``ω(a_h)`` and ratio ``ζ(a_h)``
+    (its values at ``a_h = amplitude``, the flank's amplitude) answers the modal force ``F_q`` with the amplitude
+    ``a_h``: the roots of ``(F_q/a_h)² = (ω² − Ω²)² + (2ζωΩ)²``.
+
+    >>> [round(w, 4) for w in half_power(0.1, 1.0, 0.05, 1 / np.sqrt(2))]     # linear: ≈ 1 ∓ ζ
+    [0.946, 1.0465]
+    """
+    w2, c = frequency**2, 1 - 2 * zeta**2
+    disc = w2**2 * (c**2 - 1) + (force / amplitude) ** 2
+    if disc < 0 or w2 * c - np.sqrt(disc) <= 0:
+        raise ValueError(f"no two frequencies give the amplitude {amplitude!r} under the modal force {force!r}")
+    return float(np.sqrt(w2 * c - np.sqrt(disc))), float(np.sqrt(w2 * c + np.sqrt(disc)))
 
 
 @dataclass(frozen=True)
