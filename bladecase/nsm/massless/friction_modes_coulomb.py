@@ -105,7 +105,10 @@ def _start(fl: CoulombFlight, q, p, ratio: np.ndarray) -> tuple[np.ndarray, np.n
         u0 = ph.Uq @ q + ph.Ur @ ph.rho(fl, 0.0, anchors)
         A = (G @ ph.Ur[:, fl.m:])[np.ix_(S, S)]
         anchors[S] = np.linalg.solve(A, -(G @ u0)[S])
-    return _admissible(fl, codes, anchors, q, p)
+    try:
+        return _admissible(fl, codes, anchors, q, p)
+    except ValueError:  # no admissible state from these fractions (a trial state of the solve): free of force
+        return _admissible(fl, *fl.initial(q, p), q, p)
 
 
 def _flow(fl: CoulombFlight, q, p, codes, anchors, period: float, max_switches: int = 20_000) -> CoulombTrajectory:
