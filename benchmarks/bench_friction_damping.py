@@ -14,8 +14,10 @@ by their areas. At each amplitude (times the mode's grazing amplitude):
    started in the mode's orbit, swept over ``--points`` frequencies across ±2.5 ζ(a) around ω(a): its peak
    amplitude ``a_peak`` and frequency, and the damping it says two ways —
    ``ζ_F = F / (2ω_peak²a_peak)`` (phase resonance) against ζ(a_peak) by the concept, and the half-power width
-   read as a linear mode's, ``(Ω₂ − Ω₁)/(2Ω_peak)``, against the same; and the half-power frequencies predicted by
-   the concept at ``a_peak/√2`` (a single nonlinear mode) against the sweep's.
+   read as a linear mode's, ``(Ω₂ − Ω₁)/(2Ω_peak)``, against the same (and friction's part of ``ζ_F``: less the
+   mode's ratio without friction, by the rotation model's concept at μ = 0, against friction's part of ζ); and
+   the half-power frequencies predicted by the concept at ``a_peak/√2`` (a single nonlinear mode) against the
+   sweep's.
 
     python benchmarks/bench_friction_damping.py                       # 1.5, 2, 3 x grazing
     python benchmarks/bench_friction_damping.py --amplitudes 1.5 2
@@ -37,6 +39,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from bench_rub import at_speed, demo  # noqa: E402
 
 from bladecase.nsm import Damping  # noqa: E402
+from bladecase.nsm.massless.friction import Friction  # noqa: E402
+from bladecase.nsm.massless.friction_modes import friction_mode  # noqa: E402
 from bladecase.nsm.massless.friction_modes_coulomb import coulomb_decay_ratio, coulomb_mode  # noqa: E402
 from bladecase.nsm.massless.friction_modes_forced import forced_sweep, half_power, resonance  # noqa: E402
 from bladecase.reduction.nodal_friction import nodal_friction  # noqa: E402
@@ -94,8 +98,11 @@ def main() -> None:
               f"({sum(p.periods for p in pts)} periods, {unsettled} not settled to 1e-6): peak a = {r.amplitude:.5g} "
               f"({r.amplitude / amp - 1:+.2%} from a) at {r.frequency / 2 / np.pi:.4f} Hz")
         mp = coulomb_mode(s, fr, r.amplitude, damping=DAMPING, guess=m)
-        print(f"   EPMC at a_peak: zeta {mp.zeta:.6f}, f = {mp.frequency / 2 / np.pi:.4f} Hz")
-        print(f"   phase resonance zeta_F = F/(2 w^2 a) = {r.zeta_phase:.6f}: {rel(r.zeta_phase, mp.zeta)}")
+        z0 = friction_mode(s, Friction(0.0, T=fr.T, C_nt=fr.C_nt, C_tt=fr.C_tt), r.amplitude, damping=DAMPING).zeta
+        print(f"   EPMC at a_peak: zeta {mp.zeta:.6f}, f = {mp.frequency / 2 / np.pi:.4f} Hz; without friction "
+              f"zeta {z0:.6f} (friction's part {mp.zeta - z0:.3e})")
+        print(f"   phase resonance zeta_F = F/(2 w^2 a) = {r.zeta_phase:.6f}: {rel(r.zeta_phase, mp.zeta)}; friction's "
+              f"part {r.zeta_phase - z0:.3e}: {(r.zeta_phase - z0) / (mp.zeta - z0) - 1:+.2%}")
         if r.zeta_half_power is None:
             print("   half-power: the sweep does not reach a_peak/sqrt2 on both flanks")
             continue
