@@ -11,7 +11,8 @@ by their areas. At each amplitude (times the mode's grazing amplitude):
 1. the extended periodic motion concept: frequency and ζ(a); the free decay from the orbit's start (certified
    simulator, without the term) beside it;
 2. the forced response to ``F cos Ωt`` along the mode's shape with ``F = 2ζ(a)ω(a)²a`` (phase resonance at a),
-   started in the mode's orbit, swept over ``--points`` frequencies across ±2.5 ζ(a) around ω(a): its peak
+   started in the mode's orbit, swept over ``--points`` frequencies across ±2.5 ζ(a) around ω(a), the top refined
+   by ``--refine`` golden-section evaluations: its peak
    amplitude ``a_peak`` and frequency, and the damping it says two ways —
    ``ζ_F = F / (2ω_peak²a_peak)`` (phase resonance) against ζ(a_peak) by the concept, and the half-power width
    read as a linear mode's, ``(Ω₂ − Ω₁)/(2Ω_peak)``, against the same (and friction's part of ``ζ_F``: less the
@@ -42,7 +43,7 @@ from bladecase.nsm import Damping  # noqa: E402
 from bladecase.nsm.massless.friction import Friction  # noqa: E402
 from bladecase.nsm.massless.friction_modes import friction_mode  # noqa: E402
 from bladecase.nsm.massless.friction_modes_coulomb import coulomb_decay_ratio, coulomb_mode  # noqa: E402
-from bladecase.nsm.massless.friction_modes_forced import forced_sweep, half_power, resonance  # noqa: E402
+from bladecase.nsm.massless.friction_modes_forced import forced_sweep, half_power, refine_peak, resonance  # noqa: E402
 from bladecase.reduction.nodal_friction import nodal_friction  # noqa: E402
 from bladecase.study.rub import stage  # noqa: E402
 
@@ -60,6 +61,7 @@ def main() -> None:
     ap.add_argument("--nodes", type=int, nargs="+", default=[0, 8, 17, 25])
     ap.add_argument("--rpm", type=float, default=1650.0)
     ap.add_argument("--points", type=int, default=21)
+    ap.add_argument("--refine", type=int, default=10, help="golden-section evaluations at the peak (0: none)")
     a = ap.parse_args()
     t0 = time.perf_counter()
     study, model, contact = demo()
@@ -91,7 +93,7 @@ def main() -> None:
         state = (m.x0, m.v0, m.codes, m.anchors)
         up = forced_sweep(s, fr, shape, ws[mid:], DAMPING, state=state, rtol=1e-6)
         down = forced_sweep(s, fr, shape, ws[mid::-1], DAMPING, state=state, rtol=1e-6)
-        pts = down[::-1] + up[1:]
+        pts = refine_peak(s, fr, shape, down[::-1] + up[1:], DAMPING, rtol=1e-6, evaluations=a.refine)
         r = resonance(pts, force)
         unsettled = sum(not p.settled for p in pts)
         print(f"   forced F = {force:.4g} (modal): {len(pts)} frequencies in {time.perf_counter() - t:.1f} s "

@@ -195,7 +195,15 @@ def coulomb_mode(system: NodalSystem, friction: Friction, amplitude: float, mode
     """The periodic orbit of the extended periodic motion concept with stick–slip friction (module docstring)
     through the turning point where the open-phase mode ``mode``'s coordinate is ``amplitude``: ``load``, a constant
     force on the interior (the normal preload); ``sliding``, the casing's speed under each node (m/s, default 0: at
-    rest); ``guess``, a neighbouring answer to start from."""
+    rest); ``guess``, a neighbouring answer to start from.
+
+    >>> import numpy as np
+    >>> s = NodalSystem(np.eye(2), np.diag([1.0, 4.0]), np.array([[0.0], [1.0]]), [[1e-3]], gap=[0.1])
+    >>> f = Friction(0.4, T=[[1.0], [0.0]], C_tt=[[0.5]], model="coulomb")
+    >>> m = coulomb_mode(s, f, amplitude=2.0, load=[0.0, 1.404])
+    >>> round(m.frequency, 4), round(m.zeta, 4)          # stiffer and damped by the stick–slip contact
+    (1.0493, 0.106)
+    """
     if not isinstance(friction, Friction):
         raise ValueError(f"friction must be a Friction, got {type(friction).__name__}")
     friction.check(system)
@@ -255,7 +263,15 @@ def coulomb_mode(system: NodalSystem, friction: Friction, amplitude: float, mode
 
 def orbit_kinetic(tr: CoulombTrajectory, t0: float, t1: float, order: int = 20) -> float:
     """``∫ x'ᵀMx' dt`` over ``[t0, t1]`` of a stick–slip trajectory (Gauss–Legendre of ``order`` on each phase
-    piece, cut at most a tenth of the open-phase fastest period long)."""
+    piece, cut at most a tenth of the open-phase fastest period long).
+
+    >>> import numpy as np
+    >>> s = NodalSystem(np.eye(2), np.diag([1.0, 4.0]), np.array([[0.0], [1.0]]), [[1e-3]], gap=[0.1])
+    >>> f = Friction(0.4, T=[[1.0], [0.0]], C_tt=[[0.5]], model="coulomb")
+    >>> m = coulomb_mode(s, f, amplitude=2.0, load=[0.0, 1.404])
+    >>> round(m.xi * orbit_kinetic(m.orbit, 0.0, m.period), 6)     # = the Jenkins loop 4·0.4·(2 − 0.2)
+    2.88
+    """
     s = tr.system
     step = 0.1 * 2 * np.pi / float(s.modes[0].max())
     cuts = np.r_[t0, tr.starts[(tr.starts > t0) & (tr.starts < t1)], t1]
