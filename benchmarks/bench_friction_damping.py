@@ -20,7 +20,7 @@ by their areas. At each amplitude (times the mode's grazing amplitude):
    the half-power frequencies predicted by the concept at ``a_peak/√2`` (a single nonlinear mode) against the
    sweep's.
 
-    python benchmarks/bench_friction_damping.py                       # 1.5, 2, 3 x grazing
+    python benchmarks/bench_friction_damping.py                       # 1.5, 2, 2.5, 3 x grazing
     python benchmarks/bench_friction_damping.py --amplitudes 1.5 2
 """
 
@@ -42,7 +42,7 @@ from bench_rub import at_speed, demo  # noqa: E402
 from bladecase.nsm import Damping  # noqa: E402
 from bladecase.nsm.massless.friction import Friction  # noqa: E402
 from bladecase.nsm.massless.friction_modes import friction_mode  # noqa: E402
-from bladecase.nsm.massless.friction_modes_coulomb import coulomb_decay_ratio, coulomb_mode  # noqa: E402
+from bladecase.nsm.massless.friction_modes_coulomb import coulomb_decay_ratio, coulomb_mode, orbit_kinetic  # noqa: E402
 from bladecase.nsm.massless.friction_modes_forced import forced_sweep, half_power, refine_peak, resonance  # noqa: E402
 from bladecase.reduction.nodal_friction import nodal_friction  # noqa: E402
 from bladecase.study.rub import stage  # noqa: E402
@@ -57,7 +57,7 @@ def rel(a: float, b: float) -> str:
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--amplitudes", type=float, nargs="+", default=[1.5, 2.0, 3.0])
+    ap.add_argument("--amplitudes", type=float, nargs="+", default=[1.5, 2.0, 2.5, 3.0])
     ap.add_argument("--nodes", type=int, nargs="+", default=[0, 8, 17, 25])
     ap.add_argument("--rpm", type=float, default=1650.0)
     ap.add_argument("--points", type=int, default=21)
@@ -81,10 +81,12 @@ def main() -> None:
         m = coulomb_mode(s, fr, amp, damping=DAMPING, guess=guess)
         guess = m
         z_decay = coulomb_decay_ratio(s, fr, m, DAMPING)
+        kappa = orbit_kinetic(m.orbit, 0.0, m.period) / (np.pi * m.frequency * amp**2)
         print(f"\n{k:.2f} x grazing: EPMC f = {m.frequency / 2 / np.pi:.4f} Hz ({m.frequency / omega[0] - 1:+.3e}), "
               f"zeta {m.zeta:.6f} (friction {m.zeta - DAMPING.zeta:+.6f}), closed to {m.residual:.0e}, "
               f"{m.orbit.starts.size} phases; free decay {z_decay:.6f} ({z_decay / m.zeta - 1:+.2%}); "
-              f"{time.perf_counter() - t:.1f} s")
+              f"{time.perf_counter() - t:.1f} s; the orbit's kinetic integral over a harmonic mode's pi w a^2: "
+              f"{kappa:.4f}")
         force = 2 * m.zeta * m.frequency**2 * amp
         shape = 1j * force * (s.M @ phi[:, 0])  # −F sin Ωt: in phase resonance with the orbit x0 cos Ωt
         t = time.perf_counter()
