@@ -6,7 +6,8 @@ stick–slip model, 0.5 % structural damping, the casing at rest (sliding speed 
 with the casing sliding at ΩR the rotation model's friction does no net work on a free mode). The stick–slip
 simulator does not run the 26 tip nodes against a casing at rest (a grazing switch of the coupled massless nodes),
 so the tip is represented by ``--nodes`` of them (default 4, spread across the tip), sharing the casing's stiffness
-by their areas. At each amplitude (times the mode's grazing amplitude):
+by their areas. First the same checks on the Jenkins oscillator of the tests; then at each amplitude (times the
+mode's grazing amplitude):
 
 1. the extended periodic motion concept: frequency and ζ(a); the free decay from the orbit's start (certified
    simulator, without the term) beside it;
@@ -44,6 +45,7 @@ from bladecase.nsm.massless.friction import Friction  # noqa: E402
 from bladecase.nsm.massless.friction_modes import friction_mode  # noqa: E402
 from bladecase.nsm.massless.friction_modes_coulomb import coulomb_decay_ratio, coulomb_mode, orbit_kinetic  # noqa: E402
 from bladecase.nsm.massless.friction_modes_forced import forced_sweep, half_power, refine_peak, resonance  # noqa: E402
+from bladecase.nsm.massless.nodes import NodalSystem  # noqa: E402
 from bladecase.reduction.nodal_friction import nodal_friction  # noqa: E402
 from bladecase.study.rub import stage  # noqa: E402
 
@@ -55,6 +57,29 @@ def rel(a: float, b: float) -> str:
     return f"{d:+.2%} {'ok' if abs(d) <= GOAL else 'NOT within 5 %'}"
 
 
+def jenkins() -> None:
+    """The Jenkins oscillator of the tests (k = 1, k_t = 2, μN = 0.4, 2 % damping) at a = 4: the same checks."""
+    s = NodalSystem(np.eye(2), np.diag([1.0, 4.0]), np.array([[0.0], [1.0]]), [[1e-3]], gap=[0.1])
+    f = Friction(0.4, T=[[1.0], [0.0]], C_tt=[[0.5]], model="coulomb")
+    load, d, amp = [0.0, 1.404], Damping(zeta=0.02), 4.0
+    t = time.perf_counter()
+    m = coulomb_mode(s, f, amp, damping=d, load=load)
+    force = 2 * m.zeta * m.frequency**2 * amp
+    shape = 1j * force * (s.M @ s.modes[1][:, 0])
+    ws = m.frequency * (1 + m.zeta * np.linspace(-3, 3, 41))
+    state = (m.x0, m.v0, m.codes, m.anchors)
+    up = forced_sweep(s, f, shape, ws[20:], d, load, rtol=1e-7, state=state)
+    down = forced_sweep(s, f, shape, ws[20::-1], d, load, rtol=1e-7, state=state)
+    r = resonance(refine_peak(s, f, shape, down[::-1] + up[1:], d, load, rtol=1e-7), force)
+    mp = coulomb_mode(s, f, r.amplitude, damping=d, load=load)
+    mh = coulomb_mode(s, f, r.amplitude / np.sqrt(2), damping=d, load=load)
+    lo, hi = half_power(force, mh.frequency, mh.zeta, r.amplitude / np.sqrt(2))
+    print(f"the Jenkins oscillator at a = {amp:g}: zeta {m.zeta:.5f}; forced peak a = {r.amplitude:.5g}; phase "
+          f"resonance {r.zeta_phase:.5f} against {mp.zeta:.5f}: {rel(r.zeta_phase, mp.zeta)}; half-power read as "
+          f"linear {r.zeta_half_power:.5f}: {rel(r.zeta_half_power, mp.zeta)}; predicted half-power width "
+          f"{rel(r.high - r.low, hi - lo)} ({time.perf_counter() - t:.1f} s)\n")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--amplitudes", type=float, nargs="+", default=[1.5, 2.0, 2.5, 3.0])
@@ -63,6 +88,7 @@ def main() -> None:
     ap.add_argument("--points", type=int, default=21)
     ap.add_argument("--refine", type=int, default=10, help="golden-section evaluations at the peak (0: none)")
     a = ap.parse_args()
+    jenkins()
     t0 = time.perf_counter()
     study, model, contact = demo()
     reduced, _, _ = at_speed(study, model, contact, a.rpm, nodes=a.nodes)
