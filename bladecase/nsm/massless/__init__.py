@@ -37,8 +37,12 @@ has contact phases of finite duration instead of impacts. One module per step:
   each revolution's energy balance and the sliding check (:func:`friction_rub`);
   :mod:`~bladecase.nsm.massless.friction_coulomb` (with ``friction_coulomb_phase`` and ``friction_coulomb_rub``) —
   stick–slip Coulomb friction, the sliding speed free to vanish (:func:`simulate_coulomb`: each node open, sliding
-  either way or sticking, every combination a linear phase flown exactly); further friction models sit beside
-  them, in modules named ``friction*``;
+  either way or sticking, every combination a linear phase flown exactly);
+  :mod:`~bladecase.nsm.massless.friction_modes_coulomb` — a mode's damping ratio with stick–slip friction by the
+  extended periodic motion concept, its free decay and the Jenkins element's closed form (:func:`coulomb_mode`),
+  and :mod:`~bladecase.nsm.massless.friction_modes_forced` — the forced response with stick–slip friction, its
+  resonance peak and half-power frequencies; further friction models sit beside them, in modules named
+  ``friction*``;
 - :mod:`~bladecase.nsm.massless.wear` — an abradable coating round the casing worn by the tip (:class:`Abradable`,
   :class:`WearProfile`, :func:`pass_tip`), elastic–perfectly plastic: the profile each tip passage leaves;
 - :mod:`~bladecase.nsm.massless.wear_rub` — the rub that wears the coating: each revolution flown against the
