@@ -115,11 +115,9 @@ class FrictionMode:
     converged: bool
 
 
-def friction_mode(system: NodalSystem, friction: Friction, amplitude: float, mode: int = 0, damping=None,
-                  guess: FrictionMode | None = None, tol: float = 1e-10) -> FrictionMode:
-    """The periodic orbit of the extended periodic motion concept (module docstring) through the turning point
-    where the open-phase mode ``mode``'s coordinate is ``amplitude``; ``guess``: a neighbouring answer to start
-    from (default: the open-phase mode itself, ``ξ = 0``)."""
+def checked_mode(system: NodalSystem, friction: Friction, amplitude: float, mode: int):
+    """The arguments of an extended-periodic-motion mode checked (``ValueError`` naming the bad one); returns
+    ``(n, ω, Φ, the other modes' indices)``."""
     if not isinstance(friction, Friction):
         raise ValueError(f"friction must be a Friction, got {type(friction).__name__}")
     friction.check(system)
@@ -130,6 +128,15 @@ def friction_mode(system: NodalSystem, friction: Friction, amplitude: float, mod
     if not (isinstance(mode, (int, np.integer)) and 0 <= mode < n):
         raise ValueError(f"mode must be an integer in 0..{n - 1}, got {mode!r}")
     others = np.flatnonzero(np.arange(n) != mode)
+    return n, omega, phi, others
+
+
+def friction_mode(system: NodalSystem, friction: Friction, amplitude: float, mode: int = 0, damping=None,
+                  guess: FrictionMode | None = None, tol: float = 1e-10) -> FrictionMode:
+    """The periodic orbit of the extended periodic motion concept (module docstring) through the turning point
+    where the open-phase mode ``mode``'s coordinate is ``amplitude``; ``guess``: a neighbouring answer to start
+    from (default: the open-phase mode itself, ``ξ = 0``)."""
+    n, omega, phi, others = checked_mode(system, friction, amplitude, mode)
     if guess is None:
         y0 = np.r_[np.zeros(2 * (n - 1)), 2 * np.pi / omega[mode], 0.0]
     else:

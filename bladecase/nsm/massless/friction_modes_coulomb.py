@@ -45,7 +45,7 @@ from .friction import Friction
 from .friction_coulomb import CoulombFlight, CoulombTrajectory
 from .friction_coulomb_phase import OPEN, STICK
 from .friction_coulomb_rub import _stored
-from .friction_modes import _first
+from .friction_modes import _first, checked_mode
 from .nodes import SURFACE_RTOL, NodalSystem, lcp
 
 __all__ = ["CoulombMode", "coulomb_decay_ratio", "coulomb_mode", "equivalent_ratio", "jenkins_dissipation",
@@ -204,16 +204,7 @@ def coulomb_mode(system: NodalSystem, friction: Friction, amplitude: float, mode
     >>> round(m.frequency, 4), round(m.zeta, 4)          # stiffer and damped by the stick–slip contact
     (1.0493, 0.106)
     """
-    if not isinstance(friction, Friction):
-        raise ValueError(f"friction must be a Friction, got {type(friction).__name__}")
-    friction.check(system)
-    if not (np.isfinite(amplitude) and amplitude > 0):
-        raise ValueError(f"amplitude must be a finite number > 0 (the mode's modal coordinate), got {amplitude!r}")
-    n = system.n
-    omega, phi = system.modes
-    if not (isinstance(mode, (int, np.integer)) and 0 <= mode < n):
-        raise ValueError(f"mode must be an integer in 0..{n - 1}, got {mode!r}")
-    others = np.flatnonzero(np.arange(n) != mode)
+    n, omega, phi, others = checked_mode(system, friction, amplitude, mode)
     if guess is None:
         y0, ratio = _guess(system, friction, damping, sliding, load, amplitude, mode, others, n)
     else:
