@@ -13,6 +13,9 @@ $(STAMP): pyproject.toml
 	@# optional CHOLMOD from cvxopt's wheel (pip alone): faster, leaner sparse factorisation; SuperLU without it
 	$(BIN)/python -m pip install --quiet --only-binary=cvxopt -e ".[cvxopt]" \
 	    || echo "optional cvxopt (CHOLMOD) not installed: no wheel for this platform, SuperLU used"
+	@# optional METIS ordering for CHOLMOD (pymetis's wheel): less fill on large models; CHOLMOD's AMD without it
+	$(BIN)/python -m pip install --quiet --only-binary=pymetis -e ".[metis]" \
+	    || echo "optional pymetis (METIS ordering) not installed: no wheel for this platform, AMD used"
 	@# optional CHOLMOD (faster sparse factorisation): only where SuiteSparse's headers are installed
 	@if [ -f /usr/include/suitesparse/cholmod.h ]; then \
 	    $(BIN)/python -m pip install --quiet "scikit-sparse<0.5" \

@@ -3,7 +3,9 @@ pivots checked), scikit-sparse's CHOLMOD where installed, and CHOLMOD as shipped
 
 ``cvxopt`` (PyPI wheels for Linux, macOS and Windows) bundles SuiteSparse's CHOLMOD with an optimised BLAS,
 so ``pip`` installs it with no compiler and no system headers (``make`` installs it).  Its factorisation is
-CHOLMOD's supernodal Cholesky ``Pᵀ A P = L Lᵀ`` (AMD ordering: cvxopt's CHOLMOD has no METIS), single-threaded;
+CHOLMOD's supernodal Cholesky ``Pᵀ A P = L Lᵀ`` (cvxopt's CHOLMOD has no METIS: large matrices are ordered by
+METIS's nested dissection through ``pymetis`` where installed, :mod:`bladecase.ordering`, else by CHOLMOD's AMD),
+single-threaded;
 on the 110k-dof blade it is 5 to 6 times faster than SuperLU and takes a third of its memory
 (``docs/performance.md``).  cvxopt's ``cholmod.solve`` solves a block of right-hand sides one column at a time;
 a block of :data:`SPSOLVE_MIN_COLUMNS` or more goes through its ``cholmod.spsolve`` instead, CHOLMOD's supernodal
@@ -25,6 +27,8 @@ from contextlib import contextmanager
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+
+from .ordering import nested_dissection
 
 __all__ = ["INDEFINITE_PIVOT_THRESHOLD", "NotPositiveDefinite", "SPSOLVE_MIN_COLUMNS", "cholmod_factor",
            "cvxopt_cholesky", "fail", "import_cholmod", "import_cvxopt", "superlu_factor"]
@@ -78,9 +82,14 @@ def _release_freed_memory() -> None:
         pass
 
 
-def _factor(cholmod, lower):
+def _factor(cholmod, lower, perm=None):
     with _default_options(cholmod):
-        F = cholmod.symbolic(lower, uplo="L")
+        if perm is None:
+            F = cholmod.symbolic(lower, uplo="L")
+        else:
+            import cvxopt
+
+            F = cholmod.symbolic(lower, p=cvxopt.matrix(perm.astype(np.int32), tc="i"), uplo="L")
         try:
             cholmod.numeric(lower, F)
         except ArithmeticError:  # CHOLMOD_NOT_POSDEF: cvxopt gives the failing column
@@ -98,8 +107,9 @@ def cvxopt_cholesky(A: sp.csc_array, name: str, hint: str, definite: bool):
     if not definite:
         raise ValueError("the cvxopt backend factors positive definite matrices only (no pivoting)")
     cvxopt, cholmod = import_cvxopt()
+    perm = nested_dissection(A)  # METIS where installed and worth it; else CHOLMOD's AMD
     n, lower = A.shape[0], _lower(cvxopt, sp.csc_array(A))  # the closures keep n and lower, not A
-    F = _factor(cholmod, lower)
+    F = _factor(cholmod, lower, perm)
 
     def solve(b: np.ndarray) -> np.ndarray:
         if b.ndim == 2 and b.shape[1] >= SPSOLVE_MIN_COLUMNS:  # CHOLMOD's supernodal solve, 4 columns at a time
@@ -109,7 +119,7 @@ def cvxopt_cholesky(A: sp.csc_array, name: str, hint: str, definite: bool):
         return np.array(B).reshape(b.shape)
 
     def ldlt():
-        G = _factor(cholmod, lower)
+        G = _factor(cholmod, lower, perm)
         p = cvxopt.matrix(np.arange(n, dtype=float))
         cholmod.solve(G, p, sys=7)  # CHOLMOD_P: p = Perm, A[Perm][:, Perm] = L Lᵀ
         colptr, rows, values = (np.array(a).ravel() for a in cholmod.getfactor(G).CCS)
