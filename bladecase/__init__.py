@@ -17,6 +17,7 @@ no stage:
   ``factor_backend()``) and the one lowest-modes solver; a factorisation is passed on and reused, never recomputed;
 - :mod:`bladecase.linalg_backends` — the sparse factorisations: SuperLU, scikit-sparse's and cvxopt's CHOLMOD;
 - :mod:`bladecase.linalg_block` — block shift-invert Lanczos for a CHOLMOD factor;
+- :mod:`bladecase.ordering` — METIS's fill-reducing ordering of large sparse Cholesky factorisations;
 - :mod:`bladecase.threads` — how many BLAS threads a stage may use on a busy machine;
 - :mod:`bladecase.checks` — validators that name the value and what would be valid;
 - :mod:`bladecase.io` — atomic files and folder swaps;
