@@ -10,6 +10,8 @@
   form's clearance and the same first rub as that list given by hand; both given and agreeing run, disagreeing (or
   a casing inside the tips) exit 2 naming the blade and both values; ``force`` with only a ``[casing]`` runs every
   blade's rub against the casing's clearances.
+* On the parametric sector with no axis anywhere, the casing turns about the disk's own axis: a round casing 100 µm
+  beyond the tip gives the first rub of ``[mistuning] clearance = 1e-4``.
 """
 
 from __future__ import annotations
@@ -98,6 +100,15 @@ def _rows(out):
     return [{k: v for k, v in r.items()} for r in csv.DictReader(open(out / "mistuning_rub.csv"))]
 
 
+def _same_rub(a, b, rel=1e-8):
+    """Two runs' ``mistuning_rub.csv``: the same first blade of every sample, the same figures to ``rel``."""
+    ra, rb = _rows(a), _rows(b)
+    assert len(ra) == len(rb) == 3 and [r["first_blade"] for r in ra] == [r["first_blade"] for r in rb]
+    for x, y in zip(ra, rb):
+        for key in ("level_n", "tuned_ratio", "lead"):
+            assert float(x[key]) == pytest.approx(float(y[key]), rel=rel), key
+
+
 @pytest.fixture(scope="module")
 def round_runs(tmp_path_factory):
     """The same disk with a round casing 100 µm beyond the tips, and with that clearance given by hand."""
@@ -114,11 +125,7 @@ def test_a_round_casing_is_its_uniform_clearance(round_runs):
     a, b = (json.loads((round_runs[k] / "summary.json").read_text())["mistuning"]["rub"] for k in ("casing", "given"))
     assert a["clearance_from"] == "casing" and b["clearance_from"] == "mistuning"
     assert a["clearance_m"] == pytest.approx(1e-4, rel=1e-9)
-    ra, rb = _rows(round_runs["casing"]), _rows(round_runs["given"])
-    assert len(ra) == 3 and [r["first_blade"] for r in ra] == [r["first_blade"] for r in rb]
-    for x, y in zip(ra, rb):
-        for key in ("level_n", "tuned_ratio", "lead"):
-            assert float(x[key]) == pytest.approx(float(y[key]), rel=1e-8), key
+    _same_rub(round_runs["casing"], round_runs["given"])
 
 
 def test_an_out_of_round_casing_gives_each_blade_its_clearance(tmp_path, round_runs):
@@ -179,3 +186,23 @@ def test_the_keys_around_a_casing():
         loads(base + "[casing]\nradius = 0.3\n")
     with pytest.raises(StudyError, match=r"\[mistuning\] force: .* or a \[casing\] \(radius\)"):
         loads(base + "[cyclic]\nsectors = 6\n")
+
+
+def test_the_parametric_sectors_casing_turns_about_the_disks_axis(tmp_path):
+    """No axis anywhere: the casing is about the sector's engine axis (the line through (0, 0, −rim) along +x), so a
+    casing 100 µm beyond the tip node's radius about it gives every blade 100 µm."""
+    rim = 0.2
+    geometry = (f'geometry = {{kind = "sector", sectors = {N}, hub_radius = 0.1, rim_radius = {rim}, '
+                'disk_thickness = 0.03, span = 0.1, root_chord = 0.03, thickness = 0.005, size = 0.04}')
+    text = (f'study = {{name = "p"}}\n{geometry}\nfem = {{order = 1}}\noutput = {{formats = []}}\n'
+            f"cyclic = {{modes = 1}}\n[mistuning]\n{MISTUNING}")
+    first = tmp_path / "a.toml"
+    first.write_text(text + "clearance = 1e-4\n")
+    assert main(["run", str(first), "--out", str(tmp_path / "a"), "--quiet"]) == 0
+    tip = json.loads((tmp_path / "a" / "summary.json").read_text())["mistuning"]["tip"]
+    second = tmp_path / "b.toml"
+    second.write_text(text + f"[casing]\nradius = {tip['radius_m'] + 1e-4!r}\n")
+    assert main(["run", str(second), "--out", str(tmp_path / "b"), "--quiet"]) == 0
+    rub = json.loads((tmp_path / "b" / "summary.json").read_text())["mistuning"]["rub"]
+    assert rub["clearance_from"] == "casing" and rub["clearance_m"] == pytest.approx(1e-4, rel=1e-9)
+    _same_rub(tmp_path / "b", tmp_path / "a")
