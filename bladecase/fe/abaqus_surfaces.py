@@ -18,7 +18,8 @@ and a quadratic element's face adds the midside nodes of its edges.
 A line **without a face label** (``EALL`` or ``EALL,``) is, as in Abaqus, the **free faces** of its elements: every
 face of them that no other element of the whole mesh shares (its corner nodes those of exactly one element face of
 the deck) — for solid elements the exterior faces of the body among them, for plane elements the outline edges.  A
-face two elements share (inside the body, or between the set and the rest of the mesh) is not free.
+face two elements share (inside the body, or between the set and the rest of the mesh) is not free.  CalculiX
+(2.21, ``surfaces.f``) reads only lines with a label S1 … S6: a deck that CalculiX also runs keeps them.
 
 A face label the element type does not have, an element number the deck does not define, an element set it does not
 define, a line without an element, a line without a label whose elements have no free face, and an element of a type
