@@ -188,7 +188,7 @@ def test_calculix_runs_the_element_surface_deck(tmp_path):
     ("99, S1", r"line \d+: \*SURFACE, NAME=SLEFT: element 99 is of a type bladecase leaves out \(left out: S4R\)"),
     ("NOSUCH, S1", r"line \d+: \*SURFACE, NAME=SLEFT names the element set 'NOSUCH', which the deck does not "
                    r"define \(\*ELSETs: EALL"),
-    ("EALL", r"line \d+: \*SURFACE, NAME=SLEFT: an element-based surface line is 'element or element set, face "
+    (", S1", r"line \d+: \*SURFACE, NAME=SLEFT: an element-based surface line is 'element or element set, face "
              r"label' \(e.g. '12, S3'"),
 ])
 def test_bad_surface_lines_are_named(tmp_path, line, words):

@@ -13,9 +13,17 @@ their nodes are those of the Abaqus and CalculiX manuals (CalculiX's own tables 
   S6 = 4-8-5-1;
 * plane ``CPS``/``CPE`` 3, 4, 6, 8: the edges S1 = 1-2, S2 = 2-3, S3 = 3-1 (triangles) or 3-4, S4 = 4-1;
 
-and a quadratic element's face adds the midside nodes of its edges.  A face label the element type does not have,
-an element number the deck does not define, an element set it does not define, a line without a face label, and an
-element of a type bladecase leaves out (shells, beams) are errors naming the line and what is valid.
+and a quadratic element's face adds the midside nodes of its edges.
+
+A line **without a face label** (``EALL`` or ``EALL,``) is, as in Abaqus, the **free faces** of its elements: every
+face of them that no other element of the whole mesh shares (its corner nodes those of exactly one element face of
+the deck) — for solid elements the exterior faces of the body among them, for plane elements the outline edges.  A
+face two elements share (inside the body, or between the set and the rest of the mesh) is not free.  CalculiX
+(2.21, ``surfaces.f``) reads only lines with a label S1 … S6: a deck that CalculiX also runs keeps them.
+
+A face label the element type does not have, an element number the deck does not define, an element set it does not
+define, a line without an element, a line without a label whose elements have no free face, and an element of a type
+bladecase leaves out (shells, beams) are errors naming the line and what is valid.
 """
 
 from __future__ import annotations
@@ -46,6 +54,12 @@ FACE_NODES: dict[str, dict[str, tuple[int, ...]]] = {
     "quad": {"S1": (1, 2), "S2": (2, 3), "S3": (3, 4), "S4": (4, 1)},
     "quad8": {"S1": (1, 2, 5), "S2": (2, 3, 6), "S3": (3, 4, 7), "S4": (4, 1, 8)},
 }
+
+#: Element kinds whose faces list their corners first, then as many midside nodes.
+_QUADRATIC = frozenset({"tetra10", "wedge15", "hexahedron20", "triangle6", "quad8"})
+
+#: The face "label" of a surface line that has none: the free faces of its elements.
+FREE = "free"
 
 #: The element family of each kind, for the messages.
 _FAMILY = {"tetra": "C3D4", "tetra10": "C3D10", "wedge": "C3D6", "wedge15": "C3D15", "hexahedron": "C3D8",
@@ -111,6 +125,7 @@ def surface_nodes(deck, numbers) -> dict[str, np.ndarray]:
         order = np.argsort(ids, kind="stable")
         owners[kind] = (ids[order], np.array([r for _, r in rows], dtype=np.int64)[order])
     out: dict[str, np.ndarray] = {}
+    free: dict = {}  # the free faces of every element, computed once when a line asks for them
     for name, _, lines in deck.surfaces.values():
         labels: dict[str, tuple[list, list, list, list]] = {}  # face label -> its elements, each with its line:
         for where, text in lines:                                  # of its sets, then its numbers (checked at once)
@@ -126,19 +141,51 @@ def surface_nodes(deck, numbers) -> dict[str, np.ndarray]:
         for label, (sets, set_places, listed, places) in labels.items():
             if listed:
                 sets.append(numbers.listed(listed, places, "element", f"*SURFACE, NAME={name}"))
-            parts += _faces_of(owners, deck, name, set_places + places, np.concatenate(sets), label)
+            if label == FREE and not free:
+                free.update(free_faces(owners))
+            parts += _faces_of(owners, deck, name, set_places + places, np.concatenate(sets), label, free)
         out[name] = np.unique(np.concatenate(parts))
     return out
 
 
+def free_faces(owners: dict) -> dict[str, np.ndarray]:
+    """``{kind: (elements, faces) bool}``: which faces of every element (in the order of ``FACE_NODES[kind]``) are
+    free — no other element face of the mesh has the same corner nodes. ``owners``: ``{kind: (element numbers,
+    their node numbers)}``.
+
+    Two hexahedra sharing the face ``5-6-7-8``: each has five free faces, the shared one is not free.
+
+    >>> conn = np.array([[1, 2, 3, 4, 5, 6, 7, 8], [5, 6, 7, 8, 9, 10, 11, 12]])
+    >>> free_faces({"hexahedron": (np.array([1, 2]), conn)})["hexahedron"].astype(int).tolist()
+    [[1, 0, 1, 1, 1, 1], [0, 1, 1, 1, 1, 1]]
+    """
+    keys, sizes = [], []
+    for kind, (ids, conn) in owners.items():
+        for nodes in FACE_NODES[kind].values():
+            n = len(nodes) // 2 if kind in _QUADRATIC else len(nodes)  # the face's corners
+            corners = np.sort(conn[:, np.array(nodes[:n]) - 1], axis=1)
+            keys.append(np.pad(corners, ((0, 0), (0, 4 - n)), constant_values=-1))
+        sizes.append((kind, ids.size, len(FACE_NODES[kind])))
+    _, inverse, counts = np.unique(np.concatenate(keys), axis=0, return_inverse=True, return_counts=True)
+    once = counts[inverse.ravel()] == 1
+    out, start = {}, 0
+    for kind, count, faces in sizes:
+        out[kind] = once[start:start + count * faces].reshape(faces, count).T
+        start += count * faces
+    return out
+
+
 def _line_elements(deck, numbers, name: str, where, text: str) -> tuple[np.ndarray | int, str]:
-    """The element numbers (of a set; one number, not checked yet) and the face label of one surface line."""
+    """The element numbers (of a set; one number, not checked yet) and the face label of one surface line
+    (:data:`FREE` without one)."""
     fields = [f.strip() for f in text.split(",")]
     owner = f"*SURFACE, NAME={name}"
-    if len(fields) < 2 or not fields[0] or not fields[1]:
+    if not fields[0]:
         raise AbaqusError(f"{at_line(where)}: {owner}: an element-based surface line is 'element or element set, "
-                          f"face label' (e.g. '12, S3'; S1 … S6 for a solid element), got {text!r}")
-    target, label = fields[0], fields[1].upper()
+                          f"face label' (e.g. '12, S3'; S1 … S6 for a solid element), or 'element or element set' "
+                          f"alone for the free faces of its elements, got {text!r}")
+    target = fields[0]
+    label = fields[1].upper() if len(fields) > 1 and fields[1] else FREE
     if re.fullmatch(r"[+-]?\d+", target):
         return int(target), label
     if target.upper() not in deck.elsets:
@@ -149,8 +196,10 @@ def _line_elements(deck, numbers, name: str, where, text: str) -> tuple[np.ndarr
     return numbers.elements(members, f"*ELSET {written!r}"), label
 
 
-def _faces_of(owners, deck, name: str, places: list, elements: np.ndarray, label: str) -> list[np.ndarray]:
-    """The node numbers of face ``label`` of each of ``elements`` (``places``: the line naming each), by kind."""
+def _faces_of(owners, deck, name: str, places: list, elements: np.ndarray, label: str,
+              free: dict) -> list[np.ndarray]:
+    """The node numbers of face ``label`` of each of ``elements`` (``places``: the line naming each), by kind; for
+    :data:`FREE`, of each of their free faces (``free``: :func:`free_faces`)."""
     found = np.zeros(elements.size, dtype=bool)
     parts = []
     for kind, (ids, conn) in owners.items():
@@ -160,6 +209,10 @@ def _faces_of(owners, deck, name: str, places: list, elements: np.ndarray, label
             continue
         found |= inside
         faces = FACE_NODES[kind]
+        if label == FREE:
+            rows, mask = conn[k[inside]], free[kind][k[inside]]
+            parts += [rows[mask[:, i]][:, np.array(nodes) - 1].ravel() for i, nodes in enumerate(faces.values())]
+            continue
         if label not in faces:
             first = int(np.flatnonzero(inside)[0])
             raise AbaqusError(f"{at_line(places[first])}: *SURFACE, NAME={name}: element {elements[first]} is a "
@@ -172,4 +225,9 @@ def _faces_of(owners, deck, name: str, places: list, elements: np.ndarray, label
                           f"bladecase leaves out (left out: {', '.join(sorted(deck.left_out)) or 'none'}): faces "
                           "are read of solid elements C3D4, C3D6, C3D8, C3D10, C3D15, C3D20 and plane CPS/CPE 3, 4, "
                           "6, 8")
+    if label == FREE and not sum(p.size for p in parts):
+        raise AbaqusError(f"{at_line(places[0])}: *SURFACE, NAME={name}: a line without a face label is the free "
+                          f"faces of its elements, but none of these {elements.size} element(s) has a free face "
+                          "(each face is shared with another element of the mesh): give their face labels, e.g. "
+                          "'12, S3'")
     return parts

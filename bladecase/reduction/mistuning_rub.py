@@ -14,7 +14,8 @@ that rubs first is the one of the smallest ``F_j`` (:func:`first_rub`), and its 
   first by chance.
 
 A clearance per blade (an out-of-round casing seen at each blade's angle, a worn or offset casing) changes who
-rubs first: the blade of the largest ``a_j/c_j``, not of the largest ``a_j``.
+rubs first: the blade of the largest ``a_j/c_j``, not of the largest ``a_j``. :func:`blade_clearances` reads each
+blade's clearance off a casing of revolution (:class:`~bladecase.reduction.casing.Casing`), offset or out-of-round.
 
 >>> from bladecase.reduction.mistuning import family_band, lumped_disk, mistuning_model
 >>> sector, kb = lumped_disk(6)
@@ -31,9 +32,12 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize_scalar
 
+from ..checks import integer
+from ..fe.cyclic import rotation_matrix
+from .casing import Casing
 from .mistuning import MistuningModel, _amplitudes, _load, _zeta, mistuned_stiffness
 
-__all__ = ["blade_peaks", "first_rub", "sample_rub"]
+__all__ = ["blade_clearances", "blade_peaks", "first_rub", "sample_rub"]
 
 #: Local maxima of each blade's amplitude on the sweep refined (bounded Brent between the grid neighbours).
 PEAKS_PER_BLADE = 2
@@ -108,3 +112,47 @@ def sample_rub(delta, *, model: MistuningModel, order: int, frequencies, zeta: f
     out["tuned_ratio"] = out["level"] / float(tuned_level)
     out.update(peaks=a.tolist(), frequencies_hz=hz.tolist())
     return out
+
+
+def blade_clearances(tip, sectors: int, axis, casing: Casing, lobes: int | None = None,
+                     amplitude: float = 0.0) -> np.ndarray:
+    """Each blade's tip clearance (m) to ``casing`` with the disk at rest. Blade ``j``'s tip is blade 0's ``tip`` (a
+    point, m) turned by ``jα`` (``α = 2π/N``, right-handed) about the disk's ``axis`` (a
+    :class:`~bladecase.fe.rotation.RotationAxis`); its clearance is measured along its radius about the casing's own
+    axis, ``R(s_j) − r_j`` (the casing's radius at the tip's axial station less the tip's radius: what its radial
+    excursion must cover). An out-of-round casing of ``lobes`` lobes reaches ``amplitude`` further in where blade
+    0's tip is: ``c_j = R(s_j) − r_j − amplitude·cos(lobes·φ_j)``, ``φ_j`` blade ``j``'s angle about the casing's
+    axis from blade 0's tip — the clearance the rub response sees at ``t = 0``. A casing offset from the disk's axis
+    gives every blade its own clearance too.
+
+    >>> from bladecase.fe.rotation import RotationAxis
+    >>> axis = RotationAxis((0, 0, 0), (1, 0, 0))
+    >>> c = blade_clearances([0, 0, 0.25], 4, axis, Casing(axis, radius=0.2502), lobes=2, amplitude=1e-4)
+    >>> (c * 1e6).round(6).tolist()      # µm: 200 less a lobe at blades 0 and 2, plus a trough at 1 and 3
+    [100.0, 300.0, 100.0, 300.0]
+
+    Raises ``ValueError`` when a blade's tip touches or crosses the casing, naming the blade.
+    """
+    n = integer("sectors", sectors, 1)
+    p0 = np.asarray(tip, dtype=float).reshape(3)
+    o, d = np.asarray(axis.origin, dtype=float), np.asarray(axis.direction, dtype=float)
+    points = np.array([o + rotation_matrix(d, 2 * np.pi * j / n) @ (p0 - o) for j in range(n)])
+    a, x = casing.axis.direction, points - casing.axis.origin
+    s = x @ a
+    radial = x - np.outer(s, a)
+    r = np.linalg.norm(radial, axis=1)
+    if np.any(r <= 0):
+        raise ValueError(f"blade 0's tip {p0.tolist()} turned about the disk's axis meets the casing's axis: it has no "
+                         "radial direction to the casing")
+    R, _ = casing.profile(s)
+    c = R - r
+    if lobes is not None and amplitude:
+        e = radial / r[:, None]
+        phi = np.arctan2(np.cross(e[0], e) @ a, e @ e[0])
+        c = c - float(amplitude) * np.cos(int(lobes) * phi)
+    if np.any(c <= 0):
+        j = int(np.argmin(c))
+        raise ValueError(f"blade {j}'s tip (radius {r[j]:.6g} m about the casing's axis) touches or crosses the casing "
+                         f"at rest: clearance {c[j]:.4g} m (every blade's must be > 0: a larger casing radius, or a "
+                         "smaller out-of-round amplitude)")
+    return c

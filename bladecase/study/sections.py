@@ -307,8 +307,13 @@ CASING_KEYS: dict[str, Key] = {
 
 def casing_checks(c: dict, model: bool = True) -> None:
     """``[casing]``: one of radius/radii, an axis (its own or [rotation]'s), a face contact, no [contact] clearance
-    (each node's comes from the casing); without ``[casing]``, ``[contact] clearance`` is required."""
+    (each node's comes from the casing); without ``[casing]``, ``[contact] clearance`` is required. In a mistuning
+    study without a contact face, the casing gives the blade tips' clearances: no face, and the disk's axis by
+    default."""
+    from .disk.mistuning_keys import mistuning_requested
+
     k = c.get("casing") or {}
+    tips = mistuning_requested(c) and c["contact"]["face"] is None and c["contact"].get("nodes") is None
     given = k and (k.get("radius") is not None or k.get("radii") is not None)
     ct = c["contact"]
     if not given:
@@ -323,10 +328,11 @@ def casing_checks(c: dict, model: bool = True) -> None:
         raise StudyError("[casing] radii: give radius (a cylinder) or radii (a cone), not both")
     if k["axis"] is None:
         r = c.get("rotation") or {}
-        if r.get("axis") is None:
+        if r.get("axis") is not None:
+            k["axis"] = dict(r["axis"])
+        elif not tips:  # (a mistuned disk's tips: the disk's own axis, known once the sector is read)
             raise StudyError("[casing] axis: required (or [rotation] axis): the casing is a surface of revolution "
                              "about the engine axis")
-        k["axis"] = dict(r["axis"])
     else:
         axis = k["axis"]
         k["axis"] = {"origin": list(axis.get("origin", [0.0, 0.0, 0.0])), "direction": list(axis["direction"])}
@@ -334,7 +340,7 @@ def casing_checks(c: dict, model: bool = True) -> None:
         given, missing = ("lobes", "amplitude") if k["amplitude"] is None else ("amplitude", "lobes")
         raise StudyError(f"[casing] {missing}: an out-of-round casing needs lobes and amplitude together (got "
                          f"{given} = {k[given]!r} alone)")
-    if ct["face"] is None and ct.get("nodes") is None:
+    if ct["face"] is None and ct.get("nodes") is None and not tips:
         raise StudyError("[casing]: each node of a contact face gets its clearance from the casing: set [contact] "
                          "face (e.g. 'tip') or nodes")
     if ct["clearance"] is not None:

@@ -16,10 +16,13 @@ one pattern ``deviations``) run through the study's executor, each a
 * ``mistuning.png`` — the histogram of the amplification factor against Whitehead's bound;
 * ``summary["mistuning"]`` — the model, the forcing, the percentiles, the largest, the bound ``½(1 + √N)`` and how
   many samples exceed it;
-* with ``[mistuning] clearance``: who rubs first (:mod:`bladecase.reduction.mistuning_rub`, each sample a
-  :func:`~bladecase.reduction.mistuning_rub.sample_rub` task through the same executor) — each blade's tip excursion
-  along the radius at the tip node (the casing normal) against its clearance as the forcing rises:
+* with ``[mistuning] clearance`` or a ``[casing]``: who rubs first (:mod:`bladecase.reduction.mistuning_rub`, each
+  sample a :func:`~bladecase.reduction.mistuning_rub.sample_rub` task through the same executor) — each blade's tip
+  excursion along the radius at the tip node (the casing normal) against its clearance as the forcing rises:
   ``mistuning_rub.csv`` (``sample, first_blade, level_n, tuned_ratio, lead``) and ``summary["mistuning"]["rub"]``.
+  With a ``[casing]`` each blade's clearance is the casing's at its tip
+  (:func:`~bladecase.reduction.mistuning_rub.blade_clearances`: offset, conical or out-of-round, the casing's axis
+  the disk's unless given); a ``[mistuning] clearance`` given as well must agree with it (:data:`AGREE`).
 """
 
 from __future__ import annotations
@@ -46,7 +49,12 @@ from ..schema import Study, StudyError
 from .mistuning_contact import compute_contacts, radial_response
 from .mistuning_keys import check_deviations
 
-__all__ = ["blade_cells", "compute_mistuning", "excitation_dof", "mistuning_csv", "radial_response"]
+__all__ = ["AGREE", "blade_cells", "compute_mistuning", "excitation_dof", "mistuning_csv", "radial_response",
+           "tip_clearances"]
+
+#: A ``[mistuning] clearance`` given with a ``[casing]`` must equal the casing's clearance at every blade's tip to
+#: this relative tolerance (the digits a clearance is typed with).
+AGREE = 1e-3
 
 
 def blade_cells(mesh, axis, geometry, group: str | None) -> np.ndarray:
@@ -116,6 +124,43 @@ def mistuning_csv(stats: MistuningStatistics) -> str:
     return buf.getvalue()
 
 
+def tip_clearances(study: Study, fe_model, axis, tip: dict, sectors: int) -> tuple[np.ndarray | None, str | None]:
+    """``(c, source)``: each blade's tip clearance (m) and where it comes from — ``"casing"`` (the ``[casing]`` at the
+    tip ``node`` of every blade, :func:`~bladecase.reduction.mistuning_rub.blade_clearances`, its axis the disk's
+    ``axis`` unless the section gives one) or ``"mistuning"`` (``[mistuning] clearance``); ``(None, None)`` without
+    either. ``StudyError`` for a blade that touches the casing at rest, or a ``[mistuning] clearance`` that differs
+    from the casing's by more than :data:`AGREE`."""
+    from ...fe.rotation import RotationAxis
+    from ...reduction.casing import Casing
+    from ...reduction.mistuning_rub import blade_clearances
+
+    given = study["mistuning"]["clearance"]
+    k = study.config.get("casing") or {}
+    if k.get("radius") is None and k.get("radii") is None:
+        if given is None:
+            return None, None
+        return np.broadcast_to(np.asarray(given, dtype=float), (sectors,)).copy(), "mistuning"
+    own = k.get("axis")
+    where = RotationAxis(own["origin"], own["direction"]) if own else axis
+    try:
+        casing = Casing(where, radius=k["radius"], radii=None if k["radii"] is None else tuple(map(tuple, k["radii"])))
+        c = blade_clearances(fe_model.mesh.points[tip["node"]], sectors, axis, casing, k.get("lobes"),
+                             k.get("amplitude") or 0.0)
+    except ValueError as exc:
+        raise StudyError(f"[casing]: the mistuned disk's blade tips (node {tip['node']} of each sector): "
+                         f"{exc}") from None
+    if given is not None:
+        g = np.broadcast_to(np.asarray(given, dtype=float), (sectors,))
+        off = np.abs(g - c) > AGREE * c
+        if off.any():
+            j = int(np.flatnonzero(off)[0])
+            raise StudyError(f"[mistuning] clearance: blade {j}'s is {g[j]:.6g} m, but the [casing] puts its tip "
+                             f"(node {tip['node']} turned to blade {j}) {c[j]:.6g} m from the casing (blades 0…"
+                             f"{sectors - 1}: {', '.join(f'{x:.6g}' for x in c)} m): give one of them, or make them "
+                             f"agree within {AGREE:.1%}")
+    return c, "casing"
+
+
 def _model(study: Study, fe_model, sector, cells: np.ndarray, spectrum=None) -> MistuningModel:
     m = study["mistuning"]
     try:
@@ -178,11 +223,14 @@ def compute_mistuning(study: Study, staging: Path, files: dict, *, fe_model, mes
         "above_bound": above, "largest_frequency_hz": float(stats.frequencies[worst]),
         "largest_deviations": stats.deltas[worst].tolist(),
     })
-    if m["clearance"] is not None:
-        section["rub"] = _first_rub(m, fe_model, axis, tip, shared, deltas, staging, files, executor, progress)
+    clearance, source = tip_clearances(study, fe_model, axis, tip, n)
+    if clearance is not None:
+        section["rub"] = _first_rub(clearance, fe_model, axis, tip, shared, deltas, staging, files, executor,
+                                    progress)
+        section["rub"]["clearance_from"] = source
     if m["force"] is not None:
-        section["contact"] = compute_contacts(m, fe_model, sector, axis, tip, cells, deltas, hz, staging, files,
-                                              executor, progress)
+        section["contact"] = compute_contacts(m, clearance, fe_model, sector, axis, tip, cells, deltas, hz, staging,
+                                              files, executor, progress)
     log.info("mistuning (%s, family %d, engine order %d, ζ = %g): %d sample(s) of %d blades, amplification "
              "median %.4f, largest %.4f (sample %d, blade %d); Whitehead's bound %.4f, %d sample(s) above it",
              model.kind, m["family"], order, m["damping"], deltas.shape[0], n, section["percentiles"]["p50"],
@@ -193,13 +241,13 @@ def compute_mistuning(study: Study, staging: Path, files: dict, *, fe_model, mes
     return section
 
 
-def _first_rub(m: dict, fe_model, axis, tip: dict, shared: dict, deltas: np.ndarray, staging: Path, files: dict,
-               executor: Executor, progress: bool) -> dict:
-    """Who rubs first in each sample (module docstring): ``mistuning_rub.csv`` and ``summary["mistuning"]["rub"]``."""
+def _first_rub(c: np.ndarray, fe_model, axis, tip: dict, shared: dict, deltas: np.ndarray, staging: Path,
+               files: dict, executor: Executor, progress: bool) -> dict:
+    """Who rubs first in each sample (module docstring) against each blade's clearance ``c`` (m):
+    ``mistuning_rub.csv`` and ``summary["mistuning"]["rub"]``."""
     from ...reduction.mistuning_rub import blade_peaks, first_rub, sample_rub
 
     n = deltas.shape[1]
-    c = np.broadcast_to(np.asarray(m["clearance"], dtype=float), (n,))
     kw = {**shared, "response": radial_response(fe_model, axis, tip["node"]), "clearance": c}
     tuned_peaks, _ = blade_peaks(kw["model"], np.zeros(n), kw["order"], kw["frequencies"], zeta=kw["zeta"],
                                  force=kw["force"], response=kw["response"])
@@ -220,7 +268,8 @@ def _first_rub(m: dict, fe_model, axis, tip: dict, shared: dict, deltas: np.ndar
     lead = np.array([r["lead"] for r in rows])
     soonest = int(np.argmin(ratio))
     counts = np.bincount([r["blade"] for r in rows], minlength=n)
-    out = {"clearance_m": c.tolist() if np.ptp(c) else float(c[0]), "tuned_level_n": tuned["level"],
+    uniform = np.ptp(c) <= 1e-9 * c.max()  # (a round casing's clearances differ by roundoff only)
+    out = {"clearance_m": float(c.mean()) if uniform else c.tolist(), "tuned_level_n": tuned["level"],
            "tuned_blade": tuned["blade"], "response": "radial at the tip node",
            "tuned_ratio": {"min": float(ratio.min()), "p5": float(np.percentile(ratio, 5)),
                            "p50": float(np.percentile(ratio, 50)), "max": float(ratio.max())},

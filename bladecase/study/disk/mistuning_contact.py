@@ -1,6 +1,6 @@
-"""How hard each blade of a mistuned disk rubs (``[mistuning] force`` with ``clearance``): the steady engine-order
-rub of every blade, each its own massless contact at its tip node, for the first ``contact_samples`` samples through
-the study's executor.
+"""How hard each blade of a mistuned disk rubs (``[mistuning] force`` with ``clearance`` or a ``[casing]``): the
+steady engine-order rub of every blade, each its own massless contact at its tip node, for the first
+``contact_samples`` samples through the study's executor.
 
 The disk is the reduced disk of :func:`~bladecase.reduction.disk.disk_model` (the sector with its tip node's mass
 moved to its neighbours, one contact along the radius at the tip node, the family's modes of every nodal diameter
@@ -58,16 +58,17 @@ def sample_contacts(delta, *, disk, coupling, load, residual, band, zeta: float,
             "fraction": out.contact_fraction.tolist(), "periods": out.periods_run}
 
 
-def compute_contacts(m: dict, fe_model, sector, axis, tip: dict, cells: np.ndarray, deltas: np.ndarray, band,
-                     staging: Path, files: dict, executor: Executor, progress: bool) -> dict:
-    """The contact stage (module docstring); returns ``summary["mistuning"]["contact"]``."""
+def compute_contacts(m: dict, clearance, fe_model, sector, axis, tip: dict, cells: np.ndarray, deltas: np.ndarray,
+                     band, staging: Path, files: dict, executor: Executor, progress: bool) -> dict:
+    """The contact stage (module docstring) with each blade's ``clearance`` (m; ``[mistuning] clearance`` or the
+    ``[casing]``'s); returns ``summary["mistuning"]["contact"]``."""
     from ...reduction import Contact
     from ...reduction.disk import disk_model, massless_sector
     from ...reduction.mistuning_disk import blade_coupling, engine_order_load
     from ...reduction.mistuning_fe import blade_stiffness
 
     n = sector.sectors
-    c = np.broadcast_to(np.asarray(m["clearance"], dtype=float), (n,))
+    c = np.broadcast_to(np.asarray(clearance, dtype=float), (n,))
     radial = radial_response(fe_model, axis, tip["node"])
     normal = radial[np.flatnonzero(fe_model.dofs.node == tip["node"])]
     full = np.zeros(3)

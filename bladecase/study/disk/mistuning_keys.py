@@ -29,6 +29,7 @@ import math
 
 from ..keys import _INT, _LIST, _NUM, _STR, Key, StudyError
 from ..values import _int_between, _name, _one_of
+from .cyclic_keys import cyclic_requested
 
 __all__ = ["MISTUNING_KEYS", "MODELS", "mistuning_checks", "mistuning_requested", "sectors_of"]
 
@@ -90,8 +91,11 @@ MISTUNING_KEYS: dict[str, Key] = {
                  _one_of(*MODELS)),
     "clearance": Key((int, float, list), None, "The casing clearance at the blade tips (m): one number, or one per "
                      "blade (N numbers). Given: which blade rubs first as the forcing rises, how soon against the "
-                     "tuned disk, by how much before the next (mistuning_rub.csv).", _clearance),
-    "force": Key(_NUM, None, "With 'clearance': the engine-order force at each blade's tip (N, amplitude) at which "
+                     "tuned disk, by how much before the next (mistuning_rub.csv). With a [casing] (radius or radii, "
+                     "optionally lobes and amplitude, an offset axis) each blade's clearance is the casing's at its "
+                     "tip instead; this, if given too, must agree with it.", _clearance),
+    "force": Key(_NUM, None, "With 'clearance' (or a [casing]): the engine-order force at each blade's tip (N, "
+                 "amplitude) at which "
                  "every blade's rub is computed — each blade its own massless contact at its tip node, the steady "
                  "rub at the mistuned disk's resonance (mistuning_contact.csv). Needs [fem] mass = 'lumped'.",
                  lambda v: None if math.isfinite(v) and v > 0 else "must be a force amplitude > 0 (N)"),
@@ -167,8 +171,14 @@ def mistuning_checks(c: dict) -> None:
     elif m["std"] is None:
         raise StudyError("[mistuning] std: required for random samples (the standard deviation of the blades' "
                          "relative stiffness deviations, e.g. std = 0.02), or give 'deviations' (N numbers)")
-    if m["force"] is not None and m["clearance"] is None:
-        raise StudyError("[mistuning] force: the rub of each blade needs the casing: give [mistuning] clearance (m)")
+    k = c.get("casing") or {}
+    casing = k.get("radius") is not None or k.get("radii") is not None
+    if m["force"] is not None and m["clearance"] is None and not casing:
+        raise StudyError("[mistuning] force: the rub of each blade needs the casing: give [mistuning] clearance (m), "
+                         "or a [casing] (radius) from which each blade's clearance is read")
+    if casing and g is None and not cyclic_requested(c):
+        raise StudyError("[casing]: the casing of a mistuned disk read from a sector deck: add a [cyclic] key, e.g. "
+                         "[cyclic] sectors = N (the deck's N), so that the run is the bladed disk's")
     if m["force"] is not None and (c.get("fem") or {}).get("mass") != "lumped":
         raise StudyError("[mistuning] force: each blade's contact is a massless contact (its tip's mass moved to its "
                          f"neighbours): [fem] mass = 'lumped', got {(c.get('fem') or {}).get('mass')!r}")
