@@ -70,9 +70,16 @@ ABRADABLE_KEY = Key((dict,), None, "An abradable coating on the casing, worn by 
 def friction_checks(c: dict) -> None:
     """``[contact] friction`` and ``[casing] abradable`` need the ``[rub]`` response that uses them; the coating is the
     casing's compliance (no ``casing_stiffness`` beside it). Fills in their defaults (``model``, ``cells``)."""
+    from ..disk.cyclic_keys import cyclic_requested
+
     ct, k = c["contact"], c.get("casing") or {}
     rub = (c.get("rub") or {}).get("speeds")
     fr, ab = ct.get("friction"), k.get("abradable")
+    if rub and cyclic_requested(c):
+        for given, what in ((fr, "[contact] friction"), (ab, "[casing] abradable")):
+            if given is not None:
+                raise StudyError(f"{what}: the rub of a bladed disk (a [cyclic] study) is computed without friction "
+                                 "and wear; remove it, or study one blade's rub (without [cyclic])")
     if fr is not None:
         if not rub:
             raise StudyError("[contact] friction: it acts in the rub response: give [rub] speeds (with an out-of-round "
