@@ -6,7 +6,7 @@ import pytest
 from bladecase.study.schema import StudyError, loads
 
 BASE = ('mesh = {{path = "s.inp"}}\n[search]\nipp = [1]\n[cyclic]\nsectors = 6\n'
-        '[contact]\nface = "tip"\nmodel = "massless"\n{friction}[rub]\nspeeds = [1000]\n'
+        '[contact]\nface = "tip"\nmodel = "massless"\n{friction}[rub]\nspeeds = [1000]\nratio = 0.01\n'
         '[casing]\nradius = 0.3\nlobes = 3\namplitude = 1e-4\naxis = {{direction = [1, 0, 0]}}\n{abradable}')
 
 
