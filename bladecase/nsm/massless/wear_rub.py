@@ -36,7 +36,7 @@ import numpy as np
 from .friction import friction_flight
 from .nodes import NodalFlight, NodalSystem, Profile, Rub, simulate_nodes
 from .wear import Abradable, WearProfile, pass_tip
-from .wear_lobes import LobeCheck, lobe_check
+from .wear_lobes import LobeCheck, dominant_ratio, lobe_check
 
 __all__ = ["WearRub", "vibration_ratio", "wear_rub"]
 
@@ -76,23 +76,15 @@ class WearRub:
 
 def vibration_ratio(signal, samples_per_turn: int) -> float:
     """The dominant frequency of ``signal`` (sampled ``samples_per_turn`` times a revolution over whole
-    revolutions, its mean taken out) over the rotation frequency, refined by the parabola through the strongest bin
-    of the Hann-windowed spectrum and its neighbours.
+    revolutions) over the rotation frequency: the strongest line of its Hann-windowed spectrum above half an engine
+    order, its mean and trend taken out, refined by the parabola through it and its neighbours
+    (:func:`~bladecase.nsm.massless.wear_lobes.dominant_ratio`).
 
     >>> t = np.arange(400) / 100                       # four revolutions, 100 samples each
     >>> round(vibration_ratio(np.cos(2 * np.pi * 7.9 * t), 100), 1)
     7.9
     """
-    y = np.asarray(signal, dtype=float)
-    y = (y - y.mean()) * np.hanning(y.size)
-    a = np.abs(np.fft.rfft(y))
-    k = 1 + int(np.argmax(a[1:]))
-    shift = 0.0
-    if 1 <= k < a.size - 1:
-        lo, mid, hi = np.log(a[k - 1:k + 2] + 1e-300)
-        den = lo - 2 * mid + hi
-        shift = 0.5 * (lo - hi) / den if den != 0 else 0.0
-    return float((k + shift) * samples_per_turn / y.size)
+    return dominant_ratio(signal, samples_per_turn)[0]
 
 
 def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, amplitude: float, angles,
