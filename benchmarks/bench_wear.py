@@ -94,6 +94,8 @@ def main() -> None:
               + (f" (next line {c['second']:.3g} at {c['second_share']:.2f} of it)" if c["second_share"] else "")
               + f": {c['verdict'].upper() if c['verdict'] != 'agree' else 'agree'}"
               + (f" - {c['reason']}" if c["reason"] else ""))
+        print("      f_vib/f_rot of each of those revolutions alone: "
+              + ", ".join(f"{r:.2f}" for r in c["per_revolution"]))
     for f in section["failed_speeds"]:
         print(f"  {f['speed']:7.6g} rpm refused: {f['reason']}")
     print(f"lobe count = round(f_vib / f_rot) over the last revolutions: agree at {verdicts['agree']}, differ at "

@@ -56,7 +56,8 @@ class LobeCheck:
     """:func:`lobe_check`'s answer: ``verdict`` (``"agree"``, ``"differ"``, ``"undefined"``), the ``window``
     (revolutions read), the ``lobes`` of the wear over the window and their ``rival`` harmonic (``0``: none),
     ``ratio`` = f_vib / f_rot and the runner-up spectral line's ratio and share of the strongest (``second``,
-    ``second_share``), ``expected`` = round(ratio), and ``reason`` (empty unless undefined)."""
+    ``second_share``), ``expected`` = round(ratio), ``reason`` (empty unless undefined), and the strongest line of
+    each revolution of the window alone (``per_revolution``: a vibration that stays one shows one value)."""
 
     verdict: str
     window: int
@@ -67,10 +68,11 @@ class LobeCheck:
     second_share: float
     expected: int
     reason: str
+    per_revolution: tuple = ()
 
     def as_dict(self) -> dict:
         """The check as plain numbers and words."""
-        return asdict(self)
+        return {**asdict(self), "per_revolution": list(self.per_revolution)}
 
 
 def dominant_ratio(signal, samples_per_turn: int) -> tuple[float, float, float]:
@@ -140,7 +142,8 @@ def lobe_check(depths, tip, samples_per_turn: int, window: int = 4, share: float
         reasons.append(f"f_vib / f_rot = {ratio:.3g} is {abs(eps):.2g} from the engine order {expected}: over the {n} "
                        f"revolutions read the lobes drift by {abs(eps) * n:.2g} lobe lengths, the wear is smeared")
     verdict = "undefined" if reasons else ("agree" if lobes == expected else "differ")
-    return LobeCheck(verdict, n, lobes, rival, ratio, second, second_share, expected, "; ".join(reasons))
+    each = tuple(dominant_ratio(row, samples_per_turn)[0] for row in tip[-n:])
+    return LobeCheck(verdict, n, lobes, rival, ratio, second, second_share, expected, "; ".join(reasons), each)
 
 
 def lobe_words(c: dict) -> str:
