@@ -47,6 +47,8 @@ has contact phases of finite duration instead of impacts. One module per step:
   :class:`WearProfile`, :func:`pass_tip`), elastic–perfectly plastic: the profile each tip passage leaves;
 - :mod:`~bladecase.nsm.massless.wear_rub` — the rub that wears the coating: each revolution flown against the
   profile the previous ones left (:func:`wear_rub`);
+- :mod:`~bladecase.nsm.massless.wear_lobes` — the held-out check of the lobes worn over the last revolutions against
+  the tip's vibration frequency over the same ones: agree, differ, or undefined with the reason (:func:`lobe_check`);
 - :mod:`~bladecase.nsm.massless.disk_modes` — travelling-wave nonsmooth modes of a tuned bladed disk: shooting over
   a fraction of the period against the blade shift, checked on the whole disk without the symmetry, with its
   Floquet multipliers;
@@ -122,7 +124,8 @@ from .orbits import (
 )
 from .phases import PHASES, PhasedOrbit, solve_half, split_at, violation
 from .rub import RubResponse, rub_response, rub_sweep
-from .wear import Abradable, WearProfile, pass_tip
+from .wear import Abradable, WearProfile, harmonic_lobes, pass_tip
+from .wear_lobes import LobeCheck, lobe_check
 from .wear_rub import WearRub, vibration_ratio, wear_rub
 
 __all__ = [
@@ -136,7 +139,8 @@ __all__ = [
     "FRICTION_MODELS", "Friction", "FrictionFlight", "SlidingCheck", "friction_flight", "lemke", "simulate_friction",
     "sliding_check", "FrictionEnergy", "FrictionRub", "energy_balance", "friction_rub", "per_revolution",
     "FrictionMode", "decay_ratio", "friction_mode", "CoulombFlight", "CoulombTrajectory", "simulate_coulomb",
-    "Abradable", "Profile", "WearProfile", "WearRub", "pass_tip", "vibration_ratio", "wear_rub",
+    "Abradable", "Profile", "WearProfile", "WearRub", "pass_tip", "vibration_ratio", "wear_rub", "harmonic_lobes",
+    "LobeCheck", "lobe_check",
     # bar
     "CONTACT_MODELS", "bar", "bar_continuum_band_energy", "bar_continuum_energy", "bar_continuum_field",
     # branches

@@ -1,5 +1,5 @@
 """An abradable coating round the casing, worn by the blade tip: :class:`Abradable`, :class:`WearProfile`,
-:func:`pass_tip`.
+:func:`pass_tip`, :func:`harmonic_lobes`.
 
 **The coating.** A layer of ``thickness`` on the casing, discretised round the casing into ``cells`` equal
 angular cells (the profile). Each cell is an elastic–perfectly plastic foundation: a tip pressing into it by
@@ -33,7 +33,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Abradable", "WearProfile", "pass_tip"]
+__all__ = ["LOBE_SHARE", "Abradable", "WearProfile", "harmonic_lobes", "pass_tip"]
+
+#: The share of the strongest harmonic (or spectral line) within which another one counts as its equal: a
+#: fundamental of peaked lobes, or a rival lobe count (:func:`harmonic_lobes`).
+LOBE_SHARE = 0.5
 
 
 def _positive(name: str, value, allow_inf: bool = False) -> float:
@@ -127,20 +131,42 @@ class WearProfile:
         """The cells' centre angles (rad)."""
         return (np.arange(self.coating.cells) + 0.5) * self.coating.step
 
-    def lobes(self, share: float = 0.5) -> int:
-        """The number of lobes of the profile: its strongest circumferential harmonic (``0``: unworn or uniform),
-        the lowest harmonic within ``share`` of the strongest's amplitude taken when several are close (a lobe
-        count, not an overtone).
+    def lobes(self, share: float = LOBE_SHARE) -> int:
+        """The number of lobes of the profile (:func:`harmonic_lobes`: its strongest circumferential harmonic, or
+        the lowest divisor of it within ``share`` of its amplitude; ``0``: unworn or uniform).
 
         >>> c = Abradable(1e-3, 1e6, np.inf, cells=90, radius=0.3, width=0.01)
         >>> WearProfile(c, 1e-5 * (1 + np.cos(7 * WearProfile.new(c).angles()))).lobes()
         7
         """
-        d = self.depth - self.depth.mean()
-        if not np.any(np.abs(d) > 1e-15 * max(self.depth.max(), 1e-300)):
-            return 0
-        amp = np.abs(np.fft.rfft(d))[1:]
-        return int(np.flatnonzero(amp >= (1 - share) * amp.max())[0] + 1)
+        return harmonic_lobes(self.depth, share)[0]
+
+
+def harmonic_lobes(depth, share: float = LOBE_SHARE) -> tuple[int, int]:
+    """``(lobes, rival)`` of a profile of depths round the casing (any equal cells): ``lobes`` is its strongest
+    circumferential harmonic ``N``, or the lowest divisor ``k ≥ 2`` of ``N`` whose amplitude is within ``share`` of
+    the strongest (``N`` is then an overtone of ``k`` lobes: peaked lobes); ``0`` for an unworn or uniform profile.
+    ``rival`` is the strongest other harmonic within ``share`` of the strongest that is neither a multiple of
+    ``lobes`` nor ``1`` (``0``: none): a profile with a rival has no one lobe count. Harmonic 1 is never a rival
+    (nor taken as a lobe count when another harmonic is stronger): it is wear on one part of the circumference,
+    the envelope of the lobes, not a lobe count.
+
+    >>> theta = (np.arange(90) + 0.5) * 2 * np.pi / 90
+    >>> harmonic_lobes(np.maximum(np.cos(8 * theta), 0.0))          # peaked lobes: overtones 16, 24, … of 8
+    (8, 0)
+    >>> harmonic_lobes(1.0 + np.cos(9 * theta) + 0.8 * np.cos(10 * theta))   # two lobe counts: 9 has a rival
+    (9, 10)
+    """
+    d = np.asarray(depth, dtype=float)
+    d = d - d.mean()
+    amp = np.abs(np.fft.rfft(d))[1:]
+    if amp.size == 0 or not np.any(np.abs(d) > 1e-15 * max(np.abs(np.asarray(depth, dtype=float)).max(), 1e-300)):
+        return 0, 0
+    strong = amp >= (1 - share) * amp.max()
+    top = int(np.argmax(amp)) + 1
+    lobes = next((k for k in range(2, top) if top % k == 0 and strong[k - 1]), top)
+    rivals = [h for h in np.flatnonzero(strong) + 1 if h % lobes and h != 1]
+    return lobes, int(max(rivals, key=lambda h: amp[h - 1])) if rivals else 0
 
 
 def pass_tip(profile: WearProfile, theta, r, record: bool = False) -> tuple[WearProfile, np.ndarray]:

@@ -23,6 +23,8 @@ is removed where the pressure went beyond its yield. The worn profile is the cle
 ...              revolutions=4, areas=[1.0, 1.0])
 >>> w.profile.lobes(), bool(w.removed[-1] > 0), bool(abs(w.profile.removed / w.profile.missing_volume - 1) < 1e-9)
 (3, True, True)
+>>> w.check.verdict, w.check.lobes, w.check.expected
+('agree', 3, 3)
 """
 
 from __future__ import annotations
@@ -34,6 +36,7 @@ import numpy as np
 from .friction import friction_flight
 from .nodes import NodalFlight, NodalSystem, Profile, Rub, simulate_nodes
 from .wear import Abradable, WearProfile, pass_tip
+from .wear_lobes import LobeCheck, dominant_ratio, lobe_check
 
 __all__ = ["WearRub", "vibration_ratio", "wear_rub"]
 
@@ -50,7 +53,9 @@ class WearRub:
     revolution the volume removed so far (m³), the peak tip normal displacement (m), the peak contact pressure on
     the coating (Pa) and the lobes of the profile; the dominant frequency of the last (up to 4) revolutions' mean
     tip normal displacement over the rotation frequency (:func:`vibration_ratio`); the phases flown (switches and
-    profile steps)."""
+    profile steps); that mean tip displacement over each revolution (``tip``: ``(revolutions,
+    samples_per_turn)``, m) and the held-out check of the lobes worn over the last revolutions against the
+    vibration's frequency over the same ones (``check``: :func:`~bladecase.nsm.massless.wear_lobes.lobe_check`)."""
 
     profile: WearProfile
     removed: np.ndarray
@@ -59,6 +64,9 @@ class WearRub:
     lobes: np.ndarray
     vibration_ratio: float
     phases: int
+    tip: np.ndarray | None = None
+    samples_per_turn: int = 0
+    check: LobeCheck | None = None
 
     @property
     def depths(self) -> np.ndarray:
@@ -68,23 +76,15 @@ class WearRub:
 
 def vibration_ratio(signal, samples_per_turn: int) -> float:
     """The dominant frequency of ``signal`` (sampled ``samples_per_turn`` times a revolution over whole
-    revolutions, its mean taken out) over the rotation frequency, refined by the parabola through the strongest bin
-    of the Hann-windowed spectrum and its neighbours.
+    revolutions) over the rotation frequency: the strongest line of its Hann-windowed spectrum above half an engine
+    order, its mean and trend taken out, refined by the parabola through it and its neighbours
+    (:func:`~bladecase.nsm.massless.wear_lobes.dominant_ratio`).
 
     >>> t = np.arange(400) / 100                       # four revolutions, 100 samples each
     >>> round(vibration_ratio(np.cos(2 * np.pi * 7.9 * t), 100), 1)
     7.9
     """
-    y = np.asarray(signal, dtype=float)
-    y = (y - y.mean()) * np.hanning(y.size)
-    a = np.abs(np.fft.rfft(y))
-    k = 1 + int(np.argmax(a[1:]))
-    shift = 0.0
-    if 1 <= k < a.size - 1:
-        lo, mid, hi = np.log(a[k - 1:k + 2] + 1e-300)
-        den = lo - 2 * mid + hi
-        shift = 0.5 * (lo - hi) / den if den != 0 else 0.0
-    return float((k + shift) * samples_per_turn / y.size)
+    return dominant_ratio(signal, samples_per_turn)[0]
 
 
 def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, amplitude: float, angles,
@@ -135,7 +135,10 @@ def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, 
         peak_u.append(float(y.max()))
         peak_p.append(float((lam / areas[:, None]).max()))
         count.append(profile.lobes())
-        tip = (tip + [(system.W.T @ xs[:, np.searchsorted(t, grid)]).mean(axis=0)])[-TAIL:]
+        tip.append((system.W.T @ xs[:, np.searchsorted(t, grid)]).mean(axis=0))
         x, v = tr.x_end, tr.v_end
-    ratio = vibration_ratio(np.concatenate(tip), per_turn)
-    return WearRub(profile, np.array(removed), np.array(peak_u), np.array(peak_p), np.array(count), ratio, phases)
+    tip = np.array(tip)
+    ratio = vibration_ratio(tip[-TAIL:].ravel(), per_turn)
+    check = lobe_check(np.array(profile.history), tip, per_turn, window=TAIL)
+    return WearRub(profile, np.array(removed), np.array(peak_u), np.array(peak_p), np.array(count), ratio, phases,
+                   tip, per_turn, check)

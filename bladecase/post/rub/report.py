@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...nsm.massless.wear_lobes import lobe_words
 from ..nodal.report import load_words
 
 __all__ = ["rub_report"]
@@ -153,12 +154,12 @@ def _wear_lines(w: dict | None, unit: str) -> list[str]:
         if r["removed_mm3"] == 0:
             out.append(f"- At {r['speed']:.6g} {unit} the tip removes no coating in {r['revolutions']} revolutions.")
             continue
-        match = ("as many as" if r["lobes"] == r["expected_lobes"] else "against")
+        c = r.get("lobe_check")
+        check = f"; over the last {c['window']} revolutions {lobe_words(c)}" if c else ""
         out.append(f"- At {r['speed']:.6g} {unit} after {r['revolutions']} revolutions the profile has {r['lobes']} "
                    f"lobes, {r['lobe_depth_um']:.3g} µm deep (deepest {r['max_depth_um']:.3g} µm); "
                    f"{r['removed_mm3']:.4g} mm³ removed (the profile's missing volume to {r['volume_mismatch']:.0e}); "
-                   f"the tip vibrates at {r['vibration_ratio']:.3g} × the rotation frequency: {match} "
-                   f"round(f_vib / f_rot) = {r['expected_lobes']} lobes"
+                   f"the tip vibrates at {r['vibration_ratio']:.3g} × the rotation frequency{check}"
                    + ("; **the tip has worn through to the casing**." if r["worn_through"] else "."))
     if len(w["speeds"]) > 1:
         out.append(f"- The most coating is removed at {w['most_wear']:.6g} {unit}.")

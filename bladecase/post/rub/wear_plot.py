@@ -1,5 +1,6 @@
 """The wear of an abradable coating by a rubbing blade: the worn profile unrolled over the casing's angle after each
-revolution, at the speed of most wear, and — over several speeds — the removed volume and the lobes against speed.
+revolution, at the speed of most wear, and — over several speeds — the removed volume against speed, each speed
+marked with its lobes against round(f_vib / f_rot).
 
 >>> section = {"speed_unit": "rpm", "rows": [{"speed": 1650.0}],
 ...            "wear": {"most_wear": 1650.0, "speeds": [{"speed": 1650.0, "removed_mm3": 2.0, "lobes": 8}]}}
@@ -51,12 +52,24 @@ def wear_plot(section: dict, points: list[dict], title: str | None = None) -> Fi
         volume = np.array([r["removed_mm3"] for r in per])
         bx.plot(speed, volume, "o-", color="C3")
         for s, v, r in zip(speed, volume, per):
-            bx.annotate(f"{r['lobes']}", (s, v), textcoords="offset points", xytext=(0, 6), ha="center", fontsize=8)
+            bx.annotate(_lobe_label(r), (s, v), textcoords="offset points", xytext=(0, 6), ha="center", fontsize=8)
         bx.set_xlabel(f"speed ({section['speed_unit']})")
         bx.set_ylabel("removed volume (mm³)")
-        bx.set_title("coating removed at each speed (the number: lobes of its profile)", fontsize=9)
+        bx.set_title("coating removed at each speed; lobes removed over the last revolutions = or ≠ "
+                     "round(f_vib / f_rot)\n(?: no lobe count to compare)", fontsize=9)
         bx.grid(alpha=0.3)
     if title:
         fig.suptitle(title)
     fig.tight_layout()
     return fig
+
+
+def _lobe_label(r: dict) -> str:
+    """A speed's lobes against round(f_vib / f_rot) over the last revolutions (its final profile's lobes without
+    the check)."""
+    c = r.get("lobe_check")
+    if not c:
+        return f"{r['lobes']}"
+    if c["verdict"] == "undefined":
+        return "?"
+    return f"{c['lobes']}{'=' if c['verdict'] == 'agree' else '≠'}{c['expected']}"

@@ -16,6 +16,7 @@ import numpy as np
 from ... import log
 from ...io import csv_cell, save_figure, write_text
 from ...nsm.massless.wear import Abradable
+from ...nsm.massless.wear_lobes import lobe_words
 from ..keys import StudyError
 
 __all__ = ["WEAR_COLUMNS", "coating_of", "log_wear", "wear_figures", "wear_section", "write_wear"]
@@ -77,12 +78,15 @@ def wear_figures(w) -> dict:
             "lobe_depth_m": np.ptp(depths, axis=1).tolist(), "lobes": w.lobes.tolist(),
             "peak_displacement_m": w.peak_displacement.tolist(), "peak_pressure_pa": w.peak_pressure.tolist(),
             "vibration_ratio": w.vibration_ratio, "depth_m": w.profile.depth.tolist(),
-            "history_m": depths.tolist(), "worn_through": bool(w.profile.worn_through), "phases": w.phases}
+            "history_m": depths.tolist(), "worn_through": bool(w.profile.worn_through), "phases": w.phases,
+            "lobe_check": None if w.check is None else w.check.as_dict()}
 
 
 def wear_section(study, coating: Abradable, rows: list[dict], points: list[dict]) -> dict:
     """The summary's ``rub.wear``: the coating, per speed the final lobes and depth, the removed volume against the
-    profile's missing volume, the response's vibration frequency over the rotation's; the speed of most wear."""
+    profile's missing volume, the response's vibration frequency over the rotation's, the held-out check of the
+    lobes worn over the last revolutions against it (``lobe_check``:
+    :func:`~bladecase.nsm.massless.wear_lobes.lobe_check`, as a dict); the speed of most wear."""
     per = []
     for row, p in zip(rows, points):
         w = p["wear"]
@@ -92,7 +96,8 @@ def wear_section(study, coating: Abradable, rows: list[dict], points: list[dict]
                     "missing_mm3": 1e9 * missing,
                     "volume_mismatch": abs(removed - missing) / max(missing, np.finfo(float).tiny),
                     "vibration_ratio": w["vibration_ratio"], "expected_lobes": int(round(w["vibration_ratio"])),
-                    "worn_through": w["worn_through"], "revolutions": len(w["lobes"])})
+                    "worn_through": w["worn_through"], "revolutions": len(w["lobes"]),
+                    "lobe_check": w.get("lobe_check")})
     top = max(range(len(per)), key=lambda i: per[i]["removed_mm3"]) if per else None
     return {"coating": {"thickness_m": coating.thickness, "yield_pa": coating.yield_pressure,
                         "stiffness_pa_per_m": coating.stiffness, "cells": coating.cells, "radius_m": coating.radius,
@@ -108,6 +113,10 @@ def log_wear(section: dict, unit: str) -> None:
         log.info("rub: at %.6g %s the coating is worn to %.4g µm in %d lobes after %d revolutions (%.4g mm³ removed; "
                  "the tip vibrates at %.3g × the rotation frequency)", w["speed"], unit, w["max_depth_um"], w["lobes"],
                  w["revolutions"], w["removed_mm3"], w["vibration_ratio"])
+        c = w.get("lobe_check")
+        if c:
+            log.info("rub: at %.6g %s, over the last %d revolutions: %s", w["speed"], unit, c["window"], lobe_words(c))
+
 
 
 def write_wear(folder: Path, study, model, contact, section: dict, points: list[dict], figures: bool,
