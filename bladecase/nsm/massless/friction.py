@@ -17,7 +17,8 @@ still LINEAR, ``λ_A = G_A(W_Aᵀx − g_A)`` with ``G_A = (H_μ)_AA⁻¹``, but
 ``S + (W_A − μT_A)G_AW_Aᵀ`` is NOT symmetric: the phase is flown in closed form from the complex eigenvectors of
 its first-order system (``x``, ``x'``: the reduced size, dense), with the harmonic particular solution of the
 out-of-round casing, and its first switch found by the same certified search as without friction. A phase whose
-non-symmetric stiffness makes it grow (friction-induced flutter) is refused with a clear message: the certified
+non-symmetric stiffness makes it grow (friction-induced flutter, or divergence when the growing root is real) is
+refused with a clear message: the certified
 search needs decaying or neutral terms (the extended periodic motion concept of
 :mod:`~bladecase.nsm.massless.friction_modes`, which feeds its phases on purpose, flies them with its own search).
 The set of closed contacts at a switch solves the complementarity problem
@@ -195,6 +196,16 @@ def lemke(q, M, max_pivots: int | None = None) -> np.ndarray:
     return z
 
 
+def instability(lam: np.ndarray) -> str:
+    """What the growing root of a phase's first-order eigenvalues ``lam`` is, in words: a flutter (complex: with its
+    frequency) or a divergence (real: the stiffness lost its positiveness)."""
+    top = lam[np.argmax(lam.real)]
+    if abs(top.imag) > FLUTTER_RTOL * np.abs(lam).max():
+        return f"friction-induced flutter, an oscillation of {abs(top.imag) / 2 / np.pi:.4g} Hz"
+    return ("friction-induced divergence: the phase's stiffness is no longer positive, it drifts without "
+            "oscillating")
+
+
 class _FrictionPhase(_Phase):
     """One set ``A`` of closed contacts with friction: non-symmetric, flown from its first-order eigenvectors."""
 
@@ -234,7 +245,7 @@ class _FrictionPhase(_Phase):
         growth = getattr(fl, "allow_growth", False)  # the extended periodic motion concept feeds its phases
         if not growth and grow > FLUTTER_RTOL * np.abs(lam).max():
             raise ValueError(f"a contact phase with friction (nodes {[s.nodes[k] for k in idx]} closed, mu = "
-                             f"{fr.mu:g}) is unstable: it grows at {grow:.3g} 1/s (friction-induced flutter); the "
+                             f"{fr.mu:g}) is unstable: it grows at {grow:.3g} 1/s ({instability(lam)}); the "
                              "exact flight needs decaying phases: add damping or lower mu")
         self._lu = sla.lu_factor(V)
         rcond = sla.lapack.zgecon(self._lu[0], np.abs(V).sum(axis=0).max())[0]
