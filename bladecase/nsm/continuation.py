@@ -369,34 +369,31 @@ def correct_chord_newton(curve: BatchCurve, ZP: np.ndarray, D: np.ndarray, idx: 
     """
     count, idx = len(ZP), np.asarray(idx)
     R0, J0 = start
-    out, ok, iters = ZP.copy(), np.zeros(count, dtype=bool), np.full(count, maxiter)
-    n_out, n_ok, n_it = ZP.copy(), np.zeros(count, dtype=bool), np.full(count, maxiter)  # Newton's results
-    Jout, known = np.full(J0.shape, np.nan), np.zeros(count, dtype=bool)
     cancel = np.zeros(count, dtype=bool)  # converged by the chord: Newton not needed
+    log: list[tuple] = []  # (rows, Z, converged, iteration, Newton's?) of the rows that stop, as they stop
+    Jlog: list[tuple] = []  # (rows, Jacobians) at Newton's converged points
     # the active rows: the chord's first (nc of them), then Newton's; src: the row of ZP of each
     src = np.concatenate([np.arange(count), np.arange(count)])
     nc, Z, zp, d, ix = count, np.concatenate([ZP, ZP]), np.concatenate([ZP, ZP]), np.concatenate([D, D]), idx[src]
-    Jc, Jn = J, J0  # the Jacobians of the residual tests' round-off floors: the chord's fixed one, Newton's last
-    checking = np.zeros(2 * count, dtype=bool)
+    Jc = J  # the chord's fixed Jacobians: its residual tests' round-off floor (Newton's: its last Jacobians)
+    checking, Ju = np.zeros(2 * count, dtype=bool), None
     R, Jz = np.concatenate([R0, R0]), J0
     for it in range(maxiter + 1):
         if it == maxiter:  # the last evaluation serves only the rows moved below step_tol: their residual test
-            R, Jz = curve.evaluate(Z[checking], ix[checking], False) if checking.any() else (None, None)
+            R = curve.evaluate(Z[checking], ix[checking], False)[0] if checking.any() else None
         elif it:
             R, Jz = curve.evaluate(Z, ix, nc)  # the Jacobians of Newton's rows
         leave = checking if it and checking.any() else None
         if leave is not None:  # moved less than step_tol at the last iteration: the residual test
             at = np.flatnonzero(checking)
-            c, n = at[at < nc], at[at >= nc]
-            floor = np.concatenate([roundoff_floor(Jc[c], Z[c]), roundoff_floor(Jn[n - nc], Z[n])])
-            good = np.abs(R if it == maxiter else R[at]).max(axis=1) < np.maximum(curve.tol, floor)
-            gc, gn = good[:c.size], good[c.size:]
-            rc, rn = src[c], src[n]
-            out[rc[gc]], ok[rc[gc]], iters[rc] = Z[c[gc]], True, it
-            cancel[rc[gc]] = True
-            n_out[rn[gn]], n_ok[rn], n_it[rn] = Z[n[gn]], gn, it
-            if it < maxiter:
-                Jout[rn[gn]], known[rn[gn]] = Jz[n[gn] - nc], True
+            good = (np.abs(R if it == maxiter else R[at]).max(axis=1)
+                    < np.maximum(curve.tol, roundoff_floor(Ju[at], Z[at])))
+            rows, newton = src[at], at >= nc
+            log.append((rows, Z[at], good, it, newton))
+            cancel[rows[good & ~newton]] = True
+            if it < maxiter and (good & newton).any():
+                conv = at[good & newton]
+                Jlog.append((src[conv], Jz[conv - nc]))
         if it == maxiter:
             break
         r = np.concatenate([R, np.einsum("ij,ij->i", d, Z - zp)[:, None]], axis=1)
@@ -404,7 +401,8 @@ def correct_chord_newton(curve: BatchCurve, ZP: np.ndarray, D: np.ndarray, idx: 
         if undefined.any():
             if leave is not None:
                 undefined &= ~leave
-            n_it[src[nc:][undefined[nc:]]] = it
+            at = np.flatnonzero(undefined)
+            log.append((src[at], Z[at], np.zeros(at.size, dtype=bool), it, at >= nc))
             leave = undefined if leave is None else leave | undefined
         if leave is not None:
             leave[nc:] |= cancel[src[nc:]]
@@ -414,15 +412,33 @@ def correct_chord_newton(curve: BatchCurve, ZP: np.ndarray, D: np.ndarray, idx: 
             kc = keep[:nc]
             src, Z, zp, d, ix, r, Jz = src[keep], Z[keep], zp[keep], d[keep], ix[keep], r[keep], Jz[keep[nc:]]
             P, Jc, nc = P[kc], Jc[kc], int(kc.sum())
-        Jn = Jz
-        dz = np.concatenate([-(P @ r[:nc, :, None])[:, :, 0], _newton_step(Jn, d[nc:], r[nc:])])
+        Ju = np.concatenate([Jc, Jz])
+        dz = np.concatenate([-(P @ r[:nc, :, None])[:, :, 0], _newton_step(Jz, d[nc:], r[nc:])])
         Z = Z + dz
         # a failed solve (non-finite step: its max is NaN or inf) is not checked: maxiter iterations, no convergence
         checking = np.abs(dz).max(axis=1) < curve.step_tol
-    failed = ~ok
-    out[failed], ok[failed], iters[failed] = n_out[failed], n_ok[failed], n_it[failed]
-    known &= failed
-    Jout[~known] = np.nan
+    return _chord_or_newton(ZP, J0.shape, log, Jlog, maxiter)
+
+
+def _chord_or_newton(ZP: np.ndarray, Jshape: tuple, log: list, Jlog: list, maxiter: int) -> tuple:
+    """:func:`correct_chord_newton`'s results from the records of the rows as they stopped: the chord's where it
+    converged, else Newton's (a row that never stopped: not converged in ``maxiter`` iterations)."""
+    count = len(ZP)
+    out, ok, iters = ZP.copy(), np.zeros(count, dtype=bool), np.full(count, maxiter)
+    Jout, known = np.full(Jshape, np.nan), np.zeros(count, dtype=bool)
+    by_chord = np.zeros(count, dtype=bool)
+    if log:
+        rows, Z, good, newton = (np.concatenate([e[i] for e in log]) for i in (0, 1, 2, 4))
+        it = np.concatenate([np.full(e[0].size, e[3]) for e in log])
+        chord = good & ~newton
+        by_chord[rows[chord]] = True
+        for pick in (newton & ~by_chord[rows], chord):  # Newton's record of each row the chord did not solve
+            at, conv = rows[pick], good[pick]
+            ok[at], iters[at], out[at[conv]] = conv, it[pick], Z[pick][conv]
+    if Jlog:
+        rows, Js = np.concatenate([e[0] for e in Jlog]), np.concatenate([e[1] for e in Jlog])
+        mine = ~by_chord[rows]
+        Jout[rows[mine]], known[rows[mine]] = Js[mine], True
     return out, ok, iters, Jout, known
 
 
