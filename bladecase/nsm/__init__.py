@@ -23,8 +23,6 @@ Module map of the shared modules, one entry per module (the details are in each 
 - :mod:`~bladecase.nsm.signals` — certified bounds and first roots of trigonometric sums;
 - :mod:`~bladecase.nsm.continuation` — pseudo-arclength following of ``R(z) = 0`` for any residual with an exact
   Jacobian (:class:`Curve`, :func:`trace`, :func:`bisect`);
-- :mod:`~bladecase.nsm.lstsq` — least squares, pseudo-inverses and null vectors over stacks of small matrices
-  (the continuation's corrector);
 - :mod:`~bladecase.nsm.arcs` — a mode search's period range and the admissible arcs along a followed curve, for
   either contact model;
 - :mod:`~bladecase.nsm.branches` — :class:`Branch` and :class:`Arc`: one type for backbones and k-ipp families

@@ -35,12 +35,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .lstsq import lstsq2_stack, lstsq_stack, pinv_stack, tangent_stack
-
 Vector = np.ndarray
 
-#: The stacked least squares (:func:`lstsq_stack`, :func:`lstsq2_stack`, :func:`pinv_stack`, :func:`tangent_stack`)
-#: live in :mod:`bladecase.nsm.lstsq`; their names stay available here.
+#: numpy's own least-squares driver (the LAPACK call of ``np.linalg.lstsq``), vectorised over a stack; private,
+#: hence looked up defensively (:func:`lstsq_stack` falls back to one ``np.linalg.lstsq`` per matrix).
+_LSTSQ = getattr(getattr(np.linalg, "_umath_linalg", None), "lstsq", None)
+
 
 #: The machine epsilon, and ``4 ε`` of :func:`roundoff_floor`.
 _EPS = float(np.finfo(float).eps)
@@ -232,10 +232,9 @@ class BatchCurve:
 
     Attributes
     ----------
-    evaluate : callable ``(Z, idx, jacobian: bool | int) -> (R, J or None)``
-        Residuals ``(B, m)`` and, when asked, exact Jacobians ``(B, m, n)`` — an integer ``jacobian`` (not a
-        bool) asks for those of the rows from that one on only; non-finite residuals mark points where the
-        residual is undefined.
+    evaluate : callable ``(Z, idx, jacobian: bool) -> (R, J or None)``
+        Residuals ``(B, m)`` and, when asked, exact Jacobians ``(B, m, n)``; non-finite residuals mark
+        points where the residual is undefined.
     valid : callable ``(Z, idx) -> (B,) bool``
     crossing : callable ``(Z_a, Z_b, idx) -> (B,) bool``
     tol, step_tol : float
@@ -255,15 +254,103 @@ class BatchCurve:
 
         def evaluate(Z, idx, jacobian):
             R = np.array([curves[i].residual(z) for z, i in zip(Z, idx)])
-            whole = isinstance(jacobian, (bool, np.bool_))
-            if whole and not jacobian:
-                return R, None
-            J = np.array([curves[i].jacobian(z) for z, i in zip(Z, idx)])
-            return R, (J if whole else J[int(jacobian):])
+            return R, (np.array([curves[i].jacobian(z) for z, i in zip(Z, idx)]) if jacobian else None)
 
         return cls(evaluate, lambda Z, idx: np.array([curves[i].valid(z) for z, i in zip(Z, idx)], dtype=bool),
                    lambda A, B, idx: np.array([curves[i].crossing(a, b) for a, b, i in zip(A, B, idx)], dtype=bool),
                    c0.tol, c0.step_tol)
+
+
+def lstsq_stack(A: np.ndarray, b: np.ndarray, rcond: float | None = None) -> np.ndarray:
+    """``np.linalg.lstsq(A[i], b[i], rcond)[0]`` for every ``i`` of the float stacks ``A`` ``(B, M, N)``, ``b``
+    ``(B, M)``: one call of numpy's own LAPACK driver over the whole stack when numpy exposes it (the same
+    results), else one call per matrix.  Rows that LAPACK cannot solve (non-finite input) come back NaN.
+
+    >>> A = np.array([[[1.0, 0.0], [0.0, 2.0], [0.0, 0.0]]] * 2)
+    >>> lstsq_stack(A, np.array([[1.0, 2.0, 3.0], [2.0, 4.0, 0.0]])).tolist()
+    [[1.0, 1.0], [2.0, 2.0]]
+    """
+    count, M, N = A.shape
+    rcond = _EPS * max(M, N) if rcond is None else rcond
+    if _LSTSQ is not None and count:
+        try:
+            with np.errstate(all="ignore"):
+                return _LSTSQ(A, b[..., None], rcond, signature="ddd->ddid")[0][..., 0]
+        except (TypeError, ValueError):
+            pass  # another numpy's private signature: one call per matrix
+    out = np.full((count, N), np.nan)
+    for i in range(count):
+        if np.all(np.isfinite(A[i])) and np.all(np.isfinite(b[i])):
+            out[i] = np.linalg.lstsq(A[i], b[i], rcond=rcond)[0]
+    return out
+
+
+#: Stacks of at least this many 3×2 systems are solved in closed form (:func:`lstsq2_stack`): below it, numpy's
+#: LAPACK loop is faster than the closed form's few dozen array operations (measured: equal at about 40 rows).
+LSTSQ2_MIN_ROWS = 48
+
+
+def lstsq2_stack(A: np.ndarray, b: np.ndarray, min_rows: int = LSTSQ2_MIN_ROWS) -> np.ndarray:
+    """:func:`lstsq_stack` for two unknowns (``A`` ``(B, M, 2)``, ``M >= 2``): stacks of at least ``min_rows``
+    by two Householder reflections in closed form, vectorised (backward stable, as LAPACK's QR), smaller ones by
+    :func:`lstsq_stack` (faster there).  Rows rank deficient to within ``100 ε`` are left to :func:`lstsq_stack`
+    (its rank cut-off); rows with non-finite entries come back NaN.
+
+    >>> A = np.array([[[1.0, 0.0], [0.0, 2.0], [0.0, 0.0]], [[1.0, 1.0], [1.0, 1.0], [0.0, 0.0]]])
+    >>> lstsq2_stack(A, np.array([[1.0, 2.0, 3.0], [2.0, 2.0, 0.0]]), min_rows=0).round(12).tolist()
+    [[1.0, 1.0], [1.0, 1.0]]
+    """
+    if len(A) < min_rows:
+        return lstsq_stack(A, b)
+    a1, a2, y = A[:, :, 0], A[:, :, 1].copy(), np.array(b, dtype=float)
+    with np.errstate(all="ignore"):
+        n1 = np.sqrt(np.einsum("bi,bi->b", a1, a1))
+        r11 = np.where(a1[:, 0] > 0, -n1, n1)  # the reflection of a1 onto r11·e1 (no cancellation)
+        v = a1.copy()
+        v[:, 0] -= r11
+        vv = np.einsum("bi,bi->b", v, v)
+        for x in (a2, y):  # H1 = I - 2vvᵀ/vᵀv
+            x -= (2 * np.einsum("bi,bi->b", v, x) / vv)[:, None] * v
+        u, w = a2[:, 1:], y[:, 1:]
+        n2 = np.sqrt(np.einsum("bi,bi->b", u, u))
+        r22 = np.where(u[:, 0] > 0, -n2, n2)
+        u = u.copy()
+        u[:, 0] -= r22
+        uu = np.einsum("bi,bi->b", u, u)
+        y2 = w[:, 0] - 2 * np.einsum("bi,bi->b", u, w) / uu * u[:, 0]
+        x2 = np.where(uu > 0, y2, w[:, 0]) / r22
+        x1 = (y[:, 0] - a2[:, 0] * x2) / r11
+        out = np.stack([x1, x2], axis=1)
+        weak = ~(np.abs(r22) > 100 * _EPS * np.maximum(np.abs(r11), np.abs(a2[:, 0])))
+    finite = np.isfinite(A).all(axis=(1, 2)) & np.isfinite(b).all(axis=1)
+    out[~finite] = np.nan  # as LAPACK leaves them
+    weak = finite & (weak | ~np.isfinite(out).all(axis=1))
+    if weak.any():
+        out[weak] = lstsq_stack(A[weak], b[weak])
+    return out
+
+
+def tangent_stack(J: np.ndarray, previous: np.ndarray | None = None) -> np.ndarray:
+    """:func:`tangent` of each matrix of the stack ``J`` ``(B, m, n)``, oriented along ``previous[i]``."""
+    t = np.linalg.svd(J)[2][:, -1, :]
+    if previous is not None:
+        t = np.where(np.einsum("ij,ij->i", t, previous)[:, None] < 0, -t, t)
+    return t
+
+
+def pinv_stack(A: np.ndarray) -> np.ndarray:
+    """Pseudo-inverses of the stack ``A`` ``(B, M, N)`` with the rank cut-off of :func:`lstsq_stack` (singular
+    values at most ``ε·max(M, N)`` times the largest count as zero): ``pinv_stack(A)[i] @ b`` is
+    ``lstsq_stack(A, b)[i]`` up to round-off.
+
+    >>> A = np.array([[[1.0, 0.0], [0.0, 2.0], [0.0, 0.0]]])
+    >>> (pinv_stack(A)[0] @ np.array([1.0, 2.0, 3.0])).tolist()
+    [1.0, 1.0]
+    """
+    U, sv, Vt = np.linalg.svd(A, full_matrices=False)
+    cut = _EPS * max(A.shape[1:]) * sv[:, :1]
+    inv = np.divide(1.0, sv, out=np.zeros_like(sv), where=sv > cut)
+    return np.swapaxes(Vt, 1, 2) @ (inv[:, :, None] * np.swapaxes(U, 1, 2))
 
 
 def chord_pinv(J: np.ndarray, D: np.ndarray) -> np.ndarray:
@@ -345,109 +432,6 @@ def correct_stack(curve: BatchCurve, ZP: np.ndarray, D: np.ndarray, idx: np.ndar
     return out, ok, iters
 
 
-def correct_chord_newton(curve: BatchCurve, ZP: np.ndarray, D: np.ndarray, idx: np.ndarray, J: np.ndarray,
-                         P: np.ndarray, start: tuple, maxiter: int = 10) -> tuple:
-    """The corrector of :class:`Followers`: the chord method (Jacobians ``J``, pseudo-inverses ``P``), then full
-    Newton from ``ZP`` on the rows where it fails — each row's result that of :func:`correct_stack` called so
-    (``(Z, converged, iterations, Jacobians, known)`` as with ``jacobians``) — but both correctors in lockstep,
-    in the same evaluations: every row's Newton iterations run beside its chord iterations (dropped where the
-    chord converges), so that a step costs ``maxiter`` evaluations, not up to twice as many.
-    ``start``: ``curve.evaluate(ZP, idx, True)``.
-
-    >>> circle = BatchCurve.of([Curve(residual=lambda z: np.array([z @ z - 1.0]), jacobian=lambda z: 2 * z[None, :])])
-    >>> ZP, D = np.array([[1.0, 0.3], [1.0, 0.9]]), np.array([[0.0, 1.0], [0.0, 1.0]])
-    >>> J = circle.evaluate(np.array([[1.0, 0.0], [1.0, 0.0]]), [0, 0], True)[1]
-    >>> start = circle.evaluate(ZP, [0, 0], True)
-    >>> idx = np.array([0, 0])
-    >>> Z, ok, iters, _, known = correct_chord_newton(circle, ZP, D, idx, J, chord_pinv(J, D), start)
-    >>> chord = correct_stack(circle, ZP, D, idx, J, start=start)   # converges at 0.3, not at 0.9
-    >>> newton = correct_stack(circle, ZP, D, idx, start=start)
-    >>> ok.tolist(), chord[1].tolist(), iters.tolist(), [int(chord[2][0]), int(newton[2][1])], known.tolist()
-    ([True, True], [True, False], [8, 6], [8, 6], [False, True])
-    >>> bool((Z[0] == chord[0][0]).all() and (Z[1] == newton[0][1]).all())
-    True
-    """
-    count, idx = len(ZP), np.asarray(idx)
-    R0, J0 = start
-    cancel = np.zeros(count, dtype=bool)  # converged by the chord: Newton not needed
-    log: list[tuple] = []  # (rows, Z, converged, iteration, Newton's?) of the rows that stop, as they stop
-    Jlog: list[tuple] = []  # (rows, Jacobians) at Newton's converged points
-    # the active rows: the chord's first (nc of them), then Newton's; src: the row of ZP of each
-    src = np.concatenate([np.arange(count), np.arange(count)])
-    nc, Z, zp, d, ix = count, np.concatenate([ZP, ZP]), np.concatenate([ZP, ZP]), np.concatenate([D, D]), idx[src]
-    Jc = J  # the chord's fixed Jacobians: its residual tests' round-off floor (Newton's: its last Jacobians)
-    checking, Ju = np.zeros(2 * count, dtype=bool), None
-    R, Jz = np.concatenate([R0, R0]), J0
-    for it in range(maxiter + 1):
-        if it == maxiter:  # the last evaluation serves only the rows moved below step_tol: their residual test
-            R = curve.evaluate(Z[checking], ix[checking], False)[0] if checking.any() else None
-        elif it:
-            R, Jz = curve.evaluate(Z, ix, nc)  # the Jacobians of Newton's rows
-        leave = checking if it and checking.any() else None
-        if leave is not None:  # moved less than step_tol at the last iteration: the residual test
-            at = np.flatnonzero(checking)
-            good = (np.abs(R if it == maxiter else R[at]).max(axis=1)
-                    < np.maximum(curve.tol, roundoff_floor(Ju[at], Z[at])))
-            rows, newton = src[at], at >= nc
-            log.append((rows, Z[at], good, it, newton))
-            cancel[rows[good & ~newton]] = True
-            if it < maxiter and (good & newton).any():
-                conv = at[good & newton]
-                Jlog.append((src[conv], Jz[conv - nc]))
-        if it == maxiter:
-            break
-        r = np.concatenate([R, np.einsum("ij,ij->i", d, Z - zp)[:, None]], axis=1)
-        undefined = ~np.isfinite(r).all(axis=1)  # undefined residual: no solution along this direction
-        if undefined.any():
-            if leave is not None:
-                undefined &= ~leave
-            at = np.flatnonzero(undefined)
-            log.append((src[at], Z[at], np.zeros(at.size, dtype=bool), it, at >= nc))
-            leave = undefined if leave is None else leave | undefined
-        if leave is not None:
-            leave[nc:] |= cancel[src[nc:]]
-            keep = ~leave
-            if not keep.any():
-                break
-            kc = keep[:nc]
-            src, Z, zp, d, ix, r, Jz = src[keep], Z[keep], zp[keep], d[keep], ix[keep], r[keep], Jz[keep[nc:]]
-            P, Jc, nc = P[kc], Jc[kc], int(kc.sum())
-        Ju = np.concatenate([Jc, Jz])
-        dz = np.concatenate([-(P @ r[:nc, :, None])[:, :, 0], _newton_step(Jz, d[nc:], r[nc:])])
-        Z = Z + dz
-        # a failed solve (non-finite step: its max is NaN or inf) is not checked: maxiter iterations, no convergence
-        checking = np.abs(dz).max(axis=1) < curve.step_tol
-    return _chord_or_newton(ZP, J0.shape, log, Jlog, maxiter)
-
-
-def _chord_or_newton(ZP: np.ndarray, Jshape: tuple, log: list, Jlog: list, maxiter: int) -> tuple:
-    """:func:`correct_chord_newton`'s results from the records of the rows as they stopped: the chord's where it
-    converged, else Newton's (a row that never stopped: not converged in ``maxiter`` iterations)."""
-    count = len(ZP)
-    out, ok, iters = ZP.copy(), np.zeros(count, dtype=bool), np.full(count, maxiter)
-    Jout, known = np.full(Jshape, np.nan), np.zeros(count, dtype=bool)
-    by_chord = np.zeros(count, dtype=bool)
-    if log:
-        rows, Z, good, newton = (np.concatenate([e[i] for e in log]) for i in (0, 1, 2, 4))
-        it = np.concatenate([np.full(e[0].size, e[3]) for e in log])
-        chord = good & ~newton
-        by_chord[rows[chord]] = True
-        for pick in (newton & ~by_chord[rows], chord):  # Newton's record of each row the chord did not solve
-            at, conv = rows[pick], good[pick]
-            ok[at], iters[at], out[at[conv]] = conv, it[pick], Z[pick][conv]
-    if Jlog:
-        rows, Js = np.concatenate([e[0] for e in Jlog]), np.concatenate([e[1] for e in Jlog])
-        mine = ~by_chord[rows]
-        Jout[rows[mine]], known[rows[mine]] = Js[mine], True
-    return out, ok, iters, Jout, known
-
-
-def _newton_step(Jz: np.ndarray, d: np.ndarray, r: np.ndarray) -> np.ndarray:
-    """Newton's least-squares steps on ``[Jz; d] dz = -r``."""
-    A = np.concatenate([Jz, d[:, None, :]], axis=1)
-    return lstsq2_stack(A, -r) if A.shape[2] == 2 else lstsq_stack(A, -r)
-
-
 class Followers:
     """:func:`follow` on many curves at once, members joining and leaving between steps.
 
@@ -525,9 +509,12 @@ class Followers:
         R0, J0 = curve.evaluate(ZP, idx[rows], True)  # the first iteration of both correctors
         new = rows[~st["P_known"][rows]]  # the chord's matrix changes with the point, not with the step
         st["P"][new], st["P_known"][new] = chord_pinv(st["J"][new], tan[new]), True
-        # the chord method, full Newton where it fails (the Jacobian at its corrected point known)
-        ZC, ok, iters, Jr, known = correct_chord_newton(curve, ZP, tan[rows], idx[rows], st["J"][rows], st["P"][rows],
-                                                        (R0, J0))
+        ZC, ok, iters = correct_stack(curve, ZP, tan[rows], idx[rows], st["J"][rows], start=(R0, J0), P=st["P"][rows])
+        retry = np.flatnonzero(~ok)  # chord method failed: full Newton
+        known = np.zeros(rows.size, dtype=bool)  # the Jacobian at the corrected point known (full Newton's last)
+        if retry.size:
+            ZC[retry], ok[retry], iters[retry], Jr, known[retry] = correct_stack(
+                curve, ZP[retry], tan[rows[retry]], idx[rows[retry]], jacobians=True, start=(R0[retry], J0[retry]))
         good = ok.copy()
         if good.any():
             good[good] = curve.valid(ZC[good], idx[rows[good]])
@@ -543,8 +530,10 @@ class Followers:
             return
         st["travelled"][acc] += np.linalg.norm(ZC - Z[acc], axis=1)
         if known[good].any():  # the Jacobians full Newton computed at its converged points; the others evaluated
+            lookup = np.full(rows.size, -1)
+            lookup[retry] = np.arange(retry.size)
             have = known[good]
-            st["J"][acc[have]] = Jr[good][have]
+            st["J"][acc[have]] = Jr[lookup[np.flatnonzero(good)[have]]]
             if not have.all():
                 st["J"][acc[~have]] = curve.evaluate(ZC[~have], idx[acc[~have]], True)[1]
         else:

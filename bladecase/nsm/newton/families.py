@@ -129,12 +129,8 @@ class KippCurves:
         R = np.empty((len(T0), 2))
         np.multiply(f, np.einsum("bm,bm->b", sp, c), out=R[:, 1])  # -f·s(D), s(D) = -Σ c sin
         np.negative(R[:, 1], out=R[:, 0])
-        if isinstance(jacobian, (bool, np.bool_)):
-            if not jacobian:
-                return R, None
-        elif jacobian:  # an integer: the Jacobians of the rows from that one on
-            a = int(jacobian)
-            T0, c, sh, ch, cp, sp, w, X, f = T0[a:], c[a:], sh[a:], ch[a:], cp[a:], sp[a:], w[a:], X[:, a:], f[a:]
+        if not jacobian:
+            return R, None
         cw = np.multiply(c, self.omega, out=w)
         ds = -np.einsum("bm,bm->b", cp, cw)  # s'(D)
         x = np.multiply(cw, ch, out=X[1])
@@ -148,14 +144,10 @@ class KippCurves:
         np.multiply(g, ds + b1 - b2, out=J[:, 1, 1])
         return R, J
 
-    def evaluate(self, Z, idx, jacobian: bool | int = False):
-        """Residuals ``(B, k)`` and, with ``jacobian``, exact Jacobians ``(B, k, k)`` (see :meth:`KippCurve.jacobian`;
-        an integer ``jacobian``: those of the rows from that one on); NaN rows where ``Σ`` is singular."""
-        if self.k == 2:
-            return self._evaluate2(Z, idx, jacobian)
-        whole = isinstance(jacobian, (bool, np.bool_))
-        R, J = self._evaluate(Z, idx, bool(jacobian) if whole else True)
-        return R, (J if whole else J[int(jacobian):])
+    def evaluate(self, Z, idx, jacobian: bool = False):
+        """Residuals ``(B, k)`` and, with ``jacobian``, exact Jacobians ``(B, k, k)`` (see :meth:`KippCurve.jacobian`);
+        NaN rows where ``Σ`` is singular."""
+        return self._evaluate2(Z, idx, jacobian) if self.k == 2 else self._evaluate(Z, idx, jacobian)
 
     def _evaluate(self, Z, idx, jacobian: bool):
         """:meth:`evaluate` for any ``k``."""
