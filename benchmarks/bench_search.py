@@ -59,10 +59,10 @@ lockstep, one evaluation per iteration (Newton's Jacobians only), halves the eva
 (24 214 -> 13 510) with every family, span and arc the same, but not the time: chain20 3.60/3.89/3.76 ->
 3.56/3.79/3.71, chain50 8.14/8.66/8.80 -> 8.69/8.19/10.77, demo8 2.91/2.82/2.32 -> 3.10/2.96/1.99 (replayed
 corrector calls: -12 % on stacks below 64 rows, +5 % on stacks of 256 and more, where the kernel's ``tan`` over
-``(2, rows, modes)`` dominates).  Most chord attempts fail (chain20: 37 656 of 46 402 rows, at the 10th
+``(2, rows, modes)`` dominates).  Most chord attempts fail (chain20: 37 656 of 45 964 rows, mostly at the 10th
 iteration, contracting by ~0.75 per iteration); dropping a chord row whose contraction cannot reach ``step_tol``
-in time (then Newton's point) changes the families: chain20 94 -> 90 arcs, demo8 4 -> 3, chain50 379 -> 387
-with 8 lost.
+in time (then Newton's point) changes the families: chain20 94 -> 90 arcs (the middle orbit of one arc of before
+on no family after), demo8 4 -> 3 arcs and 278 -> 266 families, chain50 379 -> 387 arcs (two middle orbits lost).
 
 With ``--compare`` each case also reports the arcs of before inside no arc of after (and the reverse) and how
 many middle orbits of the arcs of before lie on no family of after (re-solved from every new family,
