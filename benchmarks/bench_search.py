@@ -53,7 +53,16 @@ a flight whose grid shows a violation finished there: polished orbits' certifica
 acceptance and records of the polished orbits, k = 2 canonical rotations in scalar arithmetic.  CPU medians of 3
 (load 2-3.5, ``--cases chain10,chain20,chain50,demo8``, interleaved): chain10 1.31 -> 1.01, chain20 2.77 -> 2.23,
 chain50 5.73 -> 4.44, demo8 1.42 -> 1.21; ``--cases chain50,demo8`` (chain50 first: the baseline's first run
-6.98-8.1 s, faulting) chain50 5.65 -> 4.28 and 5.60 -> 4.59.
+6.98-8.1 s, faulting) chain50 5.65 -> 4.28 and 5.60 -> 4.59.  Sixth pass, not kept (load 7-10, CPU s of
+``--repeat 3``, base and new interleaved, three rounds): the chord method and its full-Newton fallback run in
+lockstep, one evaluation per iteration (Newton's Jacobians only), halves the evaluations of chain20
+(24 214 -> 13 510) with every family, span and arc the same, but not the time: chain20 3.60/3.89/3.76 ->
+3.56/3.79/3.71, chain50 8.14/8.66/8.80 -> 8.69/8.19/10.77, demo8 2.91/2.82/2.32 -> 3.10/2.96/1.99 (replayed
+corrector calls: -12 % on stacks below 64 rows, +5 % on stacks of 256 and more, where the kernel's ``tan`` over
+``(2, rows, modes)`` dominates).  Most chord attempts fail (chain20: 37 656 of 45 964 rows, mostly at the 10th
+iteration, contracting by ~0.75 per iteration); dropping a chord row whose contraction cannot reach ``step_tol``
+in time (then Newton's point) changes the families: chain20 94 -> 90 arcs (the middle orbit of one arc of before
+on no family after), demo8 4 -> 3 arcs and 278 -> 266 families, chain50 379 -> 387 arcs (two middle orbits lost).
 
 With ``--compare`` each case also reports the arcs of before inside no arc of after (and the reverse) and how
 many middle orbits of the arcs of before lie on no family of after (re-solved from every new family,
