@@ -33,8 +33,6 @@ def register(name: str, writer, scope: str, summary: str) -> Output:
     return FORMATS.register(name, writer, scope, summary)
 
 
-
-
 def _built_in(module: str):
     """The ``write`` of the built-in format module ``module``, imported at its first call: the figures' and the
     animations' libraries are imported only by a run that writes them, not by every module that reads the list
@@ -43,7 +41,7 @@ def _built_in(module: str):
     def write(scene, folder: Path, formats: set[str]) -> dict[str, str]:
         return importlib.import_module(f".{module}", __name__).write(scene, folder, formats)
 
-    write.__qualname__ = write.__name__ = f"{module}.write"
+    write.__qualname__ = f"{module}.write"
     return write
 
 
