@@ -52,11 +52,46 @@ checks), its call in :mod:`~bladecase.study.run`; its words and figures called f
 The command line (:mod:`bladecase.cli`) is a thin layer over this package.
 """
 
-from .dask_executor import DaskExecutor
-from .demo import demo_study
-from .executor import Executor, ProcessExecutor, SerialExecutor, keyword_task, make_executor
-from .run import RunResult, run
-from .schema import Study, StudyError, load_study
+import importlib
+import sys
+import types
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # what a type checker and an IDE see; at run time each name is imported on first use
+    from .dask_executor import DaskExecutor
+    from .demo import demo_study
+    from .executor import Executor, ProcessExecutor, SerialExecutor, keyword_task, make_executor
+    from .run import RunResult, run
+    from .schema import Study, StudyError, load_study
+
+#: Where each public name lives: it is imported from there on first use, so that a module of this package (a
+#: stage, the schema, a task a spawned worker unpickles) does not import the whole chain and its figures with it.
+_WHERE = {"DaskExecutor": "dask_executor", "demo_study": "demo", "Executor": "executor",
+          "ProcessExecutor": "executor", "SerialExecutor": "executor", "keyword_task": "executor",
+          "make_executor": "executor", "RunResult": "run", "run": "run", "Study": "schema", "StudyError": "schema",
+          "load_study": "schema"}
+
+
+def __getattr__(name: str):
+    """Import a public name the first time it is used (PEP 562)."""
+    if name not in _WHERE:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{_WHERE[name]}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+class _Package(types.ModuleType):
+    """This package, whose ``run`` stays the function :func:`run.run` once the module of that name is imported
+    (the import system sets a package's attribute to each submodule it loads)."""
+
+    def __setattr__(self, name: str, value) -> None:
+        if name == "run" and isinstance(value, types.ModuleType):
+            return
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package
 
 __all__ = ["DaskExecutor", "Executor", "ProcessExecutor", "RunResult", "SerialExecutor", "Study", "StudyError",
            "demo_study", "keyword_task", "load_study", "make_executor", "run"]

@@ -17,7 +17,9 @@ follow :data:`FORMATS`.
 
 from __future__ import annotations
 
-from . import animation, png, vtu
+import importlib
+from pathlib import Path
+
 from .registry import OrbitScene, Output, OutputRegistry, PlotScene
 
 __all__ = ["FORMATS", "Output", "OrbitScene", "OutputRegistry", "PlotScene", "register"]
@@ -31,7 +33,20 @@ def register(name: str, writer, scope: str, summary: str) -> Output:
     return FORMATS.register(name, writer, scope, summary)
 
 
-register("gif", animation.write, "orbit", "looping GIF animation of each chosen orbit on the blade")
-register("mp4", animation.write, "orbit", "MP4 animation of each chosen orbit (needs imageio-ffmpeg)")
-register("vtu", vtu.write, "orbit", "ParaView time series (.pvd + .vtu frames) and manifold samples")
-register("png", png.write, "run", "frequency–energy plot of every model")
+def _built_in(module: str):
+    """The ``write`` of the built-in format module ``module``, imported at its first call: the figures' and the
+    animations' libraries are imported only by a run that writes them, not by every module that reads the list
+    of formats (the study's schema)."""
+
+    def write(scene, folder: Path, formats: set[str]) -> dict[str, str]:
+        return importlib.import_module(f".{module}", __name__).write(scene, folder, formats)
+
+    write.__qualname__ = f"{module}.write"
+    return write
+
+
+_animation = _built_in("animation")
+register("gif", _animation, "orbit", "looping GIF animation of each chosen orbit on the blade")
+register("mp4", _animation, "orbit", "MP4 animation of each chosen orbit (needs imageio-ffmpeg)")
+register("vtu", _built_in("vtu"), "orbit", "ParaView time series (.pvd + .vtu frames) and manifold samples")
+register("png", _built_in("png"), "run", "frequency–energy plot of every model")
