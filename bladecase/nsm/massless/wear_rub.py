@@ -33,12 +33,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .coating_flight import CoatingFlight
 from .friction import friction_flight
 from .nodes import NodalFlight, NodalSystem, Profile, Rub, simulate_nodes
 from .wear import Abradable, WearProfile, pass_tip
 from .wear_lobes import LobeCheck, dominant_ratio, lobe_check
 
-__all__ = ["WearRub", "vibration_ratio", "wear_rub"]
+__all__ = ["COUPLINGS", "WearRub", "vibration_ratio", "wear_rub"]
+
+#: How the coating's removal meets the flight: ``"in_flight"``, the coating yields during the flight (each node a
+#: Jenkins element, :mod:`~bladecase.nsm.massless.coating_flight`); ``"staggered"``, elastic within a revolution,
+#: its removal taken at the revolution's end.
+COUPLINGS = ("in_flight", "staggered")
 
 #: Samples per coating cell of each node's path (at least), besides the switches.
 SAMPLES_PER_CELL = 3
@@ -89,12 +95,14 @@ def vibration_ratio(signal, samples_per_turn: int) -> float:
 
 def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, amplitude: float, angles,
              damping=None, revolutions: int = 10, areas=None, friction=None,
-             max_switches: int = 2_000_000, flight: NodalFlight | None = None) -> WearRub:
+             max_switches: int = 2_000_000, flight: NodalFlight | None = None,
+             coupling: str = "staggered") -> WearRub:
     """The coupled rub and wear of ``system`` at ``speed`` (rad/s) in a casing with ``lobes`` lobes of
     ``amplitude`` (m) lined with ``coating``, from rest over ``revolutions`` turns (module docstring). ``areas``:
     each node's tributary area (m²), for the pressure (``system.casing`` should be ``coating.stiffness × areas``);
     ``friction``: a :class:`~bladecase.nsm.massless.friction.Friction`, or ``None``; ``flight``: the flight to fly
-    (its phases reused, e.g. the rub response's: of this system, damping, casing and friction)."""
+    (its phases reused, e.g. the rub response's: of this system, damping, casing and friction; the staggered
+    coupling's only); ``coupling``: one of :data:`COUPLINGS`."""
     if not isinstance(coating, Abradable):
         raise ValueError(f"coating must be an Abradable, got {type(coating).__name__}")
     if isinstance(revolutions, bool) or int(revolutions) != revolutions or revolutions < 1:
@@ -102,9 +110,16 @@ def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, 
     speed = float(speed)
     if not (np.isfinite(speed) and speed > 0):
         raise ValueError(f"speed must be a finite number > 0 (rad/s), got {speed!r}")
+    if coupling not in COUPLINGS:
+        raise ValueError(f"coupling must be one of {COUPLINGS}, got {coupling!r}")
     areas = np.ones(system.m) if areas is None else np.asarray(areas, dtype=float)
     rub = Rub(lobes, amplitude, speed, angles)
-    if flight is not None:
+    if coupling == "in_flight":
+        if friction is not None:
+            raise ValueError("the coating yielding during the flight (coupling 'in_flight') has no friction model "
+                             "yet: fly friction with coupling 'staggered', or drop the friction")
+        fl = CoatingFlight(system, coating.yield_pressure * areas, damping, rub)
+    elif flight is not None:
         fl = flight
     else:
         fl = NodalFlight(system, damping, rub) if friction is None else friction_flight(system, friction, damping, rub)
@@ -117,16 +132,23 @@ def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, 
     x, v = np.zeros(system.n), np.zeros(system.n)
     removed, peak_u, peak_p, count, tip, phases = [], [], [], [], [], 0
     for _ in range(int(revolutions)):
-        tr = simulate_nodes(system, x, v, turn, flight=fl, max_switches=max_switches,
-                            profile=Profile(profile.depth, speed, phi))
+        here = Profile(profile.depth, speed, phi)
+        if coupling == "in_flight":
+            tr = fl.simulate(x, v, turn, profile=here, max_switches=max_switches)
+        else:
+            tr = simulate_nodes(system, x, v, turn, flight=fl, max_switches=max_switches, profile=here)
         if not tr.complete:
             raise ValueError(f"the wear rub at {speed:.6g} rad/s needed more than {max_switches} switches in a "
                              "revolution")
         phases += int(tr.starts.size)
         t = np.unique(np.r_[grid, tr.starts, turn])
-        xs, _, lam = tr.sample(t)
-        y = system.W.T @ xs - system.flexibility @ lam  # the nodes' own normal displacements
-        r = y - fl._base_gap(t)  # incursion beyond the unworn surface
+        if coupling == "in_flight":
+            xs, _, lam, y = tr.sample(t)
+            r = y - fl.gap(t)  # incursion beyond the unworn surface
+        else:
+            xs, _, lam = tr.sample(t)
+            y = system.W.T @ xs - system.flexibility @ lam  # the nodes' own normal displacements
+            r = y - fl._base_gap(t)
         for j in range(system.m):
             profile, _ = pass_tip(profile, phi[j] + speed * t, r[j])
         profile = WearProfile(coating, profile.depth, profile.removed, profile.history + (profile.depth.copy(),),
