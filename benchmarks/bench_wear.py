@@ -77,6 +77,7 @@ def main() -> None:
     print(f"the demo blade in an abradable coating: {c['thickness_m'] * 1e3:g} mm, yield {c['yield_pa'] * 1e-6:g} MPa, "
           f"{c['stiffness_pa_per_m']:g} Pa/m, {c['cells']} cells over a {c['width_m'] * 1e3:.4g} mm band; 8 lobes of "
           f"0.3 mm; {args.revolutions} revolutions a speed; mu = {args.mu:g}")
+    print(f"coupling: {wear['coupling']}")
     crossing = section.get("crossing") or {}
     if crossing:
         print(f"crossing speed of mode 1 with the 8 lobes: {crossing['speed']:.6g} rpm")
@@ -88,6 +89,9 @@ def main() -> None:
               f"{w['lobe_depth_um']:8.3f} um deep (deepest {w['max_depth_um']:.3f} um); removed "
               f"{w['removed_mm3']:.6g} mm3 vs missing {w['missing_mm3']:.6g} mm3 (rel. {w['volume_mismatch']:.1e})"
               + ("; worn through to the casing" if w["worn_through"] else ""))
+        y = wear["coating"]["yield_pa"] * 1e-6
+        print(f"      peak contact pressure over the revolutions {w['peak_pressure_mpa']:.6g} MPa (yield {y:g} MPa; "
+              f"peak / yield - 1 = {w['peak_pressure_mpa'] / y - 1:.1e})")
         print(f"      last {c['window']} revolutions: wear {c['lobes']} lobes"
               + (f" (rival harmonic {c['rival']})" if c["rival"] else "")
               + f"; response f_vib/f_rot = {c['ratio']:.3f} -> round {c['expected']}"

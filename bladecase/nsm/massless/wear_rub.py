@@ -4,14 +4,23 @@ The blade (a :class:`~bladecase.nsm.massless.nodes.NodalSystem`, one massless co
 inside an out-of-round casing (:class:`~bladecase.nsm.massless.nodes.Rub`) lined with an abradable coating
 (:class:`~bladecase.nsm.massless.wear.Abradable`). Each revolution is flown exactly with the worn profile left by
 the revolutions before as a clearance profile round the casing (:class:`~bladecase.nsm.massless.nodes.Profile`:
-its steps cut the flights); the coating's elastic layer is the casing's compliance at each node (its stiffness per
-area × the node's tributary area: the ``casing`` of the system), so a node in contact presses the coating with
-``p = λ_j / A_j``. After the revolution each node's path is passed over the coating
-(:func:`~bladecase.nsm.massless.wear.pass_tip`): its radial incursion beyond the unworn surface
-``r_j(t) = y_j(t) − g_j(t)`` (``y_j`` the node's normal displacement, ``g_j`` the out-of-round clearance without
-wear) at the casing angle ``θ = Ωt + φ_j``, sampled on a grid finer than the cells and at every switch; the coating
-is removed where the pressure went beyond its yield. The worn profile is the clearance of the next revolution
-(a staggered coupling: within a revolution the coating is elastic, its removal is taken at the revolution's end).
+its steps cut the flights). The coating is an elastic–perfectly plastic layer at each node: a spring (its stiffness
+per area × the node's tributary area: the ``casing`` of the system) in series with a plastic slider (its yield
+pressure × that area), so a node in contact presses the coating with ``p = λ_j / A_j``. Two couplings
+(:data:`COUPLINGS`):
+
+- ``"in_flight"`` (the default without friction): the coating yields during the flight, each node a Jenkins element
+  open, elastic or plastic (:mod:`~bladecase.nsm.massless.coating_flight`): the pressure never exceeds the yield and
+  a plastic node removes the coating as it goes, following its own receding surface;
+- ``"staggered"`` (the one with friction): within a revolution the coating is elastic, its removal taken at the
+  revolution's end.
+
+After the revolution each node's path is passed over the coating (:func:`~bladecase.nsm.massless.wear.pass_tip`):
+its radial incursion beyond the unworn surface ``r_j(t) = y_j(t) − g_j(t)`` (``y_j`` the node's normal displacement,
+``g_j`` the out-of-round clearance without wear) at the casing angle ``θ = Ωt + φ_j``, sampled on a grid finer than
+the cells and at every switch, writes into the cells the depth ``r_j − p_y/k`` it reached (in flight: the depth the
+node removed; staggered: the coating is removed where the pressure went beyond its yield). The worn profile is the
+clearance of the next revolution.
 
 >>> from bladecase.nsm import Damping
 >>> from bladecase.nsm.massless.nodes import NodalSystem
@@ -60,8 +69,9 @@ class WearRub:
     the coating (Pa) and the lobes of the profile; the dominant frequency of the last (up to 4) revolutions' mean
     tip normal displacement over the rotation frequency (:func:`vibration_ratio`); the phases flown (switches and
     profile steps); that mean tip displacement over each revolution (``tip``: ``(revolutions,
-    samples_per_turn)``, m) and the held-out check of the lobes worn over the last revolutions against the
-    vibration's frequency over the same ones (``check``: :func:`~bladecase.nsm.massless.wear_lobes.lobe_check`)."""
+    samples_per_turn)``, m), the held-out check of the lobes worn over the last revolutions against the
+    vibration's frequency over the same ones (``check``: :func:`~bladecase.nsm.massless.wear_lobes.lobe_check`) and
+    the coupling flown (:data:`COUPLINGS`)."""
 
     profile: WearProfile
     removed: np.ndarray
@@ -73,6 +83,7 @@ class WearRub:
     tip: np.ndarray | None = None
     samples_per_turn: int = 0
     check: LobeCheck | None = None
+    coupling: str = "staggered"
 
     @property
     def depths(self) -> np.ndarray:
@@ -96,13 +107,14 @@ def vibration_ratio(signal, samples_per_turn: int) -> float:
 def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, amplitude: float, angles,
              damping=None, revolutions: int = 10, areas=None, friction=None,
              max_switches: int = 2_000_000, flight: NodalFlight | None = None,
-             coupling: str = "staggered") -> WearRub:
+             coupling: str | None = None) -> WearRub:
     """The coupled rub and wear of ``system`` at ``speed`` (rad/s) in a casing with ``lobes`` lobes of
     ``amplitude`` (m) lined with ``coating``, from rest over ``revolutions`` turns (module docstring). ``areas``:
     each node's tributary area (m²), for the pressure (``system.casing`` should be ``coating.stiffness × areas``);
     ``friction``: a :class:`~bladecase.nsm.massless.friction.Friction`, or ``None``; ``flight``: the flight to fly
     (its phases reused, e.g. the rub response's: of this system, damping, casing and friction; the staggered
-    coupling's only); ``coupling``: one of :data:`COUPLINGS`."""
+    coupling's only); ``coupling``: one of :data:`COUPLINGS` (default ``"in_flight"``, ``"staggered"`` with friction:
+    the in-flight yield has no friction model yet)."""
     if not isinstance(coating, Abradable):
         raise ValueError(f"coating must be an Abradable, got {type(coating).__name__}")
     if isinstance(revolutions, bool) or int(revolutions) != revolutions or revolutions < 1:
@@ -110,6 +122,8 @@ def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, 
     speed = float(speed)
     if not (np.isfinite(speed) and speed > 0):
         raise ValueError(f"speed must be a finite number > 0 (rad/s), got {speed!r}")
+    if coupling is None:
+        coupling = "in_flight" if friction is None else "staggered"
     if coupling not in COUPLINGS:
         raise ValueError(f"coupling must be one of {COUPLINGS}, got {coupling!r}")
     areas = np.ones(system.m) if areas is None else np.asarray(areas, dtype=float)
@@ -163,4 +177,4 @@ def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, 
     ratio = vibration_ratio(tip[-TAIL:].ravel(), per_turn)
     check = lobe_check(np.array(profile.history), tip, per_turn, window=TAIL)
     return WearRub(profile, np.array(removed), np.array(peak_u), np.array(peak_p), np.array(count), ratio, phases,
-                   tip, per_turn, check)
+                   tip, per_turn, check, coupling)
