@@ -13,7 +13,7 @@ import pytest
 from bladecase.nsm import Damping
 from bladecase.nsm.massless.coating_flight import PLASTIC, CoatingFlight, simulate_coating
 from bladecase.nsm.massless.friction import Friction
-from bladecase.nsm.massless.nodes import NodalSystem, Rub, simulate_nodes
+from bladecase.nsm.massless.nodes import NodalSystem, Profile, Rub, simulate_nodes
 from bladecase.nsm.massless.wear import Abradable
 from bladecase.nsm.massless.wear_rub import wear_rub
 
@@ -103,6 +103,39 @@ def test_against_fixed_step_integrator():
     assert errs[1][0] < 0.7 * errs[0][0]  # it converges to the exact flight
 
 
+def test_worn_profile_against_fixed_step_integrator():
+    """A worn profile of 12 cells seen by two nodes over a revolution in a three-lobe casing: nodes yield, spring
+    back and, entering a cell less worn than their surface, are pressed beyond their yield and remove the excess at
+    once. Against velocity Verlet with the same law (each node on its cell's depth as it enters it, or on its own
+    surface while yielding): final state and removed depths to the integrator's first order at the steps."""
+    s, speed, phi = _two(), 2.0, np.array([0.0, 0.3])
+    rub = Rub(3, 0.5, speed, phi)
+    depth = np.array([0.026, 0.071, 0.24, 0.175, 0.028, 0.13, 0.144, 0.048, 0.22, 0.034, 0.117, 0.155])
+    turn, x0, v0 = 2 * np.pi / speed, np.zeros(2), np.array([2.0, 1.5])
+    tr = simulate_coating(s, YIELD, x0, v0, turn, rub=rub, profile=Profile(depth, speed, phi))
+    assert (tr.jumps > 0.1).any() and (tr.codes == PLASTIC).any(axis=0).all()
+    h, dt = 2 * np.pi / depth.size, 2e-3
+
+    def accel(x, t, w, cell, plastic):
+        c = np.floor((speed * t + phi) / h).astype(int)
+        enter = depth[c % depth.size]
+        w = np.where(c != cell, np.where(plastic, np.maximum(w, enter), enter), w)
+        g = s.gap + (rub.D * np.exp(1j * rub.nu * t)).real
+        lam, dw = _jenkins_forces(s, s.W.T @ x - g - w, YIELD)
+        return np.linalg.solve(s.M, -s.S @ x - s.W @ lam), w + dw, c, dw > 0, dw
+
+    x, v = x0.copy(), v0.copy()
+    a, w, cell, plastic, removed = accel(x, 0.0, np.full(2, depth[0]), np.zeros(2, int), np.zeros(2, bool))
+    for k in range(int(round(turn / dt))):
+        v = v + 0.5 * dt * a
+        x = x + dt * v
+        a, w, cell, plastic, dw = accel(x, (k + 1) * dt, w, cell, plastic)
+        removed = removed + dw
+        v = v + 0.5 * dt * a
+    assert np.abs(x - tr.x_end).max() < 3e-3 * np.abs(tr.x_end).max()
+    assert np.abs(removed - tr.removed()).max() < 3e-3 * tr.removed().max()
+
+
 def test_energy_balance():
     """No damping, a round casing: the energy plus the plastic work λ_y × removed depth of each node is conserved."""
     s = _two()
@@ -163,6 +196,8 @@ def test_bad_input():
     c = Abradable(thickness=1.0, yield_pressure=0.4, stiffness=4.0, cells=60, radius=30.0, width=1.0)
     with pytest.raises(ValueError, match="coupling must be one of"):
         wear_rub(s, c, 0.4, 3, 1.2, [0.0, 0.3], coupling="later")
+    with pytest.raises(ValueError, match=r"coating's stiffness × the node's area, \[4.0, 8.0\] N/m, got \[4.0, 4.0\]"):
+        wear_rub(s, c, 0.4, 3, 1.2, [0.0, 0.3], areas=[1.0, 2.0])
     f = Friction(0.1, T=np.eye(2), C_tt=0.1 * np.eye(2))
     with pytest.raises(ValueError, match="no friction model yet"):
         wear_rub(s, c, 0.4, 3, 1.2, [0.0, 0.3], friction=f, coupling="in_flight")

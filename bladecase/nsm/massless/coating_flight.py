@@ -329,12 +329,15 @@ class CoatingFlight:
             w = w + profile.depth[self._cells(profile, 0.0) % profile.depth.size]
         q, p = self.encode(x, v)
         t = 0.0
+        before = w
         codes, w = self.decide(q, p, t, w)
-        starts, cl, wl, qs, ps, amps = [], [], [], [], [], []
+        starts, cl, wl, qs, ps, amps, jumps = [], [], [], [], [], [], []
         while len(starts) <= max_switches:
             ph = self.phase(codes, w)
             a = ph.amplitudes(q, p, t)
             starts.append(t), cl.append(codes), wl.append(w), qs.append(q), ps.append(p), amps.append(a)
+            jumps.append(np.zeros(s.m) if before is None else self._jump(ph, q, t, codes, w, before))
+            before = None  # a switch in flight removes nothing at once; a flight cut short neither
             edges = self._edges(profile, t, codes, w) if profile is not None else np.full(s.m, np.inf)
             stop = min(float(edges.min()), t_end)
             hit, span = self._fly(ph, a, t, stop - t)
@@ -346,14 +349,14 @@ class CoatingFlight:
                 t = stop
                 if t >= t_end:
                     break
-                codes, w = self._step(ph, codes, w, q, p, t, profile, edges <= t)
+                codes, w, before = self._step(ph, codes, w, q, p, t, profile, edges <= t)
                 continue
             tau, k = hit
             q, p = ph.advance(a, t, tau)
             t += tau
             codes, w = self.settle(codes, w, q, p, t, first=k, ph=ph)
         return CoatingTrajectory(self, np.array(starts), np.array(cl), np.array(wl), np.array(qs).T,
-                                 np.array(ps).T, np.array(amps), t, bool(t >= t_end))
+                                 np.array(ps).T, np.array(amps), t, bool(t >= t_end), np.array(jumps))
 
     @staticmethod
     def _cells(profile: Profile, t: float) -> np.ndarray:
@@ -371,25 +374,32 @@ class CoatingFlight:
         k = np.where(differ.any(axis=1), np.argmax(differ, axis=1), n)  # n: none in a turn, the turn's edge
         return ((c0 + 1 + k) * profile.step - np.asarray(profile.angles)) / profile.speed
 
+    def _jump(self, ph: CoatingPhase, q, t: float, codes, w, before) -> np.ndarray:
+        """The depth each node removed at once at ``t`` (a step of the profile, the start): its decided surface (its
+        own receding one if plastic) beyond the surface it had (``before``)."""
+        after = np.where(codes == PLASTIC, self.plastic_surface(ph, q, t), w)
+        return np.maximum(after - before, 0.0)
+
     def _step(self, ph: CoatingPhase, codes, w, q, p, t: float, profile: Profile, crossing: np.ndarray):
         """The codes and surfaces after the nodes ``crossing`` entered a new cell of the profile at ``t``: an open or
-        elastic node on the new cell's depth, a plastic one on its own surface while it is the deeper."""
+        elastic node on the new cell's depth, a plastic one on its own surface while it is the deeper (a node
+        pressed beyond its yield removes the excess at once), and the surfaces the nodes had before deciding."""
         depth = profile.depth[self._cells(profile, t) % profile.depth.size]
         plastic = codes == PLASTIC
         own = self.plastic_surface(ph, q, t)
         new = np.where(crossing, np.where(plastic, np.maximum(own, depth), depth), np.where(plastic, own, w))
         if np.any(crossing & plastic & (depth > own)):
-            return self.decide(q, p, t, new)
+            return (*self.decide(q, p, t, new), new)
         try:
-            return self.settle(codes, np.where(plastic, w, new), q, p, t)
+            return (*self.settle(codes, np.where(plastic, w, new), q, p, t), new)
         except ValueError:
-            return self.decide(q, p, t, new)
+            return (*self.decide(q, p, t, new), new)
 
 
 @dataclass(frozen=True, eq=False)
 class CoatingTrajectory:
     """Result of :func:`simulate_coating`: the start of every phase (time, node codes, surfaces, modal state,
-    amplitudes)."""
+    amplitudes, and the depth each node removed at once there: ``jumps``, ``(phases, m)``)."""
 
     flight: CoatingFlight
     starts: np.ndarray
@@ -400,6 +410,7 @@ class CoatingTrajectory:
     amplitudes: np.ndarray
     t_end: float
     complete: bool
+    jumps: np.ndarray = None  # type: ignore[assignment]
 
     @property
     def switch_times(self) -> np.ndarray:
@@ -422,9 +433,10 @@ class CoatingTrajectory:
         return fl.phi @ Q, fl.phi @ P, lam, y
 
     def removed(self) -> np.ndarray:
-        """Each node's depth removed over the flight (m): the sum of its plastic phases' recession."""
+        """Each node's depth removed over the flight (m): the sum of its plastic phases' recession and of what it
+        removed at once (pressed beyond its yield where the profile steps)."""
         fl = self.flight
-        out = np.zeros(fl.m)
+        out = self.jumps.sum(axis=0) if self.jumps is not None else np.zeros(fl.m)
         ends = np.r_[self.starts[1:], self.t_end]
         for i in np.flatnonzero((self.codes == PLASTIC).any(axis=1)):
             ph = fl.phase(self.codes[i], self.surfaces[i])

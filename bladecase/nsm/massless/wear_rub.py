@@ -132,6 +132,11 @@ def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, 
         if friction is not None:
             raise ValueError("the coating yielding during the flight (coupling 'in_flight') has no friction model "
                              "yet: fly friction with coupling 'staggered', or drop the friction")
+        want = coating.stiffness * areas
+        if not np.allclose(system.casing, want, rtol=1e-6, atol=0.0):
+            raise ValueError(f"the coating yielding in flight needs the system's casing stiffness at each node to be "
+                             f"the coating's stiffness × the node's area, {want.tolist()} N/m, got "
+                             f"{system.casing.tolist()}")
         fl = CoatingFlight(system, coating.yield_pressure * areas, damping, rub)
     elif flight is not None:
         fl = flight
