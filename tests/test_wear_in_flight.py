@@ -12,7 +12,7 @@ import pytest
 
 from bladecase.nsm import Damping
 from bladecase.nsm.massless.coating_flight import PLASTIC, CoatingFlight, simulate_coating
-from bladecase.nsm.massless.friction import Friction
+from bladecase.nsm.massless.friction import Friction, simulate_friction
 from bladecase.nsm.massless.nodes import NodalSystem, Profile, Rub, simulate_nodes
 from bladecase.nsm.massless.wear import Abradable
 from bladecase.nsm.massless.wear_rub import wear_rub
@@ -50,10 +50,10 @@ def test_one_node_closed_form():
     assert abs(tr.surfaces[-2, 0] - removed) < 1e-10 * removed
 
 
-def _jenkins_forces(s: NodalSystem, b: np.ndarray, ly: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _jenkins_forces(s: NodalSystem, b: np.ndarray, ly: np.ndarray, H=None) -> tuple[np.ndarray, np.ndarray]:
     """The Jenkins law's forces and the excess removed, by enumerating every node's state (open, elastic, plastic)
-    and keeping the one that satisfies its conditions."""
-    H, m = s.H, b.size
+    and keeping the one that satisfies its conditions (``H``: the flexibility the forces see, ``s.H`` by default)."""
+    H, m = (s.H if H is None else H), b.size
     for codes in itertools.product((0, 1, 2), repeat=m):
         c = np.array(codes)
         A, P = np.flatnonzero(c == 1), np.flatnonzero(c == 2)
@@ -68,14 +68,17 @@ def _jenkins_forces(s: NodalSystem, b: np.ndarray, ly: np.ndarray) -> tuple[np.n
     raise AssertionError("no state satisfies the Jenkins law")
 
 
-def _verlet(s: NodalSystem, ly, x, v, t_end: float, dt: float):
-    """Velocity Verlet with the Jenkins law's return mapping at every force evaluation."""
+def _verlet(s: NodalSystem, ly, x, v, t_end: float, dt: float, friction: Friction | None = None):
+    """Velocity Verlet with the Jenkins law's return mapping at every force evaluation; with the rotation model's
+    ``friction``, the interior driven by ``W − μT`` and the forces seeing ``H − μC_nt``."""
     Minv = np.linalg.inv(s.M)
     w = np.zeros(s.m)
+    drive = s.W if friction is None else s.W - friction.mu * friction.T
+    H = s.H if friction is None else friction.H(s)
 
     def accel(x, w):
-        lam, dw = _jenkins_forces(s, s.W.T @ x - s.gap - w, ly)
-        return Minv @ (-s.S @ x - s.W @ lam), w + dw
+        lam, dw = _jenkins_forces(s, s.W.T @ x - s.gap - w, ly, H)
+        return Minv @ (-s.S @ x - drive @ lam), w + dw
 
     a, w = accel(x, w)
     for _ in range(int(round(t_end / dt))):
@@ -101,6 +104,31 @@ def test_against_fixed_step_integrator():
                      / tr.removed().max()))
     assert errs[1][0] < 2e-5 and errs[1][1] < 2e-5
     assert errs[1][0] < 0.7 * errs[0][0]  # it converges to the exact flight
+
+
+FRICTION = Friction(0.15, T=np.array([[0.3, 0.0], [0.1, 0.5]]), C_nt=np.array([[0.004, 0.001], [0.0, 0.003]]),
+                    C_tt=0.01 * np.eye(2))
+
+
+def test_friction_against_fixed_step_integrator_and_without_yield():
+    """With friction (the rotation model): against velocity Verlet with the same law (to 2e-5); with a yield never
+    reached, the flight of the elastic casing with friction (``simulate_friction``) to 1e-12."""
+    s, T = _two(), 2.5
+    x0, v0 = np.zeros(2), np.array([3.0, 2.0])
+    tr = simulate_coating(s, YIELD, x0, v0, T, friction=FRICTION)
+    assert (tr.codes == PLASTIC).any(axis=0).all()
+    x, _, w = _verlet(s, YIELD, x0, v0, T, 1e-3, FRICTION)
+    assert np.abs(x - tr.x_end).max() < 2e-5 * np.abs(tr.x_end).max()
+    assert np.abs(w - tr.removed()).max() < 2e-5 * tr.removed().max()
+    rub, d = Rub(3, 0.7, 0.7, [0.0, 0.4]), Damping(zeta=0.01)
+    x0 = np.array([0.5, 0.0])
+    ref = simulate_friction(s, FRICTION, x0, v0, 20.0, damping=d, rub=rub)
+    tr = simulate_coating(s, [1e9, 1e9], x0, v0, 20.0, damping=d, rub=rub, friction=FRICTION)
+    assert ref.switch_times.size > 8 and np.allclose(tr.switch_times, ref.switch_times, rtol=0, atol=1e-12)
+    t = np.linspace(0.0, 20.0, 101)
+    xr, _, lr = ref.sample(t)
+    x, _, lam, _ = tr.sample(t)
+    assert np.abs(x - xr).max() < 1e-12 * np.abs(xr).max() and np.abs(lam - lr).max() < 1e-12 * np.abs(lr).max()
 
 
 def test_worn_profile_against_fixed_step_integrator():
@@ -179,6 +207,10 @@ def test_wear_rub_in_flight():
     assert w.peak_pressure.max() <= c.yield_pressure * (1 + 1e-12)
     assert w.profile.removed > 0 and abs(w.profile.removed / w.profile.missing_volume - 1) < 1e-6
     assert w.profile.lobes() == 3
+    f = Friction(0.1, T=np.array([[0.3, 0.0], [0.1, 0.5]]), C_nt=0.01 * np.eye(2), C_tt=0.1 * np.eye(2))
+    wf = wear_rub(*args, revolutions=3, areas=[1.0, 1.0], friction=f)  # the default: in flight, with friction
+    assert wf.coupling == "in_flight" and wf.peak_pressure.max() <= c.yield_pressure * (1 + 1e-12)
+    assert abs(wf.profile.removed / wf.profile.missing_volume - 1) < 1e-6 and wf.profile.removed != w.profile.removed
     stag = wear_rub(*args, revolutions=4, areas=[1.0, 1.0], coupling="staggered")
     assert stag.peak_pressure.max() > 1.2 * c.yield_pressure  # the elastic revolution overshoots the yield
     hard = Abradable(thickness=1.0, yield_pressure=1e9, stiffness=4.0, cells=60, radius=30.0, width=1.0)
@@ -198,6 +230,6 @@ def test_bad_input():
         wear_rub(s, c, 0.4, 3, 1.2, [0.0, 0.3], coupling="later")
     with pytest.raises(ValueError, match=r"coating's stiffness × the node's area, \[4.0, 8.0\] N/m, got \[4.0, 4.0\]"):
         wear_rub(s, c, 0.4, 3, 1.2, [0.0, 0.3], areas=[1.0, 2.0])
-    f = Friction(0.1, T=np.eye(2), C_tt=0.1 * np.eye(2))
-    with pytest.raises(ValueError, match="no friction model yet"):
+    f = Friction(0.1, T=np.eye(2), C_tt=0.1 * np.eye(2), model="coulomb")
+    with pytest.raises(ValueError, match="flies the friction model 'rotation', got 'coulomb'"):
         wear_rub(s, c, 0.4, 3, 1.2, [0.0, 0.3], friction=f, coupling="in_flight")

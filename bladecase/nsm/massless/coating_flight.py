@@ -26,6 +26,11 @@ first short flight, checked at sixteen points, as the stick–slip model's (``fr
 **Energy.** ``x``, ``x'`` and ``λ`` are continuous at every switch; with a constant clearance and no damping the
 energy ``½x'ᵀMx' + ½xᵀSx + ½λᵀHλ`` plus the work of the plastic flow ``Σ_j λ_y,j (w_j − w_j(0))`` is conserved.
 
+**Friction** (:class:`~bladecase.nsm.massless.friction.Friction`, the rotation model): each node in contact is
+dragged by ``μλ_j`` along the casing's motion, so the interior is driven by ``W − μT`` and the forces see
+``H_μ = H − μC_nt`` (a plastic node: ``μλ_y,j``, constant too). The phases are then not symmetric: flown from their
+first-order eigenvectors, a growing one refused; the box problem of a decision is solved by Lemke's method.
+
 **A worn casing** (:class:`~bladecase.nsm.massless.nodes.Profile`): the surface of an open or elastic node is the
 profile's depth at its angle, stepping at the cells' edges; a plastic node keeps its own receding surface while it
 is deeper than the cell's. At a step the nodes are decided again: the forces solve the box-constrained problem
@@ -53,6 +58,7 @@ import numpy as np
 import scipy.linalg as sla
 from scipy.optimize import lsq_linear
 
+from .friction import lemke
 from .nodal_switches import _Signals, first_switch
 from .nodes import MAX_SWITCHES, NodalSystem, Profile, Rub, casing_gap
 from .nodes_phase import _Phase
@@ -72,6 +78,9 @@ FLAT_RTOL = 1e-7
 #: Relative size (of a cell's angle) within which a node counts as on a cell's edge.
 EDGE_RTOL = 1e-9
 
+#: Relative size of a phase eigenvalue's positive real part above which a phase with friction is refused.
+FLUTTER_RTOL = 1e-9
+
 #: Points at which a flat start is checked positive over its first flight.
 LEAVE_POINTS = 16
 
@@ -81,44 +90,55 @@ class CoatingPhase(_Phase):
     ``w`` enter its constants only (:meth:`at_surface`)."""
 
     def __init__(self, fl: CoatingFlight, codes: np.ndarray):
-        s, m, n = fl.system, fl.system.m, fl.n
+        m, n = fl.system.m, fl.n
         self.codes = codes
         self._fl = fl
         ia, ip = np.flatnonzero(codes == ELASTIC), np.flatnonzero(codes == PLASTIC)
         self.A, self.idx = codes == ELASTIC, ia
-        H, Hs, Wq = s.H, s.flexibility, fl.Wq
+        H, Hs, Wq, Wf = fl.Hc, fl.Hy, fl.Wq, fl.Wf
+        sym = fl.friction is None
         Lq_lam, Lg_lam, lam_c = np.zeros((m, n)), np.zeros((m, m)), np.zeros(m)
         lam_c[ip] = fl.yield_force[ip]
         if ia.size:
             try:
-                chol = sla.cho_factor(H[np.ix_(ia, ia)], lower=True, check_finite=False)
+                if sym:
+                    chol = sla.cho_factor(H[np.ix_(ia, ia)], lower=True, check_finite=False)
+                    G = sla.cho_solve(chol, np.eye(ia.size), check_finite=False)
+                    G = 0.5 * (G + G.T)
+                else:
+                    G = np.linalg.inv(H[np.ix_(ia, ia)])
             except np.linalg.LinAlgError:
                 raise ValueError("the elastic contacts' flexibility is not positive definite") from None
-            G = sla.cho_solve(chol, np.eye(ia.size), check_finite=False)
-            G = 0.5 * (G + G.T)
             Lq_lam[ia] = G @ Wq[:, ia].T
             Lg_lam[np.ix_(ia, ia)] = -G
             lam_c[ia] = -G @ (H[np.ix_(ia, ip)] @ fl.yield_force[ip])
             self.G = G
-        # λ = Λq q + Λg (g(t) + w) + λc; the interior: q'' + C q' + Ω² q = −Wq λ
+        # λ = Λq q + Λg (g(t) + w) + λc; the interior: q'' + C q' + Ω² q = −W_f λ (W_f = W − μT with friction)
         self.Lq_lam, self.Lg_lam, self.lam_c = Lq_lam, Lg_lam, lam_c
-        K = np.diag(fl.omega**2) + Wq @ Lq_lam
-        K = 0.5 * (K + K.T)
+        K = np.diag(fl.omega**2) + Wf @ Lq_lam
+        if sym:
+            K = 0.5 * (K + K.T)
+            Kf = sla.cho_factor(K, check_finite=False)
+            self.eq_w = sla.cho_solve(Kf, -Wf @ Lg_lam, check_finite=False)  # q_eq per unit of g + w
+            self.eq_c = sla.cho_solve(Kf, -Wf @ lam_c, check_finite=False)
+        else:
+            self.eq_w, self.eq_c = np.linalg.solve(K, -Wf @ Lg_lam), np.linalg.solve(K, -Wf @ lam_c)
         self.K = K
-        self._Kf = sla.cho_factor(K, check_finite=False)
-        self.eq_w = sla.cho_solve(self._Kf, -Wq @ Lg_lam, check_finite=False)  # q_eq per unit of g + w
-        self.eq_c = sla.cho_solve(self._Kf, -Wq @ lam_c, check_finite=False)
         self.nu = fl.nu
         self.X = np.zeros(n, complex)
         Dv = fl.D if fl.D is not None else np.zeros(m, complex)
         if fl.nu > 0 and fl.D is not None and ia.size:
             Z = K - fl.nu**2 * np.eye(n) + (1j * fl.nu * fl.Cq if fl.Cq is not None else 0)
             try:
-                self.X = np.linalg.solve(Z, -Wq @ (Lg_lam @ fl.D))
+                self.X = np.linalg.solve(Z, -Wf @ (Lg_lam @ fl.D))
             except np.linalg.LinAlgError:
                 raise ValueError(f"the casing's excitation at {fl.nu / 2 / np.pi:.6g} Hz is at an undamped resonance "
                                  "of a contact phase: add damping or change the speed") from None
-        self._modes(K, fl.Cq, n)
+        if sym:
+            self._modes(K, fl.Cq, n)
+        else:
+            self._grows(K, fl, codes)
+            self._modes(K, fl.Cq if fl.Cq is not None else np.zeros((n, n)), n)
         # the switching signals Lq q + Lp q' + Lg (g + w) + Ld g' + c, one or two a node: (node, kind)
         rows, meta = [], []
         zn, zm = np.zeros(n), np.zeros(m)
@@ -145,6 +165,19 @@ class CoatingPhase(_Phase):
         self.lam2 = np.abs(self.lam) ** 2
         self.w = None
 
+    @staticmethod
+    def _grows(K: np.ndarray, fl: CoatingFlight, codes: np.ndarray) -> None:
+        """Refuse a phase with friction that grows (its stiffness not symmetric): the search needs decaying terms."""
+        n = K.shape[0]
+        C = fl.Cq if fl.Cq is not None else np.zeros((n, n))
+        lam = np.linalg.eigvals(np.block([[np.zeros((n, n)), np.eye(n)], [-K, -C]]))
+        if lam.real.max() > FLUTTER_RTOL * np.abs(lam).max():
+            nodes = fl.system.nodes
+            raise ValueError(f"a contact phase with friction (nodes {[nodes[k] for k in np.flatnonzero(codes == 1)]}"
+                             f" elastic, {[nodes[k] for k in np.flatnonzero(codes == 2)]} yielding, mu = "
+                             f"{fl.friction.mu:g}) is unstable: it grows at {lam.real.max():.3g} 1/s; the exact "
+                             "flight needs decaying phases: add damping or lower mu")
+
     def at_surface(self, w: np.ndarray) -> CoatingPhase:
         """The phase with the nodes' surfaces ``w`` (m): its equilibrium and its signals' constants."""
         out = copy.copy(self)
@@ -166,9 +199,16 @@ class CoatingFlight:
     coating (module docstring): ``yield_force`` ``λ_y,j`` (N, one a node, each > 0), ``damping`` of the open-phase
     modes, an out-of-round casing (:class:`~bladecase.nsm.massless.nodes.Rub`)."""
 
-    def __init__(self, system: NodalSystem, yield_force, damping=None, rub: Rub | None = None):
+    def __init__(self, system: NodalSystem, yield_force, damping=None, rub: Rub | None = None, friction=None):
         if not isinstance(system, NodalSystem):
             raise ValueError(f"system must be a NodalSystem, got {type(system).__name__}")
+        if friction is not None:
+            friction.check(system)
+            if friction.model != "rotation":
+                raise ValueError(f"the coating yielding in flight flies the friction model 'rotation', got "
+                                 f"{friction.model!r}")
+            if friction.mu == 0:
+                friction = None
         ly = np.broadcast_to(np.asarray(yield_force, dtype=float), (system.m,)).copy()
         if not np.all(np.isfinite(ly) & (ly > 0)):
             raise ValueError(f"yield_force must be finite and > 0 at every contact node (N), got {ly.tolist()}")
@@ -176,6 +216,12 @@ class CoatingFlight:
         self.omega, self.phi = system.modes
         self.n, self.m = system.n, system.m
         self.Wq = self.phi.T @ system.W
+        self.friction = friction
+        # with friction (module docstring): the interior is driven by W − μT, the constraints see H − μC_nt
+        mu = 0.0 if friction is None else friction.mu
+        C_nt = np.zeros((self.m, self.m)) if friction is None else friction.C_nt
+        self.Wf = self.Wq if friction is None else self.Wq - mu * (self.phi.T @ friction.T)
+        self.Hc, self.Hy = system.H - mu * C_nt, system.flexibility - mu * C_nt
         if damping is not None and (damping.alpha or damping.beta or np.any(np.asarray(damping.zeta or 0) > 0)):
             self.Cq = np.diag(2 * damping.rates(self.omega))
         else:
@@ -207,7 +253,7 @@ class CoatingFlight:
         t = np.atleast_1d(np.asarray(t, dtype=float))
         Q = Q.reshape(self.n, -1)
         lam = ph.forces(Q, t)
-        return self.Wq.T @ Q - self.system.flexibility @ lam, lam
+        return self.Wq.T @ Q - self.Hy @ lam, lam
 
     def plastic_surface(self, ph: CoatingPhase, q: np.ndarray, t: float) -> np.ndarray:
         """Each node's surface if it were plastic now: ``y − g − λ_y/k`` (m)."""
@@ -267,13 +313,18 @@ class CoatingFlight:
         """The codes and surfaces of a state against the surfaces ``w``: the forces from the box-constrained problem
         ``0 ≤ λ ≤ λ_y`` (min ``½λᵀHλ − λᵀ(Wᵀx − g − w)``), a node pressed beyond its yield having its excess
         removed at once, then settled at the rate level (:meth:`settle`)."""
-        s = self.system
         b = self.Wq.T @ q - self.gap(t) - w
-        L = np.linalg.cholesky(s.H)
-        res = lsq_linear(L.T, sla.solve_triangular(L, b, lower=True), bounds=(0.0, self.yield_force),
-                         method="bvls", tol=1e-14)
-        lam = np.clip(res.x, 0.0, self.yield_force)
-        slack = -b + s.H @ lam
+        H = self.Hc
+        if self.friction is None:
+            L = np.linalg.cholesky(H)
+            res = lsq_linear(L.T, sla.solve_triangular(L, b, lower=True), bounds=(0.0, self.yield_force),
+                             method="bvls", tol=1e-14)
+            lam = np.clip(res.x, 0.0, self.yield_force)
+        else:  # H_μ is not symmetric: the box as a complementarity problem in (λ, excess) solved by Lemke's method
+            m = self.m
+            M = np.block([[H, np.eye(m)], [-np.eye(m), np.zeros((m, m))]])
+            lam = np.clip(lemke(np.r_[-b, self.yield_force], M)[:m], 0.0, self.yield_force)
+        slack = -b + H @ lam
         tol = 1e-9 * self.yield_force
         codes = np.where(lam <= tol, OPEN, np.where(lam >= self.yield_force - tol, PLASTIC, ELASTIC)).astype(np.int8)
         w = w.copy()
@@ -455,16 +506,19 @@ class CoatingTrajectory:
 
 
 def simulate_coating(system: NodalSystem, yield_force, x0, v0, t_end: float, damping=None, rub: Rub | None = None,
-                     w0=None, profile: Profile | None = None, max_switches: int = MAX_SWITCHES) -> CoatingTrajectory:
+                     w0=None, profile: Profile | None = None, max_switches: int = MAX_SWITCHES,
+                     friction=None) -> CoatingTrajectory:
     """Exact event-driven simulation of ``system`` pressing a coating that yields at the node forces
     ``yield_force`` (N; module docstring) from ``(x0, v0)`` at ``t = 0``: ``w0`` the nodes' surfaces at the start
     (m, default 0), ``profile`` a worn casing's depths round it (added to them), ``damping`` and ``rub`` as
-    :func:`~bladecase.nsm.massless.nodes.simulate_nodes`'. A run that hits ``max_switches`` stops with
-    ``complete = False``.
+    :func:`~bladecase.nsm.massless.nodes.simulate_nodes`', ``friction`` a
+    :class:`~bladecase.nsm.massless.friction.Friction` of the rotation model (module docstring). A run that hits
+    ``max_switches`` stops with ``complete = False``.
 
     >>> s = NodalSystem(np.eye(1), np.eye(1), np.eye(1), [[0.0]], gap=[1.0], casing=[100.0])
     >>> tr = simulate_coating(s, [1e9], [0.0], [10.0], 3.0)    # a yield never reached: the elastic flight
     >>> bool(tr.complete), float(tr.removed()[0])
     (True, 0.0)
     """
-    return CoatingFlight(system, yield_force, damping, rub).simulate(x0, v0, t_end, w0, profile, max_switches)
+    return CoatingFlight(system, yield_force, damping, rub, friction).simulate(x0, v0, t_end, w0, profile,
+                                                                               max_switches)

@@ -9,10 +9,10 @@ per area × the node's tributary area: the ``casing`` of the system) in series w
 pressure × that area), so a node in contact presses the coating with ``p = λ_j / A_j``. Two couplings
 (:data:`COUPLINGS`):
 
-- ``"in_flight"`` (the default without friction): the coating yields during the flight, each node a Jenkins element
+- ``"in_flight"`` (the default): the coating yields during the flight, each node a Jenkins element
   open, elastic or plastic (:mod:`~bladecase.nsm.massless.coating_flight`): the pressure never exceeds the yield and
   a plastic node removes the coating as it goes, following its own receding surface;
-- ``"staggered"`` (the one with friction): within a revolution the coating is elastic, its removal taken at the
+- ``"staggered"``: within a revolution the coating is elastic, its removal taken at the
   revolution's end.
 
 After the revolution each node's path is passed over the coating (:func:`~bladecase.nsm.massless.wear.pass_tip`):
@@ -113,8 +113,7 @@ def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, 
     each node's tributary area (m²), for the pressure (``system.casing`` should be ``coating.stiffness × areas``);
     ``friction``: a :class:`~bladecase.nsm.massless.friction.Friction`, or ``None``; ``flight``: the flight to fly
     (its phases reused, e.g. the rub response's: of this system, damping, casing and friction; the staggered
-    coupling's only); ``coupling``: one of :data:`COUPLINGS` (default ``"in_flight"``, ``"staggered"`` with friction:
-    the in-flight yield has no friction model yet)."""
+    coupling's only); ``coupling``: one of :data:`COUPLINGS` (default ``"in_flight"``)."""
     if not isinstance(coating, Abradable):
         raise ValueError(f"coating must be an Abradable, got {type(coating).__name__}")
     if isinstance(revolutions, bool) or int(revolutions) != revolutions or revolutions < 1:
@@ -123,21 +122,18 @@ def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, 
     if not (np.isfinite(speed) and speed > 0):
         raise ValueError(f"speed must be a finite number > 0 (rad/s), got {speed!r}")
     if coupling is None:
-        coupling = "in_flight" if friction is None else "staggered"
+        coupling = "in_flight"
     if coupling not in COUPLINGS:
         raise ValueError(f"coupling must be one of {COUPLINGS}, got {coupling!r}")
     areas = np.ones(system.m) if areas is None else np.asarray(areas, dtype=float)
     rub = Rub(lobes, amplitude, speed, angles)
     if coupling == "in_flight":
-        if friction is not None:
-            raise ValueError("the coating yielding during the flight (coupling 'in_flight') has no friction model "
-                             "yet: fly friction with coupling 'staggered', or drop the friction")
         want = coating.stiffness * areas
         if not np.allclose(system.casing, want, rtol=1e-6, atol=0.0):
             raise ValueError(f"the coating yielding in flight needs the system's casing stiffness at each node to be "
                              f"the coating's stiffness × the node's area, {want.tolist()} N/m, got "
                              f"{system.casing.tolist()}")
-        fl = CoatingFlight(system, coating.yield_pressure * areas, damping, rub)
+        fl = CoatingFlight(system, coating.yield_pressure * areas, damping, rub, friction)
     elif flight is not None:
         fl = flight
     else:
