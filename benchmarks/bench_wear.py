@@ -2,7 +2,7 @@
 dynamics (each revolution flown exactly with the profile the revolutions before left as its clearance), through
 the study's rub stage.
 
-The coating yields during the flight (without friction): the peak contact pressure of each speed, printed against
+The coating yields during the flight: the peak contact pressure of each speed, printed against
 the yield, must be the yield to round-off.
 
 Held-out check, over the same last four revolutions: the number of lobes of the coating worn in them, read from
