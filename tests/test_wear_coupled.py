@@ -27,7 +27,8 @@ def _coating(cells: int = 60, yield_pressure: float = 0.4) -> Abradable:
 
 @pytest.fixture(scope="module")
 def worn():
-    return wear_rub(_system(), _coating(), SPEED, 3, 1.2, ANGLES, DAMPING, revolutions=5, areas=[1.0, 1.0])
+    return wear_rub(_system(), _coating(), SPEED, 3, 1.2, ANGLES, DAMPING, revolutions=5, areas=[1.0, 1.0],
+                    coupling="staggered")
 
 
 def test_removed_volume_is_the_profiles_missing_area_times_width(worn):

@@ -135,7 +135,8 @@ def test_the_coupled_wear_carries_the_check_of_its_last_revolutions():
     s = NodalSystem(np.eye(2), np.array([[2.0, -1.0], [-1.0, 2.0]]), np.eye(2), np.diag([0.5, 0.5]), gap=[1.0, 1.0],
                     casing=[4.0, 4.0])
     coating = Abradable(thickness=1.0, yield_pressure=0.4, stiffness=4.0, cells=60, radius=30.0, width=0.7)
-    w = wear_rub(s, coating, 0.4, 3, 1.2, [0.0, 0.3], Damping(zeta=0.05), revolutions=6, areas=[1.0, 1.0])
+    w = wear_rub(s, coating, 0.4, 3, 1.2, [0.0, 0.3], Damping(zeta=0.05), revolutions=6, areas=[1.0, 1.0],
+                 coupling="staggered")
     assert w.tip.shape == (6, w.samples_per_turn)
     again = lobe_check(w.depths, w.tip, w.samples_per_turn)
     assert w.check == again and (w.check.verdict, w.check.lobes, w.check.expected) == ("agree", 3, 3)

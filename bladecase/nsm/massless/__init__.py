@@ -47,6 +47,9 @@ has contact phases of finite duration instead of impacts. One module per step:
   :class:`WearProfile`, :func:`pass_tip`), elastic–perfectly plastic: the profile each tip passage leaves;
 - :mod:`~bladecase.nsm.massless.wear_rub` — the rub that wears the coating: each revolution flown against the
   profile the previous ones left (:func:`wear_rub`);
+- :mod:`~bladecase.nsm.massless.coating_flight` — the coating yielding during the flight: each node's normal contact
+  a Jenkins element (open, elastic, plastic: a constant force while its surface recedes), every combination a
+  linear phase flown exactly (:func:`simulate_coating`);
 - :mod:`~bladecase.nsm.massless.wear_lobes` — the held-out check of the lobes worn over the last revolutions against
   the tip's vibration frequency over the same ones: agree, differ, or undefined with the reason (:func:`lobe_check`);
 - :mod:`~bladecase.nsm.massless.disk_modes` — travelling-wave nonsmooth modes of a tuned bladed disk: shooting over

@@ -4,14 +4,23 @@ The blade (a :class:`~bladecase.nsm.massless.nodes.NodalSystem`, one massless co
 inside an out-of-round casing (:class:`~bladecase.nsm.massless.nodes.Rub`) lined with an abradable coating
 (:class:`~bladecase.nsm.massless.wear.Abradable`). Each revolution is flown exactly with the worn profile left by
 the revolutions before as a clearance profile round the casing (:class:`~bladecase.nsm.massless.nodes.Profile`:
-its steps cut the flights); the coating's elastic layer is the casing's compliance at each node (its stiffness per
-area × the node's tributary area: the ``casing`` of the system), so a node in contact presses the coating with
-``p = λ_j / A_j``. After the revolution each node's path is passed over the coating
-(:func:`~bladecase.nsm.massless.wear.pass_tip`): its radial incursion beyond the unworn surface
-``r_j(t) = y_j(t) − g_j(t)`` (``y_j`` the node's normal displacement, ``g_j`` the out-of-round clearance without
-wear) at the casing angle ``θ = Ωt + φ_j``, sampled on a grid finer than the cells and at every switch; the coating
-is removed where the pressure went beyond its yield. The worn profile is the clearance of the next revolution
-(a staggered coupling: within a revolution the coating is elastic, its removal is taken at the revolution's end).
+its steps cut the flights). The coating is an elastic–perfectly plastic layer at each node: a spring (its stiffness
+per area × the node's tributary area: the ``casing`` of the system) in series with a plastic slider (its yield
+pressure × that area), so a node in contact presses the coating with ``p = λ_j / A_j``. Two couplings
+(:data:`COUPLINGS`):
+
+- ``"in_flight"`` (the default): the coating yields during the flight, each node a Jenkins element
+  open, elastic or plastic (:mod:`~bladecase.nsm.massless.coating_flight`): the pressure never exceeds the yield and
+  a plastic node removes the coating as it goes, following its own receding surface;
+- ``"staggered"``: within a revolution the coating is elastic, its removal taken at the
+  revolution's end.
+
+After the revolution each node's path is passed over the coating (:func:`~bladecase.nsm.massless.wear.pass_tip`):
+its radial incursion beyond the unworn surface ``r_j(t) = y_j(t) − g_j(t)`` (``y_j`` the node's normal displacement,
+``g_j`` the out-of-round clearance without wear) at the casing angle ``θ = Ωt + φ_j``, sampled on a grid finer than
+the cells and at every switch, writes into the cells the depth ``r_j − p_y/k`` it reached (in flight: the depth the
+node removed; staggered: the coating is removed where the pressure went beyond its yield). The worn profile is the
+clearance of the next revolution.
 
 >>> from bladecase.nsm import Damping
 >>> from bladecase.nsm.massless.nodes import NodalSystem
@@ -33,12 +42,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .coating_flight import CoatingFlight
 from .friction import friction_flight
 from .nodes import NodalFlight, NodalSystem, Profile, Rub, simulate_nodes
 from .wear import Abradable, WearProfile, pass_tip
 from .wear_lobes import LobeCheck, dominant_ratio, lobe_check
 
-__all__ = ["WearRub", "vibration_ratio", "wear_rub"]
+__all__ = ["COUPLINGS", "WearRub", "vibration_ratio", "wear_rub"]
+
+#: How the coating's removal meets the flight: ``"in_flight"``, the coating yields during the flight (each node a
+#: Jenkins element, :mod:`~bladecase.nsm.massless.coating_flight`); ``"staggered"``, elastic within a revolution,
+#: its removal taken at the revolution's end.
+COUPLINGS = ("in_flight", "staggered")
 
 #: Samples per coating cell of each node's path (at least), besides the switches.
 SAMPLES_PER_CELL = 3
@@ -54,8 +69,9 @@ class WearRub:
     the coating (Pa) and the lobes of the profile; the dominant frequency of the last (up to 4) revolutions' mean
     tip normal displacement over the rotation frequency (:func:`vibration_ratio`); the phases flown (switches and
     profile steps); that mean tip displacement over each revolution (``tip``: ``(revolutions,
-    samples_per_turn)``, m) and the held-out check of the lobes worn over the last revolutions against the
-    vibration's frequency over the same ones (``check``: :func:`~bladecase.nsm.massless.wear_lobes.lobe_check`)."""
+    samples_per_turn)``, m), the held-out check of the lobes worn over the last revolutions against the
+    vibration's frequency over the same ones (``check``: :func:`~bladecase.nsm.massless.wear_lobes.lobe_check`) and
+    the coupling flown (:data:`COUPLINGS`)."""
 
     profile: WearProfile
     removed: np.ndarray
@@ -67,6 +83,7 @@ class WearRub:
     tip: np.ndarray | None = None
     samples_per_turn: int = 0
     check: LobeCheck | None = None
+    coupling: str = "staggered"
 
     @property
     def depths(self) -> np.ndarray:
@@ -89,12 +106,14 @@ def vibration_ratio(signal, samples_per_turn: int) -> float:
 
 def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, amplitude: float, angles,
              damping=None, revolutions: int = 10, areas=None, friction=None,
-             max_switches: int = 2_000_000, flight: NodalFlight | None = None) -> WearRub:
+             max_switches: int = 2_000_000, flight: NodalFlight | None = None,
+             coupling: str | None = None) -> WearRub:
     """The coupled rub and wear of ``system`` at ``speed`` (rad/s) in a casing with ``lobes`` lobes of
     ``amplitude`` (m) lined with ``coating``, from rest over ``revolutions`` turns (module docstring). ``areas``:
     each node's tributary area (m²), for the pressure (``system.casing`` should be ``coating.stiffness × areas``);
     ``friction``: a :class:`~bladecase.nsm.massless.friction.Friction`, or ``None``; ``flight``: the flight to fly
-    (its phases reused, e.g. the rub response's: of this system, damping, casing and friction)."""
+    (its phases reused, e.g. the rub response's: of this system, damping, casing and friction; the staggered
+    coupling's only); ``coupling``: one of :data:`COUPLINGS` (default ``"in_flight"``)."""
     if not isinstance(coating, Abradable):
         raise ValueError(f"coating must be an Abradable, got {type(coating).__name__}")
     if isinstance(revolutions, bool) or int(revolutions) != revolutions or revolutions < 1:
@@ -102,9 +121,20 @@ def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, 
     speed = float(speed)
     if not (np.isfinite(speed) and speed > 0):
         raise ValueError(f"speed must be a finite number > 0 (rad/s), got {speed!r}")
+    if coupling is None:
+        coupling = "in_flight"
+    if coupling not in COUPLINGS:
+        raise ValueError(f"coupling must be one of {COUPLINGS}, got {coupling!r}")
     areas = np.ones(system.m) if areas is None else np.asarray(areas, dtype=float)
     rub = Rub(lobes, amplitude, speed, angles)
-    if flight is not None:
+    if coupling == "in_flight":
+        want = coating.stiffness * areas
+        if not np.allclose(system.casing, want, rtol=1e-6, atol=0.0):
+            raise ValueError(f"the coating yielding in flight needs the system's casing stiffness at each node to be "
+                             f"the coating's stiffness × the node's area, {want.tolist()} N/m, got "
+                             f"{system.casing.tolist()}")
+        fl = CoatingFlight(system, coating.yield_pressure * areas, damping, rub, friction)
+    elif flight is not None:
         fl = flight
     else:
         fl = NodalFlight(system, damping, rub) if friction is None else friction_flight(system, friction, damping, rub)
@@ -117,16 +147,23 @@ def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, 
     x, v = np.zeros(system.n), np.zeros(system.n)
     removed, peak_u, peak_p, count, tip, phases = [], [], [], [], [], 0
     for _ in range(int(revolutions)):
-        tr = simulate_nodes(system, x, v, turn, flight=fl, max_switches=max_switches,
-                            profile=Profile(profile.depth, speed, phi))
+        here = Profile(profile.depth, speed, phi)
+        if coupling == "in_flight":
+            tr = fl.simulate(x, v, turn, profile=here, max_switches=max_switches)
+        else:
+            tr = simulate_nodes(system, x, v, turn, flight=fl, max_switches=max_switches, profile=here)
         if not tr.complete:
             raise ValueError(f"the wear rub at {speed:.6g} rad/s needed more than {max_switches} switches in a "
                              "revolution")
         phases += int(tr.starts.size)
         t = np.unique(np.r_[grid, tr.starts, turn])
-        xs, _, lam = tr.sample(t)
-        y = system.W.T @ xs - system.flexibility @ lam  # the nodes' own normal displacements
-        r = y - fl._base_gap(t)  # incursion beyond the unworn surface
+        if coupling == "in_flight":
+            xs, _, lam, y = tr.sample(t)
+            r = y - fl.gap(t)  # incursion beyond the unworn surface
+        else:
+            xs, _, lam = tr.sample(t)
+            y = system.W.T @ xs - system.flexibility @ lam  # the nodes' own normal displacements
+            r = y - fl._base_gap(t)
         for j in range(system.m):
             profile, _ = pass_tip(profile, phi[j] + speed * t, r[j])
         profile = WearProfile(coating, profile.depth, profile.removed, profile.history + (profile.depth.copy(),),
@@ -141,4 +178,4 @@ def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, 
     ratio = vibration_ratio(tip[-TAIL:].ravel(), per_turn)
     check = lobe_check(np.array(profile.history), tip, per_turn, window=TAIL)
     return WearRub(profile, np.array(removed), np.array(peak_u), np.array(peak_p), np.array(count), ratio, phases,
-                   tip, per_turn, check)
+                   tip, per_turn, check, coupling)

@@ -69,6 +69,14 @@ def coating_of(study, model, contact) -> Abradable:
         raise StudyError(f"[casing] {exc}") from None
 
 
+#: The summary's words for each coupling of the wear to the flight.
+COUPLING_WORDS = {
+    "staggered": "each revolution is flown with the profile worn by the revolutions before as its clearance; within a "
+                 "revolution the coating is elastic, its removal taken at the revolution's end",
+    "in_flight": "each revolution is flown with the profile worn by the revolutions before as its clearance; the "
+                 "coating yields during the flight: a node pressing it at its yield pressure removes it as it goes"}
+
+
 def wear_figures(w) -> dict:
     """One speed's wear (:class:`~bladecase.nsm.massless.wear_rub.WearRub`) as plain numbers."""
     c = w.profile.coating
@@ -79,7 +87,7 @@ def wear_figures(w) -> dict:
             "peak_displacement_m": w.peak_displacement.tolist(), "peak_pressure_pa": w.peak_pressure.tolist(),
             "vibration_ratio": w.vibration_ratio, "depth_m": w.profile.depth.tolist(),
             "history_m": depths.tolist(), "worn_through": bool(w.profile.worn_through), "phases": w.phases,
-            "lobe_check": None if w.check is None else w.check.as_dict()}
+            "lobe_check": None if w.check is None else w.check.as_dict(), "coupling": w.coupling}
 
 
 def wear_section(study, coating: Abradable, rows: list[dict], points: list[dict]) -> dict:
@@ -97,14 +105,15 @@ def wear_section(study, coating: Abradable, rows: list[dict], points: list[dict]
                     "volume_mismatch": abs(removed - missing) / max(missing, np.finfo(float).tiny),
                     "vibration_ratio": w["vibration_ratio"], "expected_lobes": int(round(w["vibration_ratio"])),
                     "worn_through": w["worn_through"], "revolutions": len(w["lobes"]),
+                    "peak_pressure_mpa": 1e-6 * max(w["peak_pressure_pa"]),
                     "lobe_check": w.get("lobe_check")})
     top = max(range(len(per)), key=lambda i: per[i]["removed_mm3"]) if per else None
     return {"coating": {"thickness_m": coating.thickness, "yield_pa": coating.yield_pressure,
                         "stiffness_pa_per_m": coating.stiffness, "cells": coating.cells, "radius_m": coating.radius,
                         "width_m": coating.width, "yield_depth_m": coating.yield_depth},
             "speeds": per, "most_wear": None if top is None else per[top]["speed"],
-            "coupling": "each revolution is flown with the profile worn by the revolutions before as its clearance; "
-                        "within a revolution the coating is elastic, its removal taken at the revolution's end"}
+            "coupling": COUPLING_WORDS[next((p["wear"].get("coupling", "staggered") for p in points if "wear" in p),
+                                              "in_flight")]}
 
 
 def log_wear(section: dict, unit: str) -> None:
