@@ -109,11 +109,13 @@ class Lines(logging.Handler):
 def parse(line: str) -> dict:
     """The numbers of one per-speed log line."""
     m = re.match(r"rub: ([\d.]+) rad/s: (\d+) switches over (\d+) revolutions, ([\w-]+); ([\d.]+) s \(centrifugal "
-                 r"state ([\d.]+) s, reduction ([\d.]+) s, simulation ([\d.]+) s\)", line)
+                 r"state ([\d.]+) s, reduction ([\d.]+) s, simulation ([\d.]+) s\)(?:; centrifugal state: (\d+) Newton "
+                 r"iterations, (\d+) factorisations, (\d+) conjugate-gradient solves)?", line)
     if m is None:
         return {"line": line}
-    keys = ("speed", "switches", "revolutions", "response", "total", "state", "reduction", "simulation")
-    return {k: (v if k == "response" else float(v)) for k, v in zip(keys, m.groups())}
+    keys = ("speed", "switches", "revolutions", "response", "total", "state", "reduction", "simulation", "newton",
+            "factorisations", "cg")
+    return {k: (v if k == "response" else np.nan if v is None else float(v)) for k, v in zip(keys, m.groups())}
 
 
 def peak_mib(who: int) -> float:
@@ -157,7 +159,8 @@ def sweep(deck: Path, args) -> None:
         logger.removeHandler(handler)
     per = {round(p["speed"], 3): p for p in map(parse, handler.lines) if "speed" in p}
     print(f"\n   {'rad/s':>8} {'ratio':>6} {'switches':>8} {'revs':>5} {'sw/rev':>7} {'response':>15} {'tip mm':>7} "
-          f"{'total N':>9} {'nodes':>5} {'CPU s':>7} {'state':>6} {'reduce':>6} {'simul.':>6}")
+          f"{'total N':>9} {'nodes':>5} {'CPU s':>7} {'state':>6} {'reduce':>6} {'simul.':>6} {'Newton':>6} "
+          f"{'fact.':>5} {'CG':>4}")
     cpu = {"state": 0.0, "reduction": 0.0, "simulation": 0.0}
     for row in section["rows"]:
         p = per.get(round(row["speed"], 3), {})
@@ -168,7 +171,8 @@ def sweep(deck: Path, args) -> None:
               f"{row['switches'] / row['revolutions_run']:7.0f} {row['response']:>15} "
               f"{row['tip_normal_displacement_mm']:7.3f} {row['total_force_n']:9.1f} {row['nodes_touching']:5d} "
               f"{p.get('total', np.nan):7.1f} {p.get('state', np.nan):6.1f} {p.get('reduction', np.nan):6.1f} "
-              f"{p.get('simulation', np.nan):6.1f}")
+              f"{p.get('simulation', np.nan):6.1f} {p.get('newton', np.nan):6.0f} "
+              f"{p.get('factorisations', np.nan):5.0f} {p.get('cg', np.nan):4.0f}")
     total = sum(cpu.values())
     n = len(section["rows"])
     print(f"\n   sweep wall time {wall:.0f} s on {args.workers} processes: {wall / GOAL_S:.2f} × the 5-minute goal "
@@ -179,6 +183,9 @@ def sweep(deck: Path, args) -> None:
           f"({100 * cpu['reduction'] / total:.0f} %), simulation {cpu['simulation']:.0f} s "
           f"({100 * cpu['simulation'] / total:.0f} %); per speed {total / n:.0f} s; on {args.workers} idle cores "
           f"{total / args.workers:.0f} s ({total / args.workers / GOAL_S:.2f} × the goal)")
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    print(f"   worker processes' CPU time in all (the model shipped, the interior basis, every speed): "
+          f"{children.ru_utime + children.ru_stime:.0f} s")
     print(f"   peak memory: workers {peak_mib(resource.RUSAGE_CHILDREN):.0f} MiB (the largest), this process "
           f"{peak_mib(resource.RUSAGE_SELF):.0f} MiB; load average at the end {os.getloadavg()[0]:.1f}")
 
