@@ -152,3 +152,20 @@ def test_the_rub_stage_passes_each_speed_on_within_a_process(strip_model):
     assert [s.speed for s in earlier.states] == list(SPEEDS[1:])  # the last two, the older without its factor
     assert earlier.states[0].factor is None and earlier.states[1].factor is not None
     assert pickle.loads(pickle.dumps(earlier)).states == []  # shipped to a worker empty
+
+
+def test_each_speed_logs_its_time_and_its_centrifugal_state_solves():
+    """A long sweep's progress without a progress bar (``--no-progress``): one line per speed as it ends."""
+    from bladecase.log import transcript
+    from bladecase.study.rub.stage import _log_point
+
+    out = {"switches": 12, "revolutions_run": 40, "response": "settled",
+           "seconds": {"state": 20.5, "reduction": 9.5, "simulation": 6.0},
+           "state_solves": {"newton": 4, "factorisations": 1, "krylov": 17}}
+    with transcript() as lines:
+        _log_point(1014.0, out)
+        _log_point(1050.0, {"error": "refused", "seconds": out["seconds"]})
+    assert lines[0].endswith("rub: 1014 rad/s: 12 switches over 40 revolutions, settled; 36.0 s (centrifugal state "
+                             "20.5 s, reduction 9.5 s, simulation 6.0 s); centrifugal state: 4 Newton iterations, 1 "
+                             "factorisations, 17 conjugate-gradient solves")
+    assert "rub: 1050 rad/s: refused (refused); 36.0 s" in lines[1]
