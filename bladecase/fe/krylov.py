@@ -26,8 +26,9 @@ from ..linalg import Factor, SPDFactor, spd_factor, symmetric_factor
 __all__ = ["MAX_KRYLOV", "RATE_AFTER", "ReusedFactor", "factor_symmetric", "pcg"]
 
 #: Conjugate-gradient iterations a solve may take before the matrix is factorised instead (each costs a solve with
-#: the factorisation and a product with the matrix: about 0.12 s on the 61k-dof blade, a factorisation 80 of them).
-MAX_KRYLOV = 40
+#: the factorisation and a product with the matrix: about 0.1 s on the 61k-dof blade, a factorisation 80 to 100 of
+#: them).
+MAX_KRYLOV = 60
 #: After this many iterations the convergence rate so far predicts the count: past ``max_iter``, give up now.
 RATE_AFTER = 8
 

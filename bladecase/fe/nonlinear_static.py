@@ -59,7 +59,8 @@ UTOL = 1e-10
 #: Above this relative residual the first Newton step of a load step is shortened to the energy's minimum along it.
 LINE_SEARCH = 1e-3
 #: A Newton step solved by the preconditioned conjugate gradients is solved to a relative residual of the Newton
-#: residual (relative), at most this (:class:`~bladecase.fe.krylov.ReusedFactor`).
+#: residual (relative; looser for the last step, :func:`_forcing`), at most this
+#: (:class:`~bladecase.fe.krylov.ReusedFactor`).
 KRYLOV_RTOL = 1e-2
 
 
@@ -456,7 +457,7 @@ def _newton(problem: _Problem, u: np.ndarray, t: float, rtol: float, max_iter: i
         if k == max_iter:
             break
         try:
-            step = solver.solve(A, R, max(min(KRYLOV_RTOL, res), 1e-13), "K_T − Ω² M⊥")
+            step = solver.solve(A, R, _forcing(res, rtol), "K_T − Ω² M⊥")
         except ValueError:  # singular: a limit or bifurcation point on the path (the step is cut)
             return u, k + 1, None, res, shortened
         if search and k == 0 and res > LINE_SEARCH:
@@ -465,6 +466,13 @@ def _newton(problem: _Problem, u: np.ndarray, t: float, rtol: float, max_iter: i
         u = u - step
         still = float(np.abs(step).max()) <= UTOL * max(float(np.abs(u).max()), 1e-300)
     return u, max_iter, None, res, shortened
+
+
+def _forcing(res: float, rtol: float) -> float:
+    """The relative residual to solve a Newton step to by the conjugate gradients at the relative residual ``res``:
+    ``res`` (the quadratic convergence), or looser when the step's own error, ``η res``, can be a tenth of ``rtol``
+    and its quadratic term is below it; at most :data:`KRYLOV_RTOL`."""
+    return max(min(KRYLOV_RTOL, max(res, 0.1 * rtol / res)), 1e-13)
 
 
 def _line_search(problem: _Problem, u: np.ndarray, step: np.ndarray, g0: float, t: float) -> float:

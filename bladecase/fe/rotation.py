@@ -189,11 +189,15 @@ def spin(model: FEModel, speed: float, axis: RotationAxis | None = None, *, soft
     if static != "nonlinear":
         if not softening and factor is None:
             factor, made = spd_factor(model.K, "K"), 1
-        u0 = _linear_state(model, ops, w2, softening, factor, omega, solver)
+        # "auto" decides on the probe's states solved to PROBE_RTOL, the state kept solved again to LINEAR_RTOL
+        probe = PROBE_RTOL if static == "auto" and stiffening and softening and nearest is not None else LINEAR_RTOL
+        u0 = _linear_state(model, ops, w2, softening, factor, omega, solver, probe)
     if static in ("second-order", "auto") and stiffening and softening:
-        change, step = _second_order_step(model, ops, w2, u0, solver)
+        change, step = _second_order_step(model, ops, w2, u0, solver, probe)
         # "auto": when the state moves with its own stress stiffness, its rotations matter too
         used = static if static == "second-order" else AUTO_STATE if change > AUTO_RTOL else "linear"
+        if used == "linear" and probe != LINEAR_RTOL:
+            u0 = _linear_state(model, ops, w2, softening, factor, omega, solver, LINEAR_RTOL)
         if used == "second-order":
             u0, iterations = _second_order(model, ops, w2, step, omega, change, solver)
     made, krylov = made + solver.factorisations, solver.iterations
@@ -247,16 +251,20 @@ def spun_state(model: FEModel) -> tuple[float, RotationAxis, np.ndarray, str] | 
 #: Relative residual to which a static state's linear solve is taken when the conjugate gradients solve it
 #: (:class:`~bladecase.fe.krylov.ReusedFactor`; a factorisation solves it to round-off).
 LINEAR_RTOL = 1e-11
+#: ``static = "auto"`` with ``previous`` states: the relative residual of the conjugate gradients of the linear and
+#: the second-order step it decides on (the change, compared with :data:`AUTO_RTOL`, to about this); the linear
+#: state, when kept, is solved again to :data:`LINEAR_RTOL`.
+PROBE_RTOL = 1e-6
 
 
 def _linear_state(model: FEModel, ops: _Operators, w2: float, softening: bool, factor, omega: float,
-                  solver: ReusedFactor) -> np.ndarray:
+                  solver: ReusedFactor, rtol: float = LINEAR_RTOL) -> np.ndarray:
     """``(K − Ω² M⊥) u₀ = Ω² f₁`` (``K u₀ = Ω² f₁`` without ``softening``, with ``factor``, ``K``'s)."""
     if not softening:
         return factor.solve(w2 * ops.f1)
     A = sp.csr_array(model.K - w2 * ops.M_perp)
     try:  # definite below the first mode's speed; past it (slender blades) indefinite but regular
-        return solver.solve(A, w2 * ops.f1, LINEAR_RTOL, "K - Ω² M⊥")
+        return solver.solve(A, w2 * ops.f1, rtol, "K - Ω² M⊥")
     except ValueError:
         rpm = omega * 60 / (2 * math.pi)
         raise ValueError(f"at {omega:.6g} rad/s ({rpm:.6g} rpm) K − Ω² M⊥ is singular: the speed is a "
@@ -284,11 +292,11 @@ AUTO_RTOL = 1e-2
 AUTO_STATE = "nonlinear"
 
 
-def _second_order_step(model: FEModel, ops: _Operators, w2: float, u: np.ndarray,
-                       solver: ReusedFactor) -> tuple[float, np.ndarray]:
+def _second_order_step(model: FEModel, ops: _Operators, w2: float, u: np.ndarray, solver: ReusedFactor,
+                       rtol: float = LINEAR_RTOL) -> tuple[float, np.ndarray]:
     """One step of the second-order iteration from ``u``: ``(relative change (max norm), new state)``."""
     A = sp.csr_array(model.K + ops.stress_stiffness(u) - w2 * ops.M_perp)
-    new = solver.solve(A, w2 * ops.f1, LINEAR_RTOL, "K + K_σ − Ω² M⊥")
+    new = solver.solve(A, w2 * ops.f1, rtol, "K + K_σ − Ω² M⊥")
     return float(np.abs(new - u).max()) / max(float(np.abs(new).max()), 1e-300), new
 
 
