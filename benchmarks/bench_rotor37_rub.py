@@ -37,6 +37,14 @@ states, 2 factorisations — ``K(Ω)``'s and one for the probes —, 33–48 sol
 iterations, no factorisation, 17 solves) against 73.6 s from rest with a factorisation per iteration (6), the
 states equal to 1.1e-12 and the tangents to 3e-14 (relative, max norms).  The price: a worker keeps the previous
 speed's factorisation of ``K(Ω)`` and the states of the last two speeds, its peak memory 2.8 GiB against 1.5 GiB.
+Then Newton's last step solved only as tightly as the residual test needs, and ``"auto"``'s probes to 1e-6 when
+earlier states precondition them (load 4–10, 52 % of the CPU, 1295 s wall): 696 CPU s, the state 368 s (53 %), the
+first speed of each process 57–59 s (2 factorisations, 100–108 solves), the later ones 33–38 s (3–4 Newton
+iterations, 2 factorisations, 24–32 solves); the unchanged reduction, a control, took 115 s against 87 s above:
+CPU seconds inflate by a quarter on this loaded machine, so the two runs tie.  The responses again identical.
+The factorisation left besides ``K(Ω)``'s is ``"auto"``'s linear probe: ``K − Ω² M⊥`` preconditioned by the
+previous ``K(Ω)`` starts at a residual 46 times the load's and needs some 45 iterations to 1e-6 (the stress
+stiffness it lacks is large on this twisted blade), so it is factorised (10 s a speed).
 """
 
 from __future__ import annotations
