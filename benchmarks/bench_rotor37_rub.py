@@ -18,6 +18,33 @@ Run (OPENBLAS_NUM_THREADS=1: the workers run single-threaded BLAS anyway)::
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_rotor37_rub.py DATA/blade.inp [--speeds 9]
         [--workers 2] [--revolutions 40] [--run-on] [--campbell] [--campbell-only]
+
+Figures (CPU seconds, the stable measure on a shared machine; 2 processes, cvxopt's CHOLMOD; the machine's load
+average 5 to 10 on 2 cores, so the wall times are 3 to 4 times an idle machine's).  Before: every speed's
+``static = "auto"`` state took about nine factorisations of the 61k-dof model (the linear and the second-order
+probes, six Newton tangents from rest, ``K(Ω)``): 9 speeds 1546 CPU s, 79 % of it the centrifugal state (773 s on
+two idle cores, 2.6 × the goal); ``--speeds 3`` (load 8.4) 403 CPU s, the state 103.5–105.6 s a speed, reduction
+9.9–10.8 s, simulation 6.0–45.0 s.  After (each speed's state passed on to the next speed its process runs:
+:func:`bladecase.fe.rotation.spin`'s ``previous``; Newton's steps by conjugate gradients preconditioned with one
+reused factorisation, :mod:`bladecase.fe.krylov`), the 9 speeds (load 7–10, 28 % of the CPU for this run, 2125 s
+wall): 602 CPU s = centrifugal state 306 s (51 %), reduction 87 s, simulation 209 s (35 %: 3.4–58.5 s a speed,
+most past the crossing, where all 134 nodes touch); on two idle cores 301 s, 1.00 × the goal.  The first speed of
+each process, from rest: 43.9 and 53.8 s (6–7 Newton iterations, 2–3 factorisations with ``K(Ω)``'s, 100–103
+conjugate-gradient solves); every later speed: 25.6–37.0 s (3–5 Newton iterations from the extrapolated earlier
+states, 2 factorisations — ``K(Ω)``'s and one for the probes —, 33–48 solves).  The responses are the same
+(switches, revolutions and responses identical to the before run at the speeds both ran).  On one speed
+(1014 rad/s, from 953 rad/s's state and ``K(Ω)``, one process): the nonlinear state itself 8.4 CPU s (4 Newton
+iterations, no factorisation, 17 solves) against 73.6 s from rest with a factorisation per iteration (6), the
+states equal to 1.1e-12 and the tangents to 3e-14 (relative, max norms).  The price: a worker keeps the previous
+speed's factorisation of ``K(Ω)`` and the states of the last two speeds, its peak memory 2.8 GiB against 1.5 GiB.
+Then Newton's last step solved only as tightly as the residual test needs, and ``"auto"``'s probes to 1e-6 when
+earlier states precondition them (load 4–10, 52 % of the CPU, 1295 s wall): 696 CPU s, the state 368 s (53 %), the
+first speed of each process 57–59 s (2 factorisations, 100–108 solves), the later ones 33–38 s (3–4 Newton
+iterations, 2 factorisations, 24–32 solves); the unchanged reduction, a control, took 115 s against 87 s above:
+CPU seconds inflate by a quarter on this loaded machine, so the two runs tie.  The responses again identical.
+The factorisation left besides ``K(Ω)``'s is ``"auto"``'s linear probe: ``K − Ω² M⊥`` preconditioned by the
+previous ``K(Ω)`` starts at a residual 46 times the load's and needs some 45 iterations to 1e-6 (the stress
+stiffness it lacks is large on this twisted blade), so it is factorised (10 s a speed).
 """
 
 from __future__ import annotations
@@ -109,11 +136,13 @@ class Lines(logging.Handler):
 def parse(line: str) -> dict:
     """The numbers of one per-speed log line."""
     m = re.match(r"rub: ([\d.]+) rad/s: (\d+) switches over (\d+) revolutions, ([\w-]+); ([\d.]+) s \(centrifugal "
-                 r"state ([\d.]+) s, reduction ([\d.]+) s, simulation ([\d.]+) s\)", line)
+                 r"state ([\d.]+) s, reduction ([\d.]+) s, simulation ([\d.]+) s\)(?:; centrifugal state: (\d+) Newton "
+                 r"iterations, (\d+) factorisations, (\d+) conjugate-gradient solves)?", line)
     if m is None:
         return {"line": line}
-    keys = ("speed", "switches", "revolutions", "response", "total", "state", "reduction", "simulation")
-    return {k: (v if k == "response" else float(v)) for k, v in zip(keys, m.groups())}
+    keys = ("speed", "switches", "revolutions", "response", "total", "state", "reduction", "simulation", "newton",
+            "factorisations", "cg")
+    return {k: (v if k == "response" else np.nan if v is None else float(v)) for k, v in zip(keys, m.groups())}
 
 
 def peak_mib(who: int) -> float:
@@ -157,7 +186,8 @@ def sweep(deck: Path, args) -> None:
         logger.removeHandler(handler)
     per = {round(p["speed"], 3): p for p in map(parse, handler.lines) if "speed" in p}
     print(f"\n   {'rad/s':>8} {'ratio':>6} {'switches':>8} {'revs':>5} {'sw/rev':>7} {'response':>15} {'tip mm':>7} "
-          f"{'total N':>9} {'nodes':>5} {'CPU s':>7} {'state':>6} {'reduce':>6} {'simul.':>6}")
+          f"{'total N':>9} {'nodes':>5} {'CPU s':>7} {'state':>6} {'reduce':>6} {'simul.':>6} {'Newton':>6} "
+          f"{'fact.':>5} {'CG':>4}")
     cpu = {"state": 0.0, "reduction": 0.0, "simulation": 0.0}
     for row in section["rows"]:
         p = per.get(round(row["speed"], 3), {})
@@ -168,7 +198,8 @@ def sweep(deck: Path, args) -> None:
               f"{row['switches'] / row['revolutions_run']:7.0f} {row['response']:>15} "
               f"{row['tip_normal_displacement_mm']:7.3f} {row['total_force_n']:9.1f} {row['nodes_touching']:5d} "
               f"{p.get('total', np.nan):7.1f} {p.get('state', np.nan):6.1f} {p.get('reduction', np.nan):6.1f} "
-              f"{p.get('simulation', np.nan):6.1f}")
+              f"{p.get('simulation', np.nan):6.1f} {p.get('newton', np.nan):6.0f} "
+              f"{p.get('factorisations', np.nan):5.0f} {p.get('cg', np.nan):4.0f}")
     total = sum(cpu.values())
     n = len(section["rows"])
     print(f"\n   sweep wall time {wall:.0f} s on {args.workers} processes: {wall / GOAL_S:.2f} × the 5-minute goal "
@@ -179,6 +210,9 @@ def sweep(deck: Path, args) -> None:
           f"({100 * cpu['reduction'] / total:.0f} %), simulation {cpu['simulation']:.0f} s "
           f"({100 * cpu['simulation'] / total:.0f} %); per speed {total / n:.0f} s; on {args.workers} idle cores "
           f"{total / args.workers:.0f} s ({total / args.workers / GOAL_S:.2f} × the goal)")
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    print(f"   worker processes' CPU time in all (the model shipped, the interior basis, every speed): "
+          f"{children.ru_utime + children.ru_stime:.0f} s")
     print(f"   peak memory: workers {peak_mib(resource.RUSAGE_CHILDREN):.0f} MiB (the largest), this process "
           f"{peak_mib(resource.RUSAGE_SELF):.0f} MiB; load average at the end {os.getloadavg()[0]:.1f}")
 

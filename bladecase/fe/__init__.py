@@ -47,6 +47,8 @@ Module map, one entry per module (the details are in each module's own docstring
   spin softening) at one speed;
 - :mod:`~bladecase.fe.nonlinear_static` — :func:`nonlinear_state`: the geometrically nonlinear centrifugal state
   (total Lagrangian St-Venant–Kirchhoff, follower load) and its full tangent, as CalculiX's NLGEOM;
+- :mod:`~bladecase.fe.krylov` — :class:`~bladecase.fe.krylov.ReusedFactor`: solves with nearby symmetric matrices
+  (Newton's tangents, a sweep's speeds) by conjugate gradients preconditioned with one reused factorisation;
 - :mod:`~bladecase.fe.stress` — ``nodal_stress`` (each element's stress at its nodes, averaged), ``stress_modes``
   (many displacements in one pass), ``von_mises``;
 - :mod:`~bladecase.fe.campbell` — frequencies against speed, modes followed by MAC, engine-order crossings;

@@ -33,13 +33,15 @@ the same vectors and matrices).  At ``u = 0`` the tangent is the model's ``K`` t
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
 
-from ..linalg import Factor, spd_factor, symmetric_factor
+from ..linalg import Factor, spd_factor  # noqa: F401  (spd_factor: the docstring's example)
 from .centrifugal import RotationAxis, _operators, to_rad_s
+from .krylov import ReusedFactor
 from .model import FEModel
 
 __all__ = ["MIN_STEP", "NonlinearState", "StVenantKirchhoff", "nonlinear_state", "svk_forms"]
@@ -56,6 +58,10 @@ FAST = 5
 UTOL = 1e-10
 #: Above this relative residual the first Newton step of a load step is shortened to the energy's minimum along it.
 LINE_SEARCH = 1e-3
+#: A Newton step solved by the preconditioned conjugate gradients is solved to a relative residual of the Newton
+#: residual (relative; looser for the last step, :func:`_forcing`), at most this
+#: (:class:`~bladecase.fe.krylov.ReusedFactor`).
+KRYLOV_RTOL = 1e-2
 
 
 class StVenantKirchhoff:
@@ -221,11 +227,20 @@ class NonlinearState:
     tangent : scipy.sparse.csr_array
         ``K_T(u) − Ω² M⊥`` at the state (free dofs, symmetric): the stiffness of the vibration about it.
     iterations : int
-        Newton iterations (factorisations), all load steps and retries together.
+        Newton iterations, all load steps and retries together.
     steps : int
-        Load steps tried (those cut in half included).
+        Load steps tried (those cut in half and a warm start's attempt included).
     residual : float
         ``‖R(u)‖ / ‖Ω² (f₁ + M⊥ u) + p‖`` at the state.
+    factorisations : int
+        Tangents factorised (one per Newton iteration with ``krylov=False``).
+    krylov_iterations : int
+        Solves with a factorisation made by the preconditioned conjugate gradients.
+    preconditioner : Factor or None
+        The last factorisation used (made here, or the one given): pass it on as ``preconditioner=`` to the state
+        at a nearby speed.
+    warm : bool
+        Whether the state was reached from ``previous`` states (else from rest, by load steps).
     """
 
     displacement: np.ndarray
@@ -233,6 +248,10 @@ class NonlinearState:
     iterations: int
     steps: int
     residual: float
+    factorisations: int = 0
+    krylov_iterations: int = 0
+    preconditioner: Factor | None = None
+    warm: bool = False
 
 
 class _Problem:
@@ -263,16 +282,10 @@ class _Problem:
         return K, R, float(np.linalg.norm(R)) / max(float(np.linalg.norm(f)), 1e-300)
 
 
-def _factor(A, name: str) -> Factor:
-    try:  # a spinning or a moderately loaded body: positive definite
-        return spd_factor(A, name)
-    except ValueError:  # near buckling (compression) or past a spin-softening critical speed: indefinite
-        return symmetric_factor(A, name)
-
-
 def nonlinear_state(model: FEModel, speed: float = 0.0, axis: RotationAxis | None = None, *,
                      load: np.ndarray | None = None, rtol: float = 1e-9, steps: int = 1,
-                     max_iter: int = MAX_ITER) -> NonlinearState:
+                     max_iter: int = MAX_ITER, previous: Sequence[tuple[float, np.ndarray]] = (),
+                     preconditioner: Factor | None = None, krylov: bool = True) -> NonlinearState:
     """The geometrically nonlinear static state of ``model`` under its centrifugal load at ``speed`` (rad/s) about
     ``axis`` and a dead ``load`` (free dofs, N), by Newton's method with load stepping (module docstring).
 
@@ -296,12 +309,25 @@ def nonlinear_state(model: FEModel, speed: float = 0.0, axis: RotationAxis | Non
         (:func:`_line_search`); failing that in ``max_iter`` iterations, plain Newton from the same start; failing
         both, the step is halved.  A step that converges in :data:`FAST` iterations or fewer is followed by one
         twice as long.
+    previous : sequence of (speed, displacement)
+        Converged states of the same model, axis and dead load at other speeds (rad/s; e.g. a sweep's speeds before
+        this one): the iteration starts at the full load from their extrapolation, linear in ``Ω²`` through the two
+        nearest in ``Ω²`` (one: scaled by ``Ω²`` without a dead load, else as it is); if it does not converge, from
+        rest by load steps as without.
+    preconditioner : Factor
+        A factorisation of a nearby tangent (e.g. the previous speed's ``K(Ω)``, :attr:`SpinState.factor
+        <bladecase.fe.rotation.SpinState.factor>`, or :attr:`NonlinearState.preconditioner`) to precondition the
+        Newton steps' conjugate gradients from the start.
+    krylov : bool
+        Solve the Newton steps by the conjugate gradients preconditioned with the last factorisation, factorising
+        a tangent only when they are slow (module docstring); ``False``: factorise every tangent.
 
     Raises
     ------
     ValueError
         No load; a step below :data:`MIN_STEP` of the full load does not converge (the message gives the speed and
-        the load fraction reached and the last residual).
+        the load fraction reached and the last residual); ``previous`` without a speed, or not (speed, displacement)
+        pairs of this model.
 
     Examples
     --------
@@ -340,23 +366,32 @@ def nonlinear_state(model: FEModel, speed: float = 0.0, axis: RotationAxis | Non
         return (f"{omega * math.sqrt(t):.6g} rad/s ({rpm * math.sqrt(t):.6g} rpm) of {omega:.6g} rad/s, "
                 if ops is not None else "") + f"load factor {t:.4g}"
 
+    solver = ReusedFactor(preconditioner, krylov=krylov)
+    start = _warm_start(previous, omega, model.n_dofs, bool(p.any()))
+
+    def done(u, tangent, res, iterations, taken, warm):
+        return NonlinearState(u, sp.csr_array(0.5 * (tangent + tangent.T)), iterations, taken, res,
+                              solver.factorisations, solver.iterations, solver.factor, warm)
+
+    iterations = taken = 0
+    if start is not None:  # the full load from the other speeds' states; failing that, from rest
+        trial, iterations, tangent, res = _attempt(problem, start, 1.0, rtol, max_iter, solver)
+        taken = 1
+        if tangent is not None:
+            return done(trial, tangent, res, iterations, taken, True)
     u = np.zeros(model.n_dofs)
     t, dt = 0.0, 1.0 / max(int(steps), 1)
-    iterations = taken = 0
-    previous = None  # the last state and its load factor: the next step starts from their extrapolation
+    last = None  # the last state and its load factor: the next step starts from their extrapolation
     while True:
         target = min(1.0, t + dt)
-        start = u if previous is None else u + (u - previous[0]) * ((target - t) / (t - previous[1]))
+        start = u if last is None else u + (u - last[0]) * ((target - t) / (t - last[1]))
         taken += 1
-        for search in (True, False):
-            trial, k, tangent, res, shortened = _newton(problem, start, target, rtol, max_iter, search)
-            iterations += k
-            if tangent is not None or not shortened:
-                break
+        trial, k, tangent, res = _attempt(problem, start, target, rtol, max_iter, solver)
+        iterations += k
         if tangent is not None:
-            previous, u, t = (u, t), trial, target
+            last, u, t = (u, t), trial, target
             if t >= 1.0:
-                return NonlinearState(u, sp.csr_array(0.5 * (tangent + tangent.T)), iterations, taken, res)
+                return done(u, tangent, res, iterations, taken, False)
             dt = 2.0 * dt if k <= FAST else dt
             continue
         dt *= 0.5
@@ -368,8 +403,48 @@ def nonlinear_state(model: FEModel, speed: float = 0.0, axis: RotationAxis | Non
                              "the mesh's length unit, or use static = 'second-order'")
 
 
-def _newton(problem: _Problem, u: np.ndarray, t: float, rtol: float, max_iter: int, search: bool):
-    """Newton's iteration at load factor ``t`` from ``u``: ``(u, factorisations, tangent, residual, shortened)``, the
+def _warm_start(previous, omega: float, n: int, dead: bool) -> np.ndarray | None:
+    """The start at the full load from ``previous`` (speed, displacement) states (:func:`nonlinear_state`), ``None``
+    without."""
+    states = list(previous) if previous is not None else []
+    if not states:
+        return None
+    if omega <= 0:
+        raise ValueError("previous states start a spinning body's state: give a speed (and its axis), or no previous")
+    known = []
+    for i, state in enumerate(states):
+        try:
+            w, u = state
+        except (TypeError, ValueError):
+            raise ValueError(f"previous[{i}] must be a (speed in rad/s, displacement) pair, got {state!r}") from None
+        w, u = to_rad_s(w), np.asarray(u, dtype=float).ravel()
+        if w <= 0 or u.shape != (n,) or not np.all(np.isfinite(u)):
+            raise ValueError(f"previous[{i}] must be a speed > 0 (rad/s) and {n} finite displacements (one per free "
+                             f"dof of this model), got speed {w!r} and shape {u.shape}")
+        known.append((w * w, u))
+    known.sort(key=lambda s: abs(s[0] - omega * omega))
+    (x1, u1), w2 = known[0], omega * omega
+    for x2, u2 in known[1:]:
+        if x2 != x1:  # linear in Ω² through the nearest two
+            return u1 + (u2 - u1) * ((w2 - x1) / (x2 - x1))
+    return u1 if dead else u1 * (w2 / x1)
+
+
+def _attempt(problem: _Problem, start: np.ndarray, t: float, rtol: float, max_iter: int, solver: ReusedFactor):
+    """One load step to ``t`` from ``start``: Newton with the first step's line search, then without if that
+    shortened it and failed: ``(u, iterations, tangent or None, residual)``."""
+    iterations = 0
+    for search in (True, False):
+        trial, k, tangent, res, shortened = _newton(problem, start, t, rtol, max_iter, search, solver)
+        iterations += k
+        if tangent is not None or not shortened:
+            break
+    return trial, iterations, tangent, res
+
+
+def _newton(problem: _Problem, u: np.ndarray, t: float, rtol: float, max_iter: int, search: bool,
+            solver: ReusedFactor):
+    """Newton's iteration at load factor ``t`` from ``u``: ``(u, iterations, tangent, residual, shortened)``, the
     tangent at the converged ``u`` (``None``: not converged in ``max_iter`` iterations), ``shortened`` whether the
     line search shortened the first step (else an attempt without it would repeat this one)."""
     still = shortened = False
@@ -382,7 +457,7 @@ def _newton(problem: _Problem, u: np.ndarray, t: float, rtol: float, max_iter: i
         if k == max_iter:
             break
         try:
-            step = _factor(A, "K_T − Ω² M⊥").solve(R)
+            step = solver.solve(A, R, _forcing(res, rtol), "K_T − Ω² M⊥")
         except ValueError:  # singular: a limit or bifurcation point on the path (the step is cut)
             return u, k + 1, None, res, shortened
         if search and k == 0 and res > LINE_SEARCH:
@@ -391,6 +466,13 @@ def _newton(problem: _Problem, u: np.ndarray, t: float, rtol: float, max_iter: i
         u = u - step
         still = float(np.abs(step).max()) <= UTOL * max(float(np.abs(u).max()), 1e-300)
     return u, max_iter, None, res, shortened
+
+
+def _forcing(res: float, rtol: float) -> float:
+    """The relative residual to solve a Newton step to by the conjugate gradients at the relative residual ``res``:
+    ``res`` (the quadratic convergence), or looser when the step's own error, ``η res``, can be a tenth of ``rtol``
+    and its quadratic term is below it; at most :data:`KRYLOV_RTOL`."""
+    return max(min(KRYLOV_RTOL, max(res, 0.1 * rtol / res)), 1e-13)
 
 
 def _line_search(problem: _Problem, u: np.ndarray, step: np.ndarray, g0: float, t: float) -> float:

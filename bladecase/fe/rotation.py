@@ -23,19 +23,26 @@ its perturbation stiffness holds the material stiffness with the static state's 
 (large rotations, the follower load ``Ω² (f₁ + M⊥ u)``) and vibrates about it with its full tangent
 ``K_T(u₀) − Ω² M⊥``: CalculiX's ``NLGEOM`` static step and ``PERTURBATION`` frequencies, ANSYS's large-deflection
 prestressed modal analysis.
+
+A sweep of speeds passes each speed's state on to the next (:func:`spin`'s ``previous``): the nonlinear state
+starts from the earlier speeds' states and its Newton steps, as the solves of ``"auto"``'s and ``"second-order"``'s
+states, are preconditioned by the nearest speed's factorisation of ``K(Ω)`` (:mod:`~bladecase.fe.krylov`); the
+states are the same to the solvers' tolerances.
 """
 
 from __future__ import annotations
 
 import math
 import weakref
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
 
-from ..linalg import SPDFactor, spd_factor, symmetric_factor
+from ..linalg import SPDFactor, spd_factor
 from .centrifugal import SPEED_UNITS, RotationAxis, _Operators, _operators, to_rad_s  # noqa: F401
+from .krylov import ReusedFactor
 from .model import FEModel
 
 __all__ = ["RotationAxis", "SpinState", "coriolis_matrix", "second_order_state", "spin", "spun_state", "to_rad_s"]
@@ -79,6 +86,10 @@ class SpinState:
     second_order_change: float | None = None
     #: The nonlinear state's load steps (0 for the others).
     load_steps: int = 0
+    #: Factorisations made for this state (the static solves' and ``K(Ω)``'s).
+    factorisations: int = 0
+    #: Solves with a factorisation made by the preconditioned conjugate gradients (:mod:`~bladecase.fe.krylov`).
+    krylov_iterations: int = 0
 
     def nodal_displacement(self) -> np.ndarray:
         """``u₀`` at every mesh node ``(n_nodes, 3)`` (zero at clamped nodes)."""
@@ -90,7 +101,8 @@ class SpinState:
 
 
 def spin(model: FEModel, speed: float, axis: RotationAxis | None = None, *, softening: bool = True,
-         stiffening: bool = True, factor: SPDFactor | None = None, static: str = "linear") -> SpinState:
+         stiffening: bool = True, factor: SPDFactor | None = None, static: str = "linear",
+         previous: Sequence[SpinState] = ()) -> SpinState:
     """The model linearised about its static centrifugal state at ``speed`` (rad/s) about ``axis``.
 
     Parameters
@@ -116,6 +128,12 @@ def spin(model: FEModel, speed: float, axis: RotationAxis | None = None, *, soft
         linear state unless one second-order step moves it by more than 1 %, then the nonlinear state. Both
         ``softening`` and ``stiffening`` are needed by ``"nonlinear"`` (``"second-order"`` and ``"auto"`` stay linear
         without).
+    previous : sequence of SpinState
+        This model's states about the same axis at other speeds (a sweep's speeds before this one): the nonlinear
+        state starts from their nonlinear states (:func:`~bladecase.fe.nonlinear_static.nonlinear_state`'s
+        ``previous``), and the nearest one's factorisation of ``K(Ω)`` preconditions the conjugate gradients of the
+        static solves (:class:`~bladecase.fe.krylov.ReusedFactor`): the same state to the solvers' tolerance, with
+        fewer factorisations (:attr:`SpinState.factorisations`).
 
     Raises
     ------
@@ -123,7 +141,8 @@ def spin(model: FEModel, speed: float, axis: RotationAxis | None = None, *, soft
         An axis a 2-D (plane) model cannot spin about (tilted, or in the plane but offset out of it: see
         :class:`RotationAxis`); a speed that is negative or not finite; a speed at which ``K − Ω² M⊥`` is no
         longer positive definite (the blade diverges under spin softening: the message gives the speed); a
-        nonlinear state that does not converge (the message gives the speed reached and the residual).
+        nonlinear state that does not converge (the message gives the speed reached and the residual); ``previous``
+        not states of this model about this axis.
 
     Examples
     --------
@@ -159,23 +178,36 @@ def spin(model: FEModel, speed: float, axis: RotationAxis | None = None, *, soft
         raise ValueError("static = 'nonlinear' solves the large-deflection state with its follower centrifugal load: "
                          "its tangent holds the stress stiffness and the spin softening, so softening and stiffening "
                          "must both be on (or use static = 'linear')")
+    near = _nearest(previous, model, axis, omega)
     ops = _operators(model, axis)
     w2 = omega * omega
     rpm = omega * 60 / (2 * math.pi)
     iterations, change, steps, used, K = 0, None, 0, "linear", None
+    nearest = next((s.factor for s in near if s.factor is not None), None)
+    solver = ReusedFactor(nearest)
+    made = krylov = 0
     if static != "nonlinear":
-        u0 = _linear_state(model, ops, w2, softening, factor, omega)
+        if not softening and factor is None:
+            factor, made = spd_factor(model.K, "K"), 1
+        # "auto" decides on the probe's states solved to PROBE_RTOL, the state kept solved again to LINEAR_RTOL
+        probe = PROBE_RTOL if static == "auto" and stiffening and softening and nearest is not None else LINEAR_RTOL
+        u0 = _linear_state(model, ops, w2, softening, factor, omega, solver, probe)
     if static in ("second-order", "auto") and stiffening and softening:
-        change, step = _second_order_step(model, ops, w2, u0)
+        change, step = _second_order_step(model, ops, w2, u0, solver, probe)
         # "auto": when the state moves with its own stress stiffness, its rotations matter too
         used = static if static == "second-order" else AUTO_STATE if change > AUTO_RTOL else "linear"
+        if used == "linear" and probe != LINEAR_RTOL:
+            u0 = _linear_state(model, ops, w2, softening, factor, omega, solver, LINEAR_RTOL)
         if used == "second-order":
-            u0, iterations = _second_order(model, ops, w2, step, omega, change)
+            u0, iterations = _second_order(model, ops, w2, step, omega, change, solver)
+    made, krylov = made + solver.factorisations, solver.iterations
     if used == "nonlinear" or static == "nonlinear":
         from .nonlinear_static import nonlinear_state
 
-        state = nonlinear_state(model, omega, axis)
+        state = nonlinear_state(model, omega, axis, preconditioner=nearest if nearest is not None else solver.factor,
+                                previous=[(s.speed, s.displacement) for s in near if s.static == "nonlinear"])
         u0, K, iterations, steps, used = state.displacement, state.tangent, state.iterations, state.steps, "nonlinear"
+        made, krylov = made + state.factorisations, krylov + state.krylov_iterations
     if K is None:
         K = model.K
         if stiffening:
@@ -190,7 +222,7 @@ def spin(model: FEModel, speed: float, axis: RotationAxis | None = None, *, soft
                          "centrifugal state, K + K_σ − Ω² M⊥, is not positive definite (spin softening beats the "
                          "stiffening); check the speed, the rotation axis and the mesh's length unit") from None
     out = SpinState(omega, axis, replace(model, K=K), u0, softening, stiffening, tangent, used, iterations, change,
-                    steps)
+                    steps, made + 1, krylov)
     _SPUN[out.model] = (omega, axis, u0, used)
     return out
 
@@ -216,21 +248,40 @@ def spun_state(model: FEModel) -> tuple[float, RotationAxis, np.ndarray, str] | 
     return _SPUN.get(model)
 
 
-def _linear_state(model: FEModel, ops: _Operators, w2: float, softening: bool, factor, omega: float) -> np.ndarray:
-    """``(K − Ω² M⊥) u₀ = Ω² f₁`` (``K u₀ = Ω² f₁`` without ``softening``)."""
+#: Relative residual to which a static state's linear solve is taken when the conjugate gradients solve it
+#: (:class:`~bladecase.fe.krylov.ReusedFactor`; a factorisation solves it to round-off).
+LINEAR_RTOL = 1e-11
+#: ``static = "auto"`` with ``previous`` states: the relative residual of the conjugate gradients of the linear and
+#: the second-order step it decides on (the change, compared with :data:`AUTO_RTOL`, to about this); the linear
+#: state, when kept, is solved again to :data:`LINEAR_RTOL`.
+PROBE_RTOL = 1e-6
+
+
+def _linear_state(model: FEModel, ops: _Operators, w2: float, softening: bool, factor, omega: float,
+                  solver: ReusedFactor, rtol: float = LINEAR_RTOL) -> np.ndarray:
+    """``(K − Ω² M⊥) u₀ = Ω² f₁`` (``K u₀ = Ω² f₁`` without ``softening``, with ``factor``, ``K``'s)."""
     if not softening:
-        return (factor if factor is not None else spd_factor(model.K, "K")).solve(w2 * ops.f1)
+        return factor.solve(w2 * ops.f1)
     A = sp.csr_array(model.K - w2 * ops.M_perp)
     try:  # definite below the first mode's speed; past it (slender blades) indefinite but regular
-        solver = spd_factor(A, "K - Ω² M⊥")
+        return solver.solve(A, w2 * ops.f1, rtol, "K - Ω² M⊥")
     except ValueError:
-        try:
-            solver = symmetric_factor(A, "K - Ω² M⊥")
-        except ValueError:
-            rpm = omega * 60 / (2 * math.pi)
-            raise ValueError(f"at {omega:.6g} rad/s ({rpm:.6g} rpm) K − Ω² M⊥ is singular: the speed is a "
-                             "critical speed of the blade's spin softening; choose another speed") from None
-    return solver.solve(w2 * ops.f1)
+        rpm = omega * 60 / (2 * math.pi)
+        raise ValueError(f"at {omega:.6g} rad/s ({rpm:.6g} rpm) K − Ω² M⊥ is singular: the speed is a "
+                         "critical speed of the blade's spin softening; choose another speed") from None
+
+
+def _nearest(previous, model: FEModel, axis: RotationAxis, omega: float) -> list[SpinState]:
+    """``previous`` (:func:`spin`) checked, the nearest speed first."""
+    states = list(previous) if previous is not None else []
+    for i, s in enumerate(states):
+        if not isinstance(s, SpinState) or s.model.n_dofs != model.n_dofs:
+            raise ValueError(f"previous[{i}] must be a SpinState of this model ({model.n_dofs} free dofs) from "
+                             f"spin, got {type(s).__name__}")
+        if not (np.allclose(s.axis.origin, axis.origin) and np.allclose(s.axis.direction, axis.direction)):
+            raise ValueError(f"previous[{i}] spins about another axis ({s.axis}) than this state ({axis}): "
+                             "pass states about the same axis")
+    return sorted((s for s in states if s.speed > 0), key=lambda s: abs(s.speed - omega))
 
 
 #: ``static = "auto"``: the linear state is kept when one step of the second-order iteration moves it by less than
@@ -241,25 +292,22 @@ AUTO_RTOL = 1e-2
 AUTO_STATE = "nonlinear"
 
 
-def _second_order_step(model: FEModel, ops: _Operators, w2: float, u: np.ndarray) -> tuple[float, np.ndarray]:
+def _second_order_step(model: FEModel, ops: _Operators, w2: float, u: np.ndarray, solver: ReusedFactor,
+                       rtol: float = LINEAR_RTOL) -> tuple[float, np.ndarray]:
     """One step of the second-order iteration from ``u``: ``(relative change (max norm), new state)``."""
     A = sp.csr_array(model.K + ops.stress_stiffness(u) - w2 * ops.M_perp)
-    try:
-        solver = spd_factor(A, "K + K_σ − Ω² M⊥")
-    except ValueError:
-        solver = symmetric_factor(A, "K + K_σ − Ω² M⊥")
-    new = solver.solve(w2 * ops.f1)
+    new = solver.solve(A, w2 * ops.f1, rtol, "K + K_σ − Ω² M⊥")
     return float(np.abs(new - u).max()) / max(float(np.abs(new).max()), 1e-300), new
 
 
 def _second_order(model: FEModel, ops: _Operators, w2: float, u: np.ndarray, omega: float, change: float,
-                  rtol: float = 1e-6, max_iter: int = 30) -> tuple[np.ndarray, int]:
+                  solver: ReusedFactor, rtol: float = 1e-6, max_iter: int = 30) -> tuple[np.ndarray, int]:
     """The fixed point of ``(K + K_σ(u) − Ω² M⊥) u = Ω² f₁`` from its first step ``u`` (which moved the linear state
     by ``change``): ``(u, iterations)``."""
     for k in range(1, max_iter + 1):
         if change <= rtol:
             return u, k
-        change, u = _second_order_step(model, ops, w2, u)
+        change, u = _second_order_step(model, ops, w2, u, solver)
     raise ValueError(f"the second-order centrifugal state did not converge in {max_iter} iterations at {omega:.6g} "
                      f"rad/s (last relative change {change:.2e}): use static = 'linear' or 'nonlinear'")
 

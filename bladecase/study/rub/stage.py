@@ -27,6 +27,7 @@ area under refinement: it stays in ``rub_nodes.csv`` and ``rub.vtu`` as data, no
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -165,14 +166,33 @@ class _Interior:
         return self.basis
 
 
+class _Earlier:
+    """The centrifugal states this process solved for the speeds before (shipped to the workers empty): each speed
+    starts from them (:func:`bladecase.fe.rotation.spin`'s ``previous``: the nonlinear state from the two last, the
+    static solves preconditioned by the last one's factorisation of ``K(Ω)``; the older kept without its
+    factorisation)."""
+
+    def __init__(self):
+        self.states = []
+
+    def __getstate__(self) -> dict:
+        return {"states": []}
+
+    def add(self, state) -> None:
+        self.states = [replace(s, factor=None) for s in self.states[-1:]] + [state]
+
+
 def _rub_point(speed: float, *, model, contact: Contact, interior: np.ndarray | _Interior, size: int,
                casing: np.ndarray, angles: np.ndarray, axis: RotationAxis, static: str, lobes: int, amplitude: float,
                damping: Damping, revolutions: int, window: int, max_revolutions: int, friction: dict | None = None,
-               coating=None) -> dict:
+               coating=None, earlier: _Earlier | None = None) -> dict:
     """One speed (module level: an executor ships it to its workers). Its CPU seconds (``seconds``: the centrifugal
-    state, the reduction, the simulation) are logged in one line when it ends."""
+    state, the reduction, the simulation) and the centrifugal state's factorisations and conjugate-gradient solves
+    are logged in one line when it ends."""
     clock = [time.process_time()]
-    state = spin(model, speed, axis, static=static)
+    state = spin(model, speed, axis, static=static, previous=earlier.states if earlier is not None else ())
+    if earlier is not None:
+        earlier.add(state)
     hot = _running(model, contact, state.displacement, speed)
     clock.append(time.process_time())
     # about a geometrically nonlinear state the modes turn with the deformed blade: another speed's interior basis
@@ -201,17 +221,21 @@ def _rub_point(speed: float, *, model, contact: Contact, interior: np.ndarray | 
     out["clearances_m"] = reduced.system.gap.tolist()
     clock.append(time.process_time())
     out["seconds"] = dict(zip(("state", "reduction", "simulation"), np.diff(clock).tolist()))
+    out["state_solves"] = {"factorisations": state.factorisations, "krylov": state.krylov_iterations,
+                           "newton": state.iterations if state.static == "nonlinear" else 0}
     _log_point(speed, out)
     return out
 
 
 def _log_point(speed: float, out: dict) -> None:
     """One line per speed as it ends (a long sweep logs its progress even without a progress bar)."""
-    sec = out["seconds"]
+    sec, n = out["seconds"], out.get("state_solves") or {"factorisations": 0, "krylov": 0, "newton": 0}
     what = (f"refused ({out['error'][:80]})" if "error" in out else
             f"{out['switches']} switches over {out['revolutions_run']} revolutions, {out['response']}")
-    log.info("rub: %.6g rad/s: %s; %.1f s (centrifugal state %.1f s, reduction %.1f s, simulation %.1f s)", speed,
-             what, sum(sec.values()), sec["state"], sec["reduction"], sec["simulation"])
+    log.info("rub: %.6g rad/s: %s; %.1f s (centrifugal state %.1f s, reduction %.1f s, simulation %.1f s); "
+             "centrifugal state: %d Newton iterations, %d factorisations, %d conjugate-gradient solves", speed, what,
+             sum(sec.values()), sec["state"], sec["reduction"], sec["simulation"], n["newton"], n["factorisations"],
+             n["krylov"])
 
 
 def _meet(X: np.ndarray, F: np.ndarray, c2: float) -> float | None:
@@ -323,7 +347,8 @@ def rub_stage(study, model, contact: Contact, *, families=None, executor=None, p
              "revolutions each (the last %d read; on to at most %d until settled)", speeds.size, min(r["speeds"]),
              max(r["speeds"]), unit, k["lobes"], k["amplitude"] * 1e3, len(nodes),
              "rigid" if np.isinf(casing).all() else f"{casing.sum():.4g} N/m", r["revolutions"], r["window"], cap)
-    shared = dict(model=model, contact=contact, interior=interior, size=r["size"], casing=casing, angles=angles,
+    shared = dict(model=model, contact=contact, interior=interior, earlier=_Earlier(), size=r["size"],
+                  casing=casing, angles=angles,
                   axis=axis, static=static, lobes=k["lobes"], amplitude=k["amplitude"], damping=damping,
                   revolutions=r["revolutions"], window=r["window"], max_revolutions=cap,
                   **({"friction": friction} if friction is not None else {}),
