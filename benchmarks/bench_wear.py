@@ -106,7 +106,9 @@ def main() -> None:
         y = wear["coating"]["yield_pa"] * 1e-6
         print(f"      peak contact pressure over the revolutions {w['peak_pressure_mpa']:.6g} MPa (yield {y:g} MPa; "
               f"peak / yield - 1 = {w['peak_pressure_mpa'] / y - 1:.1e})")
-        print(f"      last {c['window']} revolutions: wear {c['lobes']} lobes"
+        first = c["last"] - c["window"] + 1
+        read = f"revolutions {first}-{c['last']} (the last that wore)" if c["last"] else "none wore"
+        print(f"      {read}: wear {c['lobes']} lobes"
               + (f" (rival harmonic {c['rival']})" if c["rival"] else "")
               + f"; response f_vib/f_rot = {c['ratio']:.3f} -> round {c['expected']}"
               + (f" (next line {c['second']:.3g} at {c['second_share']:.2f} of it)" if c["second_share"] else "")

@@ -111,8 +111,12 @@ def test_a_vibration_far_from_an_engine_order_smears_the_wear():
 
 def test_no_wear_in_the_window_and_bad_input():
     depths, tip = _worn([[(30e-6, 8, 0.0)]] + [[(10e-6, 8, 0.0)]] * 5)         # worn once, then never deeper
-    c = lobe_check(depths, tip, PER_TURN)
-    assert c.verdict == "undefined" and c.reason == "no coating removed over the 4 revolutions read"
+    c = lobe_check(depths, tip, PER_TURN)  # read on the revolution that wore it: the vibration that made the lobes
+    assert (c.verdict, c.last, c.window, c.lobes, c.expected) == ("agree", 1, 1, 8, 8)
+    c = lobe_check(np.zeros_like(depths), tip, PER_TURN)
+    assert c.verdict == "undefined" and c.reason == "no coating removed in any revolution" and c.last == 0
+    grown = _worn([[(30e-6, 8, 0.0)]] + [[(10e-6, 8, 0.0)]] * 2 + [[(40e-6, 8, 0.0)]] + [[(1e-6, 8, 0.0)]] * 2)
+    assert lobe_check(*grown, PER_TURN).last == 4  # the window ends with the last revolution that wore
     with pytest.raises(ValueError, match="window must be an integer >= 1"):
         lobe_check(depths, tip, PER_TURN, window=0)
     with pytest.raises(ValueError, match=r"one row per revolution and tip 400 samples a row, got \(6, 90\) and"):

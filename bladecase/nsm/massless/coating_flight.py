@@ -346,7 +346,13 @@ class CoatingFlight:
         flat = on & (np.abs(d0) <= FLAT_RTOL * np.maximum(rate, np.finfo(float).tiny))
         span = horizon
         if flat.any():
-            span = min(span, min(self._leave(sig, k, horizon) for k in np.flatnonzero(flat)))
+            leave = []
+            for k in np.flatnonzero(flat):
+                try:
+                    leave.append(self._leave(sig, k, horizon))
+                except ValueError:  # it stays on its surface: a switch now (e.g. a node that stopped yielding
+                    return (0.0, int(k)), 0.0  # yields on: its removal rate only grazed zero)
+            span = min(span, min(leave))
             keep = ~flat
             sig = _Signals(sig.lam, sig.C * keep[:, None], sig.E * keep, sig.nu, np.where(keep, sig.const, 1.0),
                            sig.lam2)
@@ -383,6 +389,7 @@ class CoatingFlight:
         before = w
         codes, w = self.decide(q, p, t, w)
         starts, cl, wl, qs, ps, amps, jumps = [], [], [], [], [], [], []
+        still = 0  # switches in a row at the same instant
         while len(starts) <= max_switches:
             ph = self.phase(codes, w)
             a = ph.amplitudes(q, p, t)
@@ -403,6 +410,10 @@ class CoatingFlight:
                 codes, w, before = self._step(ph, codes, w, q, p, t, profile, edges <= t)
                 continue
             tau, k = hit
+            still = still + 1 if tau == 0.0 else 0
+            if still > 2 * s.m + 2:  # switching back and forth without moving
+                raise ValueError(f"grazing switch at t = {t:.12g} s: a node that stopped yielding does not leave its "
+                                 "yield force")
             q, p = ph.advance(a, t, tau)
             t += tau
             codes, w = self.settle(codes, w, q, p, t, first=k, ph=ph)

@@ -3,7 +3,9 @@
 
 A tip vibrating at ``f_vib`` while the blade turns at ``f_rot`` meets the casing ``f_vib / f_rot`` times a
 revolution: near an engine order ``N`` it wears ``N`` lobes. The check reads each side from its own data only, over
-the SAME last ``window`` revolutions:
+the SAME ``window`` revolutions — the last ones that wore the coating (a revolution wears when it deepens some cell
+by more than :data:`WEAR_FLOOR` of the final profile's deepest wear): a coating worn to the tip's reach wears no more,
+and the vibration that made its lobes is the one of the revolutions that removed it:
 
 - **the lobes** from the profile alone: the coating removed over the window (the profile at the end less the
   profile before the window), its strongest circumferential harmonic
@@ -16,7 +18,7 @@ the SAME last ``window`` revolutions:
 
 The verdict is ``"agree"`` or ``"differ"`` where both are defined, else ``"undefined"`` with the reason:
 
-- no coating removed over the window;
+- no coating removed in any revolution;
 - the profile has no one lobe count: another harmonic, not a multiple of the strongest, within
   :data:`~bladecase.nsm.massless.wear.LOBE_SHARE` of it;
 - the response has no one frequency: another spectral line (beyond the strongest's main lobe, above half an
@@ -46,6 +48,9 @@ from .wear import LOBE_SHARE, harmonic_lobes
 
 __all__ = ["LobeCheck", "dominant_ratio", "lobe_check", "lobe_words"]
 
+#: A revolution wears the coating when it deepens some cell by more than this share of the final deepest wear.
+WEAR_FLOOR = 1e-6
+
 #: The lowest frequency over the rotation's that counts as a vibration (slower: the drift of the tip's mean
 #: position): half an engine order, which would wear no lobe.
 LOWEST_RATIO = 0.5
@@ -57,7 +62,8 @@ class LobeCheck:
     (revolutions read), the ``lobes`` of the wear over the window and their ``rival`` harmonic (``0``: none),
     ``ratio`` = f_vib / f_rot and the runner-up spectral line's ratio and share of the strongest (``second``,
     ``second_share``), ``expected`` = round(ratio), ``reason`` (empty unless undefined), and the strongest line of
-    each revolution of the window alone (``per_revolution``: a vibration that stays one shows one value)."""
+    each revolution of the window alone (``per_revolution``: a vibration that stays one shows one value), and the
+    window's ``last`` revolution (counted from 1; ``0``: no revolution wore the coating)."""
 
     verdict: str
     window: int
@@ -69,6 +75,7 @@ class LobeCheck:
     expected: int
     reason: str
     per_revolution: tuple = ()
+    last: int = 0
 
     def as_dict(self) -> dict:
         """The check as plain numbers and words."""
@@ -123,15 +130,18 @@ def lobe_check(depths, tip, samples_per_turn: int, window: int = 4, share: float
     if depths.shape[0] != tip.shape[0] or tip.shape[1] != samples_per_turn:
         raise ValueError(f"depths and tip must hold one row per revolution and tip {samples_per_turn} samples a row, "
                          f"got {depths.shape} and {tip.shape}")
-    n = min(int(window), depths.shape[0])
-    worn = depths[-1] - (depths[-1 - n] if n < depths.shape[0] else 0.0)
+    gained = np.diff(depths, axis=0, prepend=0.0).max(axis=1)  # each revolution's deepest new wear
+    wearing = np.flatnonzero(gained > WEAR_FLOOR * max(float(depths[-1].max()), 0.0))
+    last = int(wearing[-1]) + 1 if wearing.size else depths.shape[0]  # the window ends with the last wearing turn
+    n = min(int(window), last)
+    worn = depths[last - 1] - (depths[last - 1 - n] if n < last else 0.0)
     lobes, rival = harmonic_lobes(worn, share)
-    ratio, second, second_share = dominant_ratio(tip[-n:].ravel(), samples_per_turn)
+    ratio, second, second_share = dominant_ratio(tip[last - n:last].ravel(), samples_per_turn)
     expected = int(round(ratio))
     eps = ratio - expected
     reasons = []
-    if not np.any(worn > 0):
-        reasons.append(f"no coating removed over the {n} revolutions read")
+    if not wearing.size:
+        reasons.append("no coating removed in any revolution")
     elif rival:
         reasons.append(f"the wear over the {n} revolutions read has no one lobe count: harmonic {rival} is within "
                        f"{share:g} of harmonic {lobes}")
@@ -142,8 +152,9 @@ def lobe_check(depths, tip, samples_per_turn: int, window: int = 4, share: float
         reasons.append(f"f_vib / f_rot = {ratio:.3g} is {abs(eps):.2g} from the engine order {expected}: over the {n} "
                        f"revolutions read the lobes drift by {abs(eps) * n:.2g} lobe lengths, the wear is smeared")
     verdict = "undefined" if reasons else ("agree" if lobes == expected else "differ")
-    each = tuple(dominant_ratio(row, samples_per_turn)[0] for row in tip[-n:])
-    return LobeCheck(verdict, n, lobes, rival, ratio, second, second_share, expected, "; ".join(reasons), each)
+    each = tuple(dominant_ratio(row, samples_per_turn)[0] for row in tip[last - n:last])
+    return LobeCheck(verdict, n, lobes, rival, ratio, second, second_share, expected, "; ".join(reasons), each,
+                     last if wearing.size else 0)
 
 
 def lobe_words(c: dict) -> str:

@@ -55,7 +55,7 @@ def wear_plot(section: dict, points: list[dict], title: str | None = None) -> Fi
             bx.annotate(_lobe_label(r), (s, v), textcoords="offset points", xytext=(0, 6), ha="center", fontsize=8)
         bx.set_xlabel(f"speed ({section['speed_unit']})")
         bx.set_ylabel("removed volume (mm³)")
-        bx.set_title("coating removed at each speed; lobes removed over the last revolutions = or ≠ "
+        bx.set_title("coating removed at each speed; lobes removed over the last wearing revolutions = or ≠ "
                      "round(f_vib / f_rot)\n(?: no lobe count to compare)", fontsize=9)
         bx.grid(alpha=0.3)
     if title:
@@ -65,8 +65,8 @@ def wear_plot(section: dict, points: list[dict], title: str | None = None) -> Fi
 
 
 def _lobe_label(r: dict) -> str:
-    """A speed's lobes against round(f_vib / f_rot) over the last revolutions (its final profile's lobes without
-    the check)."""
+    """A speed's lobes against round(f_vib / f_rot) over the last revolutions that wore the coating (its final
+    profile's lobes without the check)."""
     c = r.get("lobe_check")
     if not c:
         return f"{r['lobes']}"

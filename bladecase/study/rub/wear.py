@@ -93,7 +93,7 @@ def wear_figures(w) -> dict:
 def wear_section(study, coating: Abradable, rows: list[dict], points: list[dict]) -> dict:
     """The summary's ``rub.wear``: the coating, per speed the final lobes and depth, the removed volume against the
     profile's missing volume, the response's vibration frequency over the rotation's, the held-out check of the
-    lobes worn over the last revolutions against it (``lobe_check``:
+    lobes worn over the last revolutions that wore the coating against it (``lobe_check``:
     :func:`~bladecase.nsm.massless.wear_lobes.lobe_check`, as a dict); the speed of most wear."""
     per = []
     for row, p in zip(rows, points):
@@ -123,8 +123,11 @@ def log_wear(section: dict, unit: str) -> None:
                  "the tip vibrates at %.3g × the rotation frequency)", w["speed"], unit, w["max_depth_um"], w["lobes"],
                  w["revolutions"], w["removed_mm3"], w["vibration_ratio"])
         c = w.get("lobe_check")
-        if c:
-            log.info("rub: at %.6g %s, over the last %d revolutions: %s", w["speed"], unit, c["window"], lobe_words(c))
+        if c and c.get("last"):
+            log.info("rub: at %.6g %s, over revolutions %d to %d (the last that wore the coating): %s", w["speed"],
+                     unit, c["last"] - c["window"] + 1, c["last"], lobe_words(c))
+        elif c:
+            log.info("rub: at %.6g %s: %s", w["speed"], unit, lobe_words(c))
 
 
 
