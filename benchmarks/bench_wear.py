@@ -15,16 +15,15 @@ the removed volume against the profile's missing area × the band's width, the s
     python benchmarks/bench_wear.py                          # 1550, 1626, 1700 rpm, 12 revolutions, 180 cells
     python benchmarks/bench_wear.py --speeds 1626 --revolutions 6 --cells 90 --mu 0.15
 
-Measured (``--speeds 1550 1600 1626 1650 1700 --revolutions 12 --cells 90``, a busy two-core machine, 279 s): peak
-pressure 2 MPa = the yield at every speed (peak / yield − 1 = 2.5e-11 to 2.3e-10); f_vib / f_rot = 8.37, 7.99, 7.99,
-7.89, 7.67; every final profile 8 lobes, 141 to 593 µm deep, none worn through; agree at 1600 and 1626 rpm (8
-lobes), undefined at 1550 rpm (no one lobe count in the last four revolutions' wear, a vibration 0.37 from the
-engine order: smeared) and at 1650 and 1700 rpm (no coating removed over the last four revolutions); removed volume
-= missing volume to 2e-16. With the coating elastic within a revolution (before): peak pressures 5 to 1000 MPa,
-agree at 1600 and 1626 rpm (8 and 10 lobes), undefined at 1550, 1650 and 1700 rpm (several vibration frequencies).
-With ``--mu 0.15`` (196 s): every speed goes through (before: refused at all five, contact phases with friction
-diverging); peak / yield − 1 = 7.5e-12 to 2.1e-11; 8 lobes, 146 to 269 µm deep; agree at 1626 rpm, undefined at
-1550, 1600, 1650 and 1700 rpm (no coating removed over the last four revolutions).
+Measured (``--speeds 1550 1600 1626 1650 1700 --revolutions 12 --cells 90``, a busy two-core machine, 137 s): peak
+pressure 2 MPa = the yield at every speed (peak / yield − 1 = 2.5e-11 to 2.3e-10); every final profile 8 lobes, 141
+to 593 µm deep, none worn through; the check on the last four revolutions that wore the coating: agree at 1600,
+1626 and 1650 rpm (8 lobes; f_vib / f_rot = 7.99, 7.99, 7.89), differ nowhere, undefined at 1550 and 1700 rpm
+(8.38 and 7.80: the lobes drift by 1.5 and 0.8 lobe lengths over the revolutions read, smeared); removed volume =
+missing volume to 2e-16. With ``--mu 0.15`` (151 s): every speed goes through (with the coating elastic within a
+revolution: refused at all five, contact phases with friction diverging); peak / yield − 1 = 1.4e-11 to 1.8e-11;
+8 lobes, 146 to 269 µm deep; agree at 1626 and 1650 rpm, differ nowhere, undefined at 1550, 1600 and 1700 rpm
+(8.38, 8.14, 7.75: smeared). With the coating elastic within a revolution (before): peak pressures 5 to 1000 MPa.
 """
 
 from __future__ import annotations
