@@ -39,7 +39,7 @@ from bench_rotor37 import ccx_deck, dat_frequencies  # noqa: E402
 
 COUNT, GOAL = 20, 0.5
 THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "CCX_NPROC_EQUATION_SOLVER",
-               "CCX_NPROC_STIFFNESS", "BLADECASE_BLAS_THREADS")
+               "CCX_NPROC_STIFFNESS")
 
 CHILD = r"""
 import json, sys, time
