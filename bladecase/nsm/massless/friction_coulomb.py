@@ -202,8 +202,18 @@ class CoulombFlight:
                 if i == j:  # the switching node itself: its next option
                     break
                 new, anc = put(i, self._options(cand, i, kind_i, new, p, t)[0], new, anc)
+        if self._grazes(ph, k, q, p, t, anchors) and not self._violations(codes, anchors, q, p, t)[1]:
+            return codes, anchors  # the signal touched its surface and turns back: the phase goes on
         raise ValueError(f"at t = {t:.12g} s contact node {self.system.nodes[j]} ({kind} signal at 0) has no "
                          f"admissible next state (tried {[_NAMES[c] for c in order]}): a grazing or degenerate switch")
+
+    def _grazes(self, ph: CoulombPhase, k: int, q, p, t: float, anchors) -> bool:
+        """Whether the signal ``k`` of the phase ``ph`` touches its surface at ``t`` and turns back: flat there
+        (its slope round-off, :data:`FLAT_RTOL` of its rate terms) and curving up."""
+        sig = ph.signals(self, ph.amplitudes(q, p, t, anchors), t, anchors, 0.0)
+        d0 = sig.values(0.0)[1][0, k]
+        rate = np.abs(sig.C[k]) @ np.abs(sig.lam) + np.abs(sig.E[k]) * sig.nu + np.abs(sig.slope[k])
+        return bool(abs(d0) <= FLAT_RTOL * max(rate, np.finfo(float).tiny) and sig.second()[k] > 0)
 
     def initial(self, q, p, t: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """The codes and anchors of a state: the closed nodes from the normal complementarity problem, each sliding
@@ -274,10 +284,17 @@ class CoulombFlight:
         """The first switch of a flight (``(τ, signal)``, or ``None``) and the span searched."""
         sig = ph.signals(self, amp, t, anchors, horizon)
         f0, d0 = (v[0] for v in sig.values(0.0))
-        scale = np.maximum(sig.magnitude, np.finfo(float).tiny)
         rate = np.abs(sig.C) @ np.abs(sig.lam) + np.abs(sig.E) * sig.nu + np.abs(sig.slope)
-        on = np.abs(f0) <= SURFACE_RTOL * scale
-        flat = on & (np.abs(d0) <= FLAT_RTOL * np.maximum(rate, np.finfo(float).tiny))
+        flat_rate = np.abs(d0) <= FLAT_RTOL * np.maximum(rate, np.finfo(float).tiny)
+        # a signal the switch left on its surface (to :meth:`_violations`' tolerance), below it by round-off and
+        # leaving it, is put on it: its start is the switch's, not a crossing of its own
+        near = (f0 < 0) & (np.abs(f0) <= ADMISSIBLE_RTOL * _start_scale(sig)) & ((d0 > 0) | flat_rate)
+        if near.any():
+            sig = _lifted(sig, np.where(near, -f0, 0.0))
+            f0 = np.where(near, 0.0, f0)
+        scale = np.maximum(sig.magnitude, np.finfo(float).tiny)
+        on = (np.abs(f0) <= SURFACE_RTOL * scale) | near
+        flat = on & flat_rate
         span = horizon
         if flat.any():
             span = min(span, min(self._leave(sig, k, horizon) for k in np.flatnonzero(flat)))
@@ -310,6 +327,18 @@ class CoulombFlight:
 
 
 _NAMES = {v: k for k, v in CODES.items()}
+
+
+def _start_scale(sig: RampSignals) -> np.ndarray:
+    """The signals' sizes at a phase's start (the ramp's growth over the flight left out), as
+    :meth:`CoulombFlight._violations` measures them."""
+    return np.maximum(np.abs(sig.C).sum(axis=1) + np.abs(sig.E) + np.abs(sig.base), np.finfo(float).tiny)
+
+
+def _lifted(sig: RampSignals, shift: np.ndarray) -> RampSignals:
+    """``sig`` with each signal raised by ``shift`` (its constant part)."""
+    return RampSignals(sig.lam, sig.C, sig.E, sig.nu, sig.const + shift, sig.lam2, sig.slope, sig.base + shift,
+                       sig.horizon)
 
 
 @dataclass(frozen=True, eq=False)
