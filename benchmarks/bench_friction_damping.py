@@ -34,6 +34,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
@@ -44,7 +45,14 @@ from bladecase.nsm import Damping  # noqa: E402
 from bladecase.nsm.massless.friction import Friction  # noqa: E402
 from bladecase.nsm.massless.friction_modes import friction_mode  # noqa: E402
 from bladecase.nsm.massless.friction_modes_coulomb import coulomb_decay_ratio, coulomb_mode, orbit_kinetic  # noqa: E402
-from bladecase.nsm.massless.friction_modes_forced import forced_sweep, half_power, refine_peak, resonance  # noqa: E402
+from bladecase.nsm.massless.friction_modes_forced import (  # noqa: E402
+    flank_mode,
+    forced_sweep,
+    half_power,
+    refine_flanks,
+    refine_peak,
+    resonance,
+)
 from bladecase.nsm.massless.nodes import NodalSystem  # noqa: E402
 from bladecase.reduction.nodal_friction import nodal_friction  # noqa: E402
 from bladecase.study.rub import stage  # noqa: E402
@@ -83,12 +91,22 @@ def jenkins() -> None:
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--amplitudes", type=float, nargs="+", default=[1.5, 2.0, 2.5, 3.0])
-    ap.add_argument("--nodes", type=int, nargs="+", default=[0, 8, 17, 25])
+    ap.add_argument("--nodes", type=int, nargs="+", default=None, help="a subset of the tip nodes (default: all)")
     ap.add_argument("--rpm", type=float, default=1650.0)
     ap.add_argument("--points", type=int, default=21)
+    ap.add_argument("--span", type=float, default=3.0, help="the sweep's half-width in zeta(sqrt2 a) (relative)")
     ap.add_argument("--refine", type=int, default=10, help="golden-section evaluations at the peak (0: none)")
+    ap.add_argument("--flank-steps", type=int, default=2, help="secant evaluations on each flank at a")
+    ap.add_argument("--rtol", type=float, default=1e-6, help="a forced point's settling: amplitude change a period")
+    ap.add_argument("--no-jenkins", action="store_true", help="skip the Jenkins oscillator's checks")
     a = ap.parse_args()
-    jenkins()
+    with threadpool_limits(limits=1, user_api="blas"):  # small dense phases: threads only wait for each other
+        if not a.no_jenkins:
+            jenkins()
+        run(a)
+
+
+def run(a) -> None:
     t0 = time.perf_counter()
     study, model, contact = demo()
     reduced, _, _ = at_speed(study, model, contact, a.rpm, nodes=a.nodes)
@@ -97,7 +115,9 @@ def main() -> None:
     s = reduced.system
     omega, phi = s.modes
     grazing = float(np.min(s.gap / np.abs(s.W.T @ phi[:, 0])))
-    print(f"the demo blade at {a.rpm:g} rpm, tip nodes {a.nodes} of {len(contact.nodes)}: n = {s.n}, m = {s.m}, "
+    free = Friction(0.0, T=fr.T, C_nt=fr.C_nt, C_tt=fr.C_tt)
+    nodes = "all" if a.nodes is None else a.nodes
+    print(f"the demo blade at {a.rpm:g} rpm, tip nodes {nodes} of {len(contact.nodes)}: n = {s.n}, m = {s.m}, "
           f"f1 = {omega[0] / 2 / np.pi:.3f} Hz open, grazing amplitude {grazing:.4g}; mu = {MU}, stick–slip, casing "
           f"at rest, {DAMPING.zeta:.1%} damping ({time.perf_counter() - t0:.1f} s to build)")
     guess = None
@@ -113,26 +133,41 @@ def main() -> None:
               f"{m.orbit.starts.size} phases; free decay {z_decay:.6f} ({z_decay / m.zeta - 1:+.2%}); "
               f"{time.perf_counter() - t:.1f} s; the orbit's kinetic integral over a harmonic mode's pi w a^2: "
               f"{kappa:.4f}")
-        force = 2 * m.zeta * m.frequency**2 * amp
+        # the force that puts the peak at sqrt2 a: the flanks at a then lie near the half-power points
+        top = coulomb_mode(s, fr, np.sqrt(2) * amp, damping=DAMPING, guess=m)
+        force = 2 * top.zeta * top.frequency**2 * np.sqrt(2) * amp
         shape = 1j * force * (s.M @ phi[:, 0])  # −F sin Ωt: in phase resonance with the orbit x0 cos Ωt
         t = time.perf_counter()
-        ws = m.frequency * (1 + m.zeta * np.linspace(-2.5, 2.5, a.points))
+        ws = top.frequency * (1 + top.zeta * np.linspace(-a.span, a.span, a.points))
         mid = a.points // 2
-        state = (m.x0, m.v0, m.codes, m.anchors)
-        up = forced_sweep(s, fr, shape, ws[mid:], DAMPING, state=state, rtol=1e-6)
-        down = forced_sweep(s, fr, shape, ws[mid::-1], DAMPING, state=state, rtol=1e-6)
-        pts = refine_peak(s, fr, shape, down[::-1] + up[1:], DAMPING, rtol=1e-6, evaluations=a.refine)
+        state = (top.x0, top.v0, top.codes, top.anchors)
+        up = forced_sweep(s, fr, shape, ws[mid:], DAMPING, state=state, rtol=a.rtol)
+        down = forced_sweep(s, fr, shape, ws[mid::-1], DAMPING, state=state, rtol=a.rtol)
+        pts = refine_peak(s, fr, shape, down[::-1] + up[1:], DAMPING, rtol=a.rtol, evaluations=a.refine)
         r = resonance(pts, force)
+        lo_w, hi_w, pts = refine_flanks(s, fr, shape, pts, amp, DAMPING, rtol=a.rtol, evaluations=a.flank_steps)
         unsettled = sum(not p.settled for p in pts)
-        print(f"   forced F = {force:.4g} (modal): {len(pts)} frequencies in {time.perf_counter() - t:.1f} s "
-              f"({sum(p.periods for p in pts)} periods, {unsettled} not settled to 1e-6): peak a = {r.amplitude:.5g} "
-              f"({r.amplitude / amp - 1:+.2%} from a) at {r.frequency / 2 / np.pi:.4f} Hz")
-        mp = coulomb_mode(s, fr, r.amplitude, damping=DAMPING, guess=m)
-        z0 = friction_mode(s, Friction(0.0, T=fr.T, C_nt=fr.C_nt, C_tt=fr.C_tt), r.amplitude, damping=DAMPING).zeta
+        print(f"   forced F = {force:.4g} (modal; phase resonance at sqrt2 a by the EPMC): {len(pts)} frequencies in "
+              f"{time.perf_counter() - t:.1f} s ({sum(p.periods for p in pts)} periods, {unsettled} not settled to "
+              f"{a.rtol:g}): peak a = {r.amplitude:.5g} ({r.amplitude / (np.sqrt(2) * amp) - 1:+.2%} from sqrt2 a) "
+              f"at {r.frequency / 2 / np.pi:.4f} Hz")
+        z0 = friction_mode(s, free, amp, damping=DAMPING).zeta
+        if lo_w is None or hi_w is None:
+            print(f"   width at a: the sweep does not reach a = {amp:.5g} on both flanks")
+        else:
+            w_w, z_w = flank_mode(lo_w, hi_w, force, amp)
+            print(f"   resonance width at a = {k:g} x grazing: flanks {lo_w / 2 / np.pi:.4f}, "
+                  f"{hi_w / 2 / np.pi:.4f} Hz "
+                  f"-> single nonlinear mode f(a) = {w_w / 2 / np.pi:.4f} Hz (EPMC {w_w / m.frequency - 1:+.2e}), "
+                  f"zeta(a) {z_w:.6f} against the EPMC's {m.zeta:.6f}: {rel(z_w, m.zeta)}; friction's share "
+                  f"{z_w - z0:.3e} against {m.zeta - z0:.3e} (without friction zeta {z0:.6f}): "
+                  f"{rel(z_w - z0, m.zeta - z0)}")
+        mp = coulomb_mode(s, fr, r.amplitude, damping=DAMPING, guess=top)
+        zp0 = friction_mode(s, free, r.amplitude, damping=DAMPING).zeta
         print(f"   EPMC at a_peak: zeta {mp.zeta:.6f}, f = {mp.frequency / 2 / np.pi:.4f} Hz; without friction "
-              f"zeta {z0:.6f} (friction's part {mp.zeta - z0:.3e})")
+              f"zeta {zp0:.6f} (friction's part {mp.zeta - zp0:.3e})")
         print(f"   phase resonance zeta_F = F/(2 w^2 a) = {r.zeta_phase:.6f}: {rel(r.zeta_phase, mp.zeta)}; friction's "
-              f"part {r.zeta_phase - z0:.3e}: {(r.zeta_phase - z0) / (mp.zeta - z0) - 1:+.2%}")
+              f"part {r.zeta_phase - zp0:.3e}: {(r.zeta_phase - zp0) / (mp.zeta - zp0) - 1:+.2%}")
         if r.zeta_half_power is None:
             print("   half-power: the sweep does not reach a_peak/sqrt2 on both flanks")
             continue
