@@ -5,12 +5,17 @@ Jenkins element, the energy balance and an independent time-stepping integrator 
 
 from __future__ import annotations
 
+from pathlib import Path
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
+from bladecase.nsm import Damping
 from bladecase.nsm.massless.friction import Friction
-from bladecase.nsm.massless.friction_coulomb import CODES, simulate_coulomb
+from bladecase.nsm.massless.friction_coulomb import CODES, CoulombFlight, simulate_coulomb
 from bladecase.nsm.massless.friction_coulomb_rub import coulomb_energy
+from bladecase.nsm.massless.friction_modes_coulomb import coulomb_decay_ratio
 from bladecase.nsm.massless.nodes import NodalSystem
 
 # a normal dof (KN) pressed by a load F on m massless nodes (each 1/KC of its own, HOFF shared), a tangential dof (K)
@@ -125,23 +130,51 @@ def stepped(s: NodalSystem, f: Friction, x0, t_end: float, h: float) -> tuple[np
 def test_coupled_nodes_against_time_stepping_and_energy():
     """Three coupled nodes on a tip that bends and twists (lever arms −0.5, 0, 0.5): the nodes stick and slide at
     different, close times. Against the independent time-stepping integrator with its coupled return mapping (steps
-    2e-3 and 1e-3 s) the tangential dofs agree to 1e-6 of their range (4.4e-7 measured; the error falling with the
-    step), and the
-    energy balance closes over each 2 s to 1e-10: the friction's work is the stored energy's change."""
+    2e-3 and 1e-3 s) the tangential dofs agree to 5e-7 of their range (1.6e-7 measured; the error falling with the
+    step squared), and the energy balance closes over each 2 s to 1e-10: the friction's work is the stored
+    energy's change."""
     s, f, x = tip(3, twist=[-0.5, 0.0, 0.5])
     x[1:] = 12.0, -3.0
-    t_end = 8.0
+    t_end = 6.0
     tr = simulate_coulomb(s, f, x, np.zeros(3), t_end, sliding=0.0, load=[F, 0.0, 0.0])
     assert tr.complete
     c = tr.codes
     assert np.all(tr.stick_time() > 0.1) and np.any(c == CODES["slip+"]) and np.any(c == CODES["slip-"])
     changes = tr.starts[1:][np.any(c[1:] != c[:-1], axis=1)]
-    assert changes.size > 10
+    assert changes.size >= 8
     errors = []
     for h in (2e-3, 1e-3):
         t, ref = stepped(s, f, x, t_end, h)
         errors.append(np.abs(tr.state(t[::10])[0][1:] - ref[::10].T).max(axis=1) / np.ptp(ref, axis=0))
-    assert np.all(errors[1] < 1e-6) and np.all(errors[1] < 0.6 * errors[0])
+    assert np.all(errors[1] < 5e-7) and np.all(errors[1] < 0.4 * errors[0])
     for t0 in np.arange(0.0, t_end, 2.0):
         e = coulomb_energy(tr, t0, t0 + 2.0)
         assert abs(e.relative) < 1e-10 and e.friction < 0
+
+
+def demo_tip() -> tuple[NodalSystem, Friction, dict]:
+    """The demo blade's 26 tip nodes at 1650 rpm (its nodal model of 8 interior dofs, μ = 0.15) and the start of its
+    first mode's orbit at 1.5 times the grazing amplitude by the extended periodic motion concept, stored."""
+    d = dict(np.load(Path(__file__).parent / "data" / "demo_tip_stick_slip.npz"))
+    s = NodalSystem(d["M"], d["S"], d["W"], d["flexibility"], d["gap"], d["casing"], nodes=tuple(d["nodes"].tolist()))
+    return s, Friction(float(d["mu"]), T=d["T"], C_nt=d["C_nt"], C_tt=d["C_tt"], model="coulomb"), d
+
+
+def test_demo_tip_turns_round_on_all_26_nodes():
+    """The demo blade's tip against a casing at rest: its 26 nodes turn round within nanoseconds of each other, each
+    sticking, and a neighbour's stick leaves another's friction force on the cone by the round-off of the phase's
+    solves (the run stopped there before). One period of free decay from the mode's start: the energy balance
+    closes to 1e-9 and the decay's ratio is the concept's within 1 % (−0.54 % measured)."""
+    s, f, d = demo_tip()
+    period = float(d["period"])
+    mode = SimpleNamespace(x0=d["x0"], v0=d["v0"], codes=d["codes"], anchors=d["anchors"], period=period,
+                           frequency=2 * np.pi / period)
+    damping = Damping(zeta=0.005)
+    assert coulomb_decay_ratio(s, f, mode, damping) == pytest.approx(float(d["zeta"]), rel=0.01)
+    fl = CoulombFlight(s, f, damping, sliding=0.0)
+    fl._stick_anchors = lambda codes, q, t: d["anchors"].copy()        # the mode's stuck nodes where they stick
+    tr = fl.simulate(d["x0"], d["v0"], period, codes=d["codes"])
+    c = tr.codes
+    assert tr.complete and np.any(c == CODES["stick"]) and np.any(c == CODES["slip+"]) and np.any(c == CODES["slip-"])
+    e = coulomb_energy(tr, 0.0, period)
+    assert abs(e.relative) < 1e-9 and e.friction < 0

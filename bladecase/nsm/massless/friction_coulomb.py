@@ -30,6 +30,14 @@ force starts on the cone with the slip's rate, and moves inside it), so a revers
 which ``τ_j`` crosses from ``+μλ_j`` to ``−μλ_j``. That stick phase's cone signal starts with zero value and zero
 slope: it is let leave its surface over a first short flight (checked at sixteen points), then searched as the others.
 
+Coupled nodes often reach their switches together: a blade tip's nodes all turn round at about the same instant.
+The node that switches first changes its neighbours' force rates through the compliances, and a neighbour whose
+signal sits on its surface may have to change too (above). The new phase's signals are computed afresh, through
+solves that lose a few digits: a signal the switch leaves on its surface (to :data:`ADMISSIBLE_RTOL`) and leaving it
+may start just below it by round-off; it is put on it, so the next flight does not take that round-off for a
+switch. A signal that only touches its surface and turns back (flat there and curving up, such as a stuck node's
+force touching the cone once a period) keeps the phase when no next state of its node starts admissible.
+
 With ``V_j`` large enough that ``v_j`` never reaches 0 every contact slides along ``+`` and the phases are those of
 the rotation model (:class:`~bladecase.nsm.massless.friction.FrictionFlight`): the same orbit.
 
