@@ -1,28 +1,31 @@
 """The damping ratio of the demo blade's first mode with stick–slip friction against amplitude, checked against a
-forced response's resonance (goal: within 5 %).
+forced response's resonance width at the same amplitude (goal: within 5 %).
 
-The demo blade at 1650 rpm (its centrifugal state and nodal model as the rub study builds them), μ = 0.15 with the
-stick–slip model, 0.5 % structural damping, the casing at rest (sliding speed 0: classic hysteretic friction damping;
-with the casing sliding at ΩR the rotation model's friction does no net work on a free mode). The stick–slip
-simulator does not run the 26 tip nodes against a casing at rest (a grazing switch of the coupled massless nodes),
-so the tip is represented by ``--nodes`` of them (default 4, spread across the tip), sharing the casing's stiffness
-by their areas. First the same checks on the Jenkins oscillator of the tests; then at each amplitude (times the
-mode's grazing amplitude):
+The demo blade at 1650 rpm (its centrifugal state and nodal model as the rub study builds them), all 26 tip nodes
+(``--nodes``: a subset, sharing the casing's stiffness by their areas), μ = 0.15 with the stick–slip model, 0.5 %
+structural damping, the casing at rest (sliding speed 0: classic hysteretic friction damping; with the casing
+sliding at ΩR the rotation model's friction does no net work on a free mode). First the same checks on the Jenkins
+oscillator of the tests; then at each amplitude ``a`` (times the mode's grazing amplitude):
 
-1. the extended periodic motion concept: frequency and ζ(a); the free decay from the orbit's start (certified
-   simulator, without the term) beside it;
-2. the forced response to ``F cos Ωt`` along the mode's shape with ``F = 2ζ(a)ω(a)²a`` (phase resonance at a),
-   started in the mode's orbit, swept over ``--points`` frequencies across ±2.5 ζ(a) around ω(a), the top refined
-   by ``--refine`` golden-section evaluations: its peak
-   amplitude ``a_peak`` and frequency, and the damping it says two ways —
-   ``ζ_F = F / (2ω_peak²a_peak)`` (phase resonance) against ζ(a_peak) by the concept, and the half-power width
-   read as a linear mode's, ``(Ω₂ − Ω₁)/(2Ω_peak)``, against the same (and friction's part of ``ζ_F``: less the
-   mode's ratio without friction, by the rotation model's concept at μ = 0, against friction's part of ζ); and
-   the half-power frequencies predicted by the concept at ``a_peak/√2`` (a single nonlinear mode) against the
-   sweep's.
+1. the extended periodic motion concept (EPMC): frequency ω(a) and ζ(a); the free decay from the orbit's start
+   (certified simulator, without the term) beside it;
+2. the forced response to ``F cos Ωt`` along the mode's shape with ``F = 2ζ(√2a)ω(√2a)²·√2a`` (phase resonance at
+   √2·a by the EPMC, so that the curve passes through ``a`` near its half-power points), started in that mode's
+   orbit, swept over ``--points`` frequencies across ±``--span`` ζ(√2a) around ω(√2a), the top refined by
+   ``--refine`` golden-section evaluations;
+3. **the resonance width at a**: the two flank frequencies Ω₁ < Ω₂ where the response's amplitude is ``a`` (each
+   refined by ``--flank-steps`` secant evaluations) both belong to the single nonlinear mode's ω(a), ζ(a):
+   ``(ω² − Ω_i²)² + (2ζωΩ_i)² = (F/a)²`` (F the modal force) gives them (``flank_mode``), compared with the EPMC's
+   at ``a`` — ζ(a), and friction's share (less the mode's ratio without friction at ``a``, the rotation model's
+   concept at μ = 0);
+4. the earlier figures at the peak: ``ζ_F = F / (2ω_peak²a_peak)`` (phase resonance) against ζ(a_peak) by the
+   EPMC (and friction's part); the half-power width read as a linear mode's, ``(Ω₂ − Ω₁)/(2Ω_peak)``; the
+   half-power frequencies predicted by the EPMC at ``a_peak/√2`` against the sweep's.
 
-    python benchmarks/bench_friction_damping.py                       # 1.5, 2, 2.5, 3 x grazing
-    python benchmarks/bench_friction_damping.py --amplitudes 1.5 2
+    python benchmarks/bench_friction_damping.py                       # 1.5, 2, 2.5, 3 x grazing, all 26 nodes
+    python benchmarks/bench_friction_damping.py --amplitudes 1.5 2 --nodes 0 8 17 25
+
+Figures: FIGURES_PLACEHOLDER
 """
 
 from __future__ import annotations
