@@ -16,6 +16,7 @@ from bladecase.nsm.massless.friction import Friction
 from bladecase.nsm.massless.friction_coulomb import CODES, CoulombFlight, simulate_coulomb
 from bladecase.nsm.massless.friction_coulomb_rub import coulomb_energy
 from bladecase.nsm.massless.friction_modes_coulomb import coulomb_decay_ratio
+from bladecase.nsm.massless.friction_modes_forced import _Forced
 from bladecase.nsm.massless.nodes import NodalSystem
 
 # a normal dof (KN) pressed by a load F on m massless nodes (each 1/KC of its own, HOFF shared), a tangential dof (K)
@@ -178,3 +179,32 @@ def test_demo_tip_turns_round_on_all_26_nodes():
     assert tr.complete and np.any(c == CODES["stick"]) and np.any(c == CODES["slip+"]) and np.any(c == CODES["slip-"])
     e = coulomb_energy(tr, 0.0, period)
     assert abs(e.relative) < 1e-9 and e.friction < 0
+
+
+def test_demo_tip_nodes_on_the_cone_decided_together():
+    """The demo blade's tip driven near resonance at three times the grazing amplitude (stored: a phase start just
+    before the switch): one node's force reaches the cone while a neighbour's is 4e-11 s from its own, and one by
+    one no next state starts admissible (the run stopped there before) — the nodes on the cone are decided together
+    by the rate-level complementarity problem. Over the next millisecond (a fifth of a period, some twenty
+    switches) every node obeys Coulomb's law: normal forces >= 0, friction within the cone, a sliding node's at μλ
+    against its slip, a sticking node at rest."""
+    s, f, d = demo_tip()
+    fl = _Forced(s, f, Damping(zeta=0.005), 0.0, None, d["forced_shape"], float(d["forced_frequency"]),
+                 anchors=d["forced_anchors"])
+    t_end = 1e-3
+    tr = fl.simulate(d["forced_x"], d["forced_v"], t_end, codes=d["forced_codes"])
+    assert tr.complete and tr.switch_times[0] == pytest.approx(float(d["forced_switch"]), rel=1e-9)
+    assert tr.switch_times.size > 10
+    t = np.union1d(np.linspace(0.0, t_end, 2001), np.minimum(tr.starts + 1e-12, t_end))
+    codes = tr.codes[np.searchsorted(tr.starts, t, side="right") - 1].T
+    _, _, lam, tau, _, zd = tr.sample(t)
+    scale = lam.max()
+    assert np.all(lam >= -1e-9 * scale) and np.all(lam[codes == CODES["open"]] == 0)
+    # two nodes the switch leaves on the cone start outside it by the round-off of the phase's solves (8e-7 of
+    # the largest force measured, the signals' round-off ADMISSIBLE_RTOL), heading in
+    assert np.all(np.abs(tau) <= f.mu * lam + 2e-6 * scale)
+    slide = (codes == CODES["slip+"]) | (codes == CODES["slip-"])
+    sigma = np.where(codes == CODES["slip+"], 1.0, -1.0)
+    assert np.allclose(tau[slide], f.mu * sigma[slide] * lam[slide], rtol=0, atol=1e-9 * scale)
+    assert np.all(sigma[slide] * -zd[slide] >= -1e-6 * np.abs(zd).max())
+    assert np.all(np.abs(zd[codes == CODES["stick"]]) <= 1e-9 * np.abs(zd).max())
