@@ -32,7 +32,10 @@ slope: it is let leave its surface over a first short flight (checked at sixteen
 
 Coupled nodes often reach their switches together: a blade tip's nodes all turn round at about the same instant.
 The node that switches first changes its neighbours' force rates through the compliances, and a neighbour whose
-signal sits on its surface may have to change too (above). The new phase's signals are computed afresh, through
+signal sits on its surface may have to change too (above). When that, node by node, finds no admissible next state,
+the nodes on the friction cone (all sliding nodes, and the sticking ones whose force is on it) are decided together
+by the rate-level complementarity problem of their stick and slip, as the closed contacts of the model without
+friction are. The new phase's signals are computed afresh, through
 solves that lose a few digits: a signal the switch leaves on its surface (to :data:`ADMISSIBLE_RTOL`) and leaving it
 may start just below it by round-off; it is put on it, so the next flight does not take that round-off for a
 switch. A signal that only touches its surface and turns back (flat there and curving up, such as a stuck node's
