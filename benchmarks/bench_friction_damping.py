@@ -148,7 +148,12 @@ def run(a) -> None:
         down = forced_sweep(s, fr, shape, ws[mid::-1], DAMPING, state=state, rtol=a.rtol)
         pts = refine_peak(s, fr, shape, down[::-1] + up[1:], DAMPING, rtol=a.rtol, evaluations=a.refine)
         r = resonance(pts, force)
-        lo_w, hi_w, pts = refine_flanks(s, fr, shape, pts, amp, DAMPING, rtol=a.rtol, evaluations=a.flank_steps)
+        print(f"   sweep: {[(round(p.frequency / 2 / np.pi, 4), float(f'{p.amplitude:.6g}')) for p in pts]}")
+        try:
+            lo_w, hi_w, pts = refine_flanks(s, fr, shape, pts, amp, DAMPING, rtol=a.rtol, evaluations=a.flank_steps)
+        except ValueError as e:  # the simulator stopped at one of them: the sweep's own crossings, said so
+            print(f"   the flanks' secant evaluations stopped ({e}): the crossings interpolated from the sweep")
+            lo_w, hi_w, pts = refine_flanks(s, fr, shape, pts, amp, DAMPING, rtol=a.rtol, evaluations=0)
         unsettled = sum(not p.settled for p in pts)
         print(f"   forced F = {force:.4g} (modal; phase resonance at sqrt2 a by the EPMC): {len(pts)} frequencies in "
               f"{time.perf_counter() - t:.1f} s ({sum(p.periods for p in pts)} periods, {unsettled} not settled to "
