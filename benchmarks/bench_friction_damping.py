@@ -42,7 +42,18 @@ The backbone rises 1.1 % from a to √2a (219.82 → 222.28 Hz), as wide as the 
 the response jumps down between 223.66 Hz (3.50e-4) and 225.04 Hz (1.69e-4); the upper "flank" at a (224.38 Hz)
 lies in the jump, and the formula gives ζ(a) +32 %, friction's share +66 %. The flanks' secant steps stopped
 there too (a switch with no admissible next state: node 37's force on the cone), so the crossings are the
-sweep's. The half-power width read as linear +8.8 %, predicted −10 %. 2 and 2.5 x grazing: not run (time).
+sweep's. The half-power width read as linear +8.8 %, predicted −10 %.
+2 x grazing (``--points 13 --refine 4``): EPMC f = 217.9649 Hz, ζ = 0.006268 (friction's share 1.30e-3), free decay
+−1.14 %; forced at F = 8.111 (21 frequencies, 4120 periods, 235 s): peak 2.416e-4 at 219.19 Hz, ζ_F −0.35 % from
+ζ(a_peak) = 0.008883 (friction's part −0.78 %); the half-power frequencies predicted at a_peak/√2 −0.82 % in
+width. Width at a: flanks 216.0851 and 220.5899 Hz → ζ(a) = 0.007323, +17 % (friction's share +81 %), NOT within
+5 %; but the sweep's own half-power crossings (216.1147, 220.8675 Hz at a_peak/√2 = 2.006 x grazing) give
+ζ = 0.006357 by the same formula, +1.2 % from the EPMC's 0.006281 there (friction's share +5.8 %). The secant
+point on the upper flank (started from its neighbour's end state) lies 0.28 Hz below the sweep's crossing at
+nearly the same level: the flank's steady state there is not settled as one — not resolved (time). At 1.5 x
+grazing the sweep's crossings alone (points 0.5 ζ apart, linear) give ζ −13 %: the width needs the refined
+flanks, and they need a check of their branch. 2.5 x grazing: not run (time). Total: 986 s (1.5 and 2 x),
+856 s (3 x).
 Cost: an EPMC 12–190 s (more phases and growth at larger amplitude), a forced point on the 26 nodes 10–60 s.
 """
 
