@@ -30,6 +30,17 @@ force starts on the cone with the slip's rate, and moves inside it), so a revers
 which ``τ_j`` crosses from ``+μλ_j`` to ``−μλ_j``. That stick phase's cone signal starts with zero value and zero
 slope: it is let leave its surface over a first short flight (checked at sixteen points), then searched as the others.
 
+Coupled nodes often reach their switches together: a blade tip's nodes all turn round at about the same instant.
+The node that switches first changes its neighbours' force rates through the compliances, and a neighbour whose
+signal sits on its surface may have to change too (above). When that, node by node, finds no admissible next state,
+the nodes on the friction cone (all sliding nodes, and the sticking ones whose force is on it) are decided together
+by the rate-level complementarity problem of their stick and slip, as the closed contacts of the model without
+friction are. The new phase's signals are computed afresh, through
+solves that lose a few digits: a signal the switch leaves on its surface (to :data:`ADMISSIBLE_RTOL`) and leaving it
+may start just below it by round-off; it is put on it, so the next flight does not take that round-off for a
+switch. A signal that only touches its surface and turns back (flat there and curving up, such as a stuck node's
+force touching the cone once a period) keeps the phase when no next state of its node starts admissible.
+
 With ``V_j`` large enough that ``v_j`` never reaches 0 every contact slides along ``+`` and the phases are those of
 the rotation model (:class:`~bladecase.nsm.massless.friction.FrictionFlight`): the same orbit.
 
@@ -50,7 +61,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .friction import Friction
+from .friction import Friction, lemke
 from .friction_coulomb_phase import OPEN, SLIP_NEG, SLIP_POS, STICK, CoulombPhase, RampSignals
 from .nodal_switches import first_switch
 from .nodes import MAX_SWITCHES, SURFACE_RTOL, NodalSystem, Rub, casing_gap, lcp
@@ -141,9 +152,11 @@ class CoulombFlight:
 
     # ------------------------------------------------------------------ switches
 
-    def _violations(self, codes, anchors, q, p, t) -> tuple[CoulombPhase, list[int]]:
+    def _violations(self, codes, anchors, q, p, t, decided=None) -> tuple[CoulombPhase, list[int]]:
         """The phase ``codes`` started at ``(q, p, t)`` and its signals that start inadmissible, the most negative
-        first: below 0, or on their surface and not leaving it (falling, or flat and not curving up)."""
+        first: below 0, or on their surface and not leaving it (falling, or flat and not curving up). ``decided``:
+        nodes whose state the rate-level problem chose (:meth:`_on_cone`): their signals above 0 may fall (a slide
+        at a small rate ends in the flight)."""
         ph = self.phase(codes)
         amp = ph.amplitudes(q, p, t, anchors)
         sig = ph.signals(self, amp, t, anchors, 0.0)
@@ -152,6 +165,8 @@ class CoulombFlight:
         rate = np.abs(sig.C) @ np.abs(sig.lam) + np.abs(sig.E) * sig.nu + np.abs(sig.slope)
         on = np.abs(f0) <= ADMISSIBLE_RTOL * scale
         flat = on & (np.abs(d0) <= FLAT_RTOL * np.maximum(rate, np.finfo(float).tiny))
+        if decided is not None:
+            on = on & ~(decided[[node for node, _ in ph.meta]] & (f0 > 0))
         bad = (~on & (f0 < 0)) | (on & ~flat & (d0 < 0)) | (flat & (sig.second() <= 0))
         order = np.argsort(np.where(on, 0.0, f0 / scale), kind="stable")
         return ph, [int(k) for k in order if bad[k]]
@@ -202,8 +217,61 @@ class CoulombFlight:
                 if i == j:  # the switching node itself: its next option
                     break
                 new, anc = put(i, self._options(cand, i, kind_i, new, p, t)[0], new, anc)
+        if self._grazes(ph, k, q, p, t, anchors) and not self._violations(codes, anchors, q, p, t)[1]:
+            return codes, anchors  # the signal touched its surface and turns back: the phase goes on
+        if kind not in ("gap", "force"):  # the nodes on the cone decided together, at the rate level
+            new, anc, decided = self._on_cone(ph, j, kind, codes, anchors, q, p, t)
+            for _ in range(2 * self.m + 2):
+                cand, bad = self._violations(new, anc, q, p, t, decided)
+                if not bad:
+                    return new, anc
+                i, kind_i = cand.meta[bad[0]]
+                new, anc = put(i, self._options(cand, i, kind_i, new, p, t)[0], new, anc)
         raise ValueError(f"at t = {t:.12g} s contact node {self.system.nodes[j]} ({kind} signal at 0) has no "
                          f"admissible next state (tried {[_NAMES[c] for c in order]}): a grazing or degenerate switch")
+
+    def _on_cone(self, ph: CoulombPhase, j: int, kind: str, codes, anchors, q, p, t: float):
+        """The codes and anchors of the nodes on the friction cone at a switch (every sliding node, and every
+        sticking one whose force is on the cone, to :data:`ADMISSIBLE_RTOL`, with the switching node ``j``), and
+        those nodes (a mask), decided together by the rate-level complementarity problem of their stick and slip:
+        with them all stuck, the rates ``m`` of their margins to the cone ``μλ_i − s_iτ_i`` (``s_i`` the side they
+        are on); sliding at the rates ``w >= 0`` (each anchor moving by ``−s_i w_i``) adds ``A w``; ``w >= 0``,
+        ``m + A w >= 0``, complementary (:func:`~bladecase.nsm.massless.friction.lemke`). A node with ``w_i > 0``
+        slides, the others stick."""
+        amp = ph.amplitudes(q, p, t, anchors)
+        f0 = ph.signals(self, amp, t, anchors, 0.0).values(0.0)[0][0]
+        scale = _start_scale(ph.signals(self, amp, t, anchors, 0.0))
+        side = np.zeros(self.m)
+        side[codes == SLIP_POS], side[codes == SLIP_NEG] = 1.0, -1.0
+        for i, (node, kd) in enumerate(ph.meta):
+            if codes[node] == STICK and kd in ("cone+", "cone-") and abs(f0[i]) <= ADMISSIBLE_RTOL * scale[i]:
+                side[node] = 1.0 if kd == "cone+" else -1.0
+        side[j] = {"cone+": 1.0, "cone-": -1.0}.get(kind, side[j])
+        D = np.flatnonzero(side != 0)
+        stuck, anc = codes.copy(), anchors.copy()
+        for i in D:
+            if codes[i] != STICK:
+                anc[i] = self._anchor(ph, i, q, t, anchors)
+        stuck[D] = STICK
+        st = self.phase(stuck)
+        sig = st.signals(self, st.amplitudes(q, p, t, anc), t, anc, 0.0)
+        d0 = sig.values(0.0)[1][0]
+        row = {(node, kd): i for i, (node, kd) in enumerate(st.meta)}
+        margin = np.array([d0[row[(i, "cone+" if side[i] > 0 else "cone-")]] for i in D])
+        G = (self.mu * st.El[D] - side[D][:, None] * st.Pt[D]) @ st.Ur[:, self.m + D]  # margins per anchor
+        w = lemke(margin, -G * side[D][None, :])
+        new = stuck.copy()
+        slide = D[w > 0]
+        new[slide] = np.where(side[slide] > 0, SLIP_POS, SLIP_NEG)
+        return new, anc, side != 0
+
+    def _grazes(self, ph: CoulombPhase, k: int, q, p, t: float, anchors) -> bool:
+        """Whether the signal ``k`` of the phase ``ph`` touches its surface at ``t`` and turns back: flat there
+        (its slope round-off, :data:`FLAT_RTOL` of its rate terms) and curving up."""
+        sig = ph.signals(self, ph.amplitudes(q, p, t, anchors), t, anchors, 0.0)
+        d0 = sig.values(0.0)[1][0, k]
+        rate = np.abs(sig.C[k]) @ np.abs(sig.lam) + np.abs(sig.E[k]) * sig.nu + np.abs(sig.slope[k])
+        return bool(abs(d0) <= FLAT_RTOL * max(rate, np.finfo(float).tiny) and sig.second()[k] > 0)
 
     def initial(self, q, p, t: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """The codes and anchors of a state: the closed nodes from the normal complementarity problem, each sliding
@@ -274,10 +342,17 @@ class CoulombFlight:
         """The first switch of a flight (``(τ, signal)``, or ``None``) and the span searched."""
         sig = ph.signals(self, amp, t, anchors, horizon)
         f0, d0 = (v[0] for v in sig.values(0.0))
-        scale = np.maximum(sig.magnitude, np.finfo(float).tiny)
         rate = np.abs(sig.C) @ np.abs(sig.lam) + np.abs(sig.E) * sig.nu + np.abs(sig.slope)
-        on = np.abs(f0) <= SURFACE_RTOL * scale
-        flat = on & (np.abs(d0) <= FLAT_RTOL * np.maximum(rate, np.finfo(float).tiny))
+        flat_rate = np.abs(d0) <= FLAT_RTOL * np.maximum(rate, np.finfo(float).tiny)
+        # a signal the switch left on its surface (to :meth:`_violations`' tolerance), below it by round-off and
+        # leaving it, is put on it: its start is the switch's, not a crossing of its own
+        near = (f0 < 0) & (np.abs(f0) <= ADMISSIBLE_RTOL * _start_scale(sig)) & ((d0 > 0) | flat_rate)
+        if near.any():
+            sig = _lifted(sig, np.where(near, -f0, 0.0))
+            f0 = np.where(near, 0.0, f0)
+        scale = np.maximum(sig.magnitude, np.finfo(float).tiny)
+        on = (np.abs(f0) <= SURFACE_RTOL * scale) | near
+        flat = on & flat_rate
         span = horizon
         if flat.any():
             span = min(span, min(self._leave(sig, k, horizon) for k in np.flatnonzero(flat)))
@@ -310,6 +385,18 @@ class CoulombFlight:
 
 
 _NAMES = {v: k for k, v in CODES.items()}
+
+
+def _start_scale(sig: RampSignals) -> np.ndarray:
+    """The signals' sizes at a phase's start (the ramp's growth over the flight left out), as
+    :meth:`CoulombFlight._violations` measures them."""
+    return np.maximum(np.abs(sig.C).sum(axis=1) + np.abs(sig.E) + np.abs(sig.base), np.finfo(float).tiny)
+
+
+def _lifted(sig: RampSignals, shift: np.ndarray) -> RampSignals:
+    """``sig`` with each signal raised by ``shift`` (its constant part)."""
+    return RampSignals(sig.lam, sig.C, sig.E, sig.nu, sig.const + shift, sig.lam2, sig.slope, sig.base + shift,
+                       sig.horizon)
 
 
 @dataclass(frozen=True, eq=False)

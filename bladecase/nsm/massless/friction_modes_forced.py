@@ -38,7 +38,8 @@ from .friction_coulomb import CoulombFlight, CoulombTrajectory
 from .friction_coulomb_phase import CoulombPhase
 from .nodes import NodalSystem, lcp
 
-__all__ = ["ForcedPoint", "Resonance", "forced_point", "forced_sweep", "half_power", "refine_peak", "resonance"]
+__all__ = ["ForcedPoint", "Resonance", "flank_mode", "forced_point", "forced_sweep", "half_power", "refine_flanks",
+           "refine_peak", "resonance"]
 
 #: Samples per forcing period at which the amplitude is read (the phases' starts added).
 SAMPLES = 400
@@ -208,6 +209,71 @@ def half_power(force: float, frequency: float, zeta: float, amplitude: float) ->
     if disc < 0 or w2 * c - np.sqrt(disc) <= 0:
         raise ValueError(f"no two frequencies give the amplitude {amplitude!r} under the modal force {force!r}")
     return float(np.sqrt(w2 * c - np.sqrt(disc))), float(np.sqrt(w2 * c + np.sqrt(disc)))
+
+
+def flank_mode(low: float, high: float, modal_force: float, amplitude: float) -> tuple[float, float]:
+    """The frequency ``ω(a)`` and damping ratio ``ζ(a)`` of a single nonlinear mode from the two forcing frequencies
+    ``Ω₁ < Ω₂`` (rad/s) at which it answers the modal force ``F_q`` with the same amplitude ``a`` (the flanks of a
+    forced curve at that level): both obey ``(ω² − Ω_i²)² + (2ζωΩ_i)² = (F_q/a)²`` with the same ``ω(a)``, ``ζ(a)``;
+    their difference gives ``ω² = (Ω₁² + Ω₂²)/2 + 2(ζω)²`` and then
+    ``(ζω)² = (2√(Ω₁²Ω₂² + (F_q/a)²) − Ω₁² − Ω₂²)/4``. The inverse of :func:`half_power`.
+
+    >>> w, z = flank_mode(*half_power(0.1, 1.0, 0.05, 0.8), 0.1, 0.8)   # any level of a linear mode: its ω, ζ
+    >>> round(w, 12), round(z, 12)
+    (1.0, 0.05)
+    """
+    w1, w2 = float(low) ** 2, float(high) ** 2
+    r = float(modal_force) / float(amplitude)
+    if not (0 < w1 < w2 and np.isfinite(w2) and np.isfinite(r) and r > 0):
+        raise ValueError(f"need 0 < low < high (rad/s) and modal_force / amplitude > 0, got low = {low!r}, "
+                         f"high = {high!r}, modal_force = {modal_force!r}, amplitude = {amplitude!r}")
+    c2 = (2 * np.sqrt(w1 * w2 + r**2) - w1 - w2) / 4
+    if c2 < 0:
+        raise ValueError(f"the flanks {low!r}, {high!r} rad/s are too far apart for the amplitude {amplitude!r} "
+                         f"under the modal force {modal_force!r}: no single mode answers both")
+    w = np.sqrt(0.5 * (w1 + w2) + 2 * c2)
+    return float(w), float(np.sqrt(c2) / w)
+
+
+def refine_flanks(system: NodalSystem, friction: Friction, shape, points: list[ForcedPoint], level: float,
+                  damping=None, load=None, sliding=0.0, mode: int = 0, rtol: float = 1e-6,
+                  evaluations: int = 2) -> tuple[float | None, float | None, list[ForcedPoint]]:
+    """The two frequencies where a sweep's amplitude is ``level`` either side of its peak, each refined by
+    ``evaluations`` secant steps (a forced point at the interpolated frequency, from the nearest point's end state,
+    replacing the bracket's end on its side): ``(low, high, points with the new ones)``; ``None`` where the sweep
+    does not reach ``level`` on that flank.
+
+    >>> s = NodalSystem(np.eye(2), np.diag([1.0, 4.0]), np.array([[0.0], [1.0]]), [[1e-3]], gap=[0.1])
+    >>> f = Friction(0.4, T=[[1.0], [0.0]], C_tt=[[0.5]], model="coulomb")
+    >>> from bladecase.nsm import Damping
+    >>> d, load = Damping(zeta=0.1), [0.0, 1.404]
+    >>> pts = forced_sweep(s, f, [0.3, 0.0], [1.0, 1.3, 1.6, 1.9], d, load, rtol=1e-4)
+    >>> lo, hi, pts = refine_flanks(s, f, [0.3, 0.0], pts, 0.3, d, load, rtol=1e-4, evaluations=1)
+    >>> round(lo, 2), round(hi, 2)
+    (1.46, 1.69)
+    """
+    pts = sorted(points, key=lambda p: p.frequency)
+    out = []
+    for side in (-1, +1):
+        for _ in range(evaluations + 1):
+            w = np.array([p.frequency for p in pts])
+            a = np.array([p.amplitude for p in pts])
+            k = int(np.argmax(a))
+            idx = range(k - 1, -1, -1) if side < 0 else range(k, len(pts) - 1)
+            pair = next(((i, i + 1) for i in idx if (a[i] - level) * (a[i + 1] - level) <= 0 and a[i] != a[i + 1]),
+                        None)
+            if pair is None:
+                out.append(None)
+                break
+            i, j = pair
+            x = float(w[i] + (level - a[i]) * (w[j] - w[i]) / (a[j] - a[i]))
+            if _ == evaluations or min(abs(x - w[i]), abs(x - w[j])) <= 1e-12 * x:
+                out.append(x)
+                break
+            near = pts[i] if abs(x - w[i]) <= abs(x - w[j]) else pts[j]
+            pts = sorted(pts + [forced_point(system, friction, shape, x, damping, load, sliding, mode, near, rtol)],
+                         key=lambda p: p.frequency)
+    return out[0], out[1], pts
 
 
 @dataclass(frozen=True)
