@@ -26,6 +26,7 @@ from functools import cached_property
 import numpy as np
 import scipy.linalg as sla
 
+from .friction import instability
 from .nodal_switches import _Row, _Signals
 from .nodes import EIGVEC_COND_LIMIT
 
@@ -150,8 +151,7 @@ class CoulombPhase:
             names = {c: [fl.system.nodes[k] for k in np.flatnonzero(codes == c)] for c in (SLIP_POS, SLIP_NEG, STICK)}
             raise ValueError(f"a stick–slip contact phase (nodes sliding {names[SLIP_POS] + names[SLIP_NEG]}, "
                              f"sticking {names[STICK]}, mu = {mu:g}) is unstable: it grows at {grow:.3g} 1/s "
-                             "(friction-induced flutter); the exact flight needs decaying phases: add damping or "
-                             "lower mu")
+                             f"({instability(lam)}); the exact flight needs decaying phases: add damping or lower mu")
         lu = sla.lu_factor(V)
         if not sla.lapack.zgecon(lu[0], np.abs(V).sum(axis=0).max())[0] * EIGVEC_COND_LIMIT > 1:
             raise ValueError("a stick–slip contact phase is nearly defective (two of its modes coincide): change mu "
