@@ -19,6 +19,13 @@ Run (OPENBLAS_NUM_THREADS=1: the workers run single-threaded BLAS anyway)::
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_rotor37_rub.py DATA/blade.inp [--speeds 9]
         [--workers 2] [--revolutions 40] [--run-on] [--campbell] [--campbell-only]
 
+Latest (with METIS's nested-dissection ordering of the factorisations, :mod:`bladecase.ordering`; 2026-11-29, the
+machine nearly idle, load 2): the 9 speeds in 220 s of wall time on 2 processes (0.73 × the 5-minute goal), the whole
+script 3 min 45 s; 398 CPU s = centrifugal state 185 s (46 %), reduction 64 s, simulation 149 s; per speed: the
+first of each process 40–42 s (7 Newton iterations, 2 factorisations, 108–115 conjugate-gradient solves), the later
+ones 30–62 s (3–4 Newton iterations, 2 factorisations, 27–32 solves; the simulation 26–36 s past the crossing, where
+28 962–31 166 switches in 40 revolutions); peak memory 2.4 GiB per worker.
+
 Figures (CPU seconds, the stable measure on a shared machine; 2 processes, cvxopt's CHOLMOD; the machine's load
 average 5 to 10 on 2 cores, so the wall times are 3 to 4 times an idle machine's).  Before: every speed's
 ``static = "auto"`` state took about nine factorisations of the 61k-dof model (the linear and the second-order
