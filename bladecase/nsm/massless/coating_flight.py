@@ -60,7 +60,7 @@ from scipy.optimize import lsq_linear
 
 from .friction import lemke
 from .nodal_switches import _Signals, first_switch
-from .nodes import MAX_SWITCHES, NodalSystem, Profile, Rub, casing_gap
+from .nodes import MAX_SWITCHES, NodalSystem, Profile, Rub, casing_gap, flight_terms
 from .nodes_phase import _Phase
 
 __all__ = ["CODES", "CoatingFlight", "CoatingTrajectory", "simulate_coating"]
@@ -194,6 +194,18 @@ class CoatingPhase(_Phase):
         return self.Lq_lam @ Q + self.Lg_lam @ g + self.lam_c[:, None]
 
 
+def _start(ph, a, t: float):
+    """The signals of the phase ``ph`` started with the amplitudes ``a`` at ``t``: ``(signals, values, rates,
+    scales, on their surface, flat there)``."""
+    sig = ph.signals(a, t)
+    f0, d0 = (v[0] for v in sig.values(0.0))
+    scale = np.maximum(sig.magnitude, np.finfo(float).tiny)
+    rate = np.abs(sig.C) @ np.abs(sig.lam) + np.abs(sig.E) * sig.nu
+    on = np.abs(f0) <= ADMISSIBLE_RTOL * scale
+    flat = on & (np.abs(d0) <= FLAT_RTOL * np.maximum(rate, np.finfo(float).tiny))
+    return sig, f0, d0, scale, on, flat
+
+
 class CoatingFlight:
     """Exact flights of a :class:`~bladecase.nsm.massless.nodes.NodalSystem` whose contacts press a yielding
     coating (module docstring): ``yield_force`` ``λ_y,j`` (N, one a node, each > 0), ``damping`` of the open-phase
@@ -222,13 +234,7 @@ class CoatingFlight:
         C_nt = np.zeros((self.m, self.m)) if friction is None else friction.C_nt
         self.Wf = self.Wq if friction is None else self.Wq - mu * (self.phi.T @ friction.T)
         self.Hc, self.Hy = system.H - mu * C_nt, system.flexibility - mu * C_nt
-        if damping is not None and (damping.alpha or damping.beta or np.any(np.asarray(damping.zeta or 0) > 0)):
-            self.Cq = np.diag(2 * damping.rates(self.omega))
-        else:
-            self.Cq = None
-        if rub is not None and len(rub.angles) != system.m:
-            raise ValueError(f"the rub needs one angle per contact node ({system.m}), got {len(rub.angles)}")
-        self.nu, self.D = (rub.nu, rub.D) if rub is not None else (0.0, None)
+        self.Cq, self.nu, self.D = flight_terms(self.omega, damping, rub, system.m)
         self._phases: dict[bytes, CoatingPhase] = {}
 
     def phase(self, codes: np.ndarray, w: np.ndarray) -> CoatingPhase:
@@ -265,12 +271,7 @@ class CoatingFlight:
     def _bad(self, ph: CoatingPhase, a, t: float) -> list[int]:
         """The signals of the phase ``ph`` started with the amplitudes ``a`` at ``t`` that start inadmissible, the
         most negative first: below 0, or on their surface and falling (flat ones must curve up: checked in flight)."""
-        sig = ph.signals(a, t)
-        f0, d0 = (v[0] for v in sig.values(0.0))
-        scale = np.maximum(sig.magnitude, np.finfo(float).tiny)
-        rate = np.abs(sig.C) @ np.abs(sig.lam) + np.abs(sig.E) * sig.nu
-        on = np.abs(f0) <= ADMISSIBLE_RTOL * scale
-        flat = on & (np.abs(d0) <= FLAT_RTOL * np.maximum(rate, np.finfo(float).tiny))
+        sig, f0, d0, scale, on, flat = _start(ph, a, t)
         bad = (~on & (f0 < 0)) | (on & ~flat & (d0 < 0))
         order = np.argsort(np.where(on, 0.0, f0 / scale), kind="stable")
         return [int(k) for k in order if bad[k]]
@@ -338,12 +339,7 @@ class CoatingFlight:
     def _fly(self, ph: CoatingPhase, a, t: float, horizon: float):
         """The first switch of a flight (``(τ, signal)``, or ``None``) and the span searched (a flat start that
         leaves its surface cuts the flight short)."""
-        sig = ph.signals(a, t)
-        f0, d0 = (v[0] for v in sig.values(0.0))
-        scale = np.maximum(sig.magnitude, np.finfo(float).tiny)
-        rate = np.abs(sig.C) @ np.abs(sig.lam) + np.abs(sig.E) * sig.nu
-        on = np.abs(f0) <= ADMISSIBLE_RTOL * scale
-        flat = on & (np.abs(d0) <= FLAT_RTOL * np.maximum(rate, np.finfo(float).tiny))
+        sig, _, _, _, on, flat = _start(ph, a, t)
         span = horizon
         if flat.any():
             leave = []

@@ -64,7 +64,7 @@ import numpy as np
 from .friction import Friction, lemke
 from .friction_coulomb_phase import OPEN, SLIP_NEG, SLIP_POS, STICK, CoulombPhase, RampSignals
 from .nodal_switches import first_switch
-from .nodes import MAX_SWITCHES, SURFACE_RTOL, NodalSystem, Rub, casing_gap, lcp
+from .nodes import MAX_SWITCHES, SURFACE_RTOL, NodalSystem, Rub, casing_gap, flight_terms, lcp
 
 __all__ = ["CODES", "CoulombFlight", "CoulombTrajectory", "simulate_coulomb"]
 
@@ -105,13 +105,7 @@ class CoulombFlight:
             raise ValueError(f"the stick–slip model needs each contact node's own tangential compliance C_tt > 0 "
                              f"(m/N); it is not at nodes {bad}: a massless node held rigidly along its tangent "
                              "cannot stick without an impact law")
-        if damping is not None and (damping.alpha or damping.beta or np.any(np.asarray(damping.zeta or 0) > 0)):
-            self.Cq = np.diag(2 * damping.rates(self.omega))
-        else:
-            self.Cq = None
-        if rub is not None and len(rub.angles) != self.m:
-            raise ValueError(f"the rub needs one angle per contact node ({self.m}), got {len(rub.angles)}")
-        self.nu, self.D = (rub.nu, rub.D) if rub is not None else (0.0, None)
+        self.Cq, self.nu, self.D = flight_terms(self.omega, damping, rub, self.m)
         self.R = None if self.D is None else np.r_[self.D, np.zeros(self.m)]
         if sliding is None:
             sliding = rub.speed * friction.radius if rub is not None and friction.radius is not None else 0.0

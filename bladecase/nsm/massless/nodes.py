@@ -75,6 +75,20 @@ def casing_gap(d: np.ndarray, D: np.ndarray | None, nu: float, t) -> np.ndarray:
     return d[:, None] + np.multiply.outer(D, np.exp(1j * nu * np.atleast_1d(t))).real
 
 
+def flight_terms(omega: np.ndarray, damping, rub: Rub | None, m: int):
+    """``(Cq, nu, D)`` of a flight: the modal damping matrix of the open-phase modes ``omega`` (``None``: undamped),
+    and the out-of-round casing's frequency and clearance amplitudes (``0, None``: round); checks one angle per
+    contact node."""
+    Cq = None
+    if damping is not None and (damping.alpha or damping.beta or np.any(np.asarray(damping.zeta or 0) > 0)):
+        Cq = np.diag(2 * damping.rates(omega))
+    if rub is None:
+        return Cq, 0.0, None
+    if len(rub.angles) != m:
+        raise ValueError(f"the rub needs one angle per contact node ({m}), got {len(rub.angles)}")
+    return Cq, rub.nu, rub.D
+
+
 class NodalFlight:
     """Exact flights of a :class:`NodalSystem`: its phases (cached per set of closed contacts), optional
     damping (:class:`~bladecase.nsm.damping.Damping` of the open-phase modes) and an out-of-round casing
@@ -87,16 +101,7 @@ class NodalFlight:
         self.omega, self.phi = system.modes
         self.n = system.n
         self.Wq = self.phi.T @ system.W
-        if damping is not None and (damping.alpha or damping.beta or np.any(np.asarray(damping.zeta or 0) > 0)):
-            self.Cq = np.diag(2 * damping.rates(self.omega))
-        else:
-            self.Cq = None
-        if rub is not None:
-            if len(rub.angles) != system.m:
-                raise ValueError(f"the rub needs one angle per contact node ({system.m}), got {len(rub.angles)}")
-            self.nu, self.D = rub.nu, rub.D
-        else:
-            self.nu, self.D = 0.0, None
+        self.Cq, self.nu, self.D = flight_terms(self.omega, damping, rub, system.m)
         self._phases: OrderedDict[bytes, _Phase] = OrderedDict()  # the least recently used first
         self.profile = None
         if profile is not None:
