@@ -206,6 +206,20 @@ def instability(lam: np.ndarray) -> str:
             "oscillating")
 
 
+def first_order_modes(K: np.ndarray, C: np.ndarray, what, growth: bool = False, vectors: bool = True):
+    """The eigenvalues (and eigenvectors, ``vectors``) of a phase's first-order system ``x'' + Cx' + Kx = …``;
+    unless ``growth`` (the extended periodic motion concept feeds its phases), a growing one is refused:
+    ``ValueError`` naming the phase (``what()``), its growth rate and whether it is a flutter or a divergence."""
+    n = K.shape[0]
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-K, -C]])
+    lam, V = np.linalg.eig(A) if vectors else (np.linalg.eigvals(A), None)
+    grow = lam.real.max()
+    if not growth and grow > FLUTTER_RTOL * np.abs(lam).max():
+        raise ValueError(f"{what()} is unstable: it grows at {grow:.3g} 1/s ({instability(lam)}); the exact flight "
+                         "needs decaying phases: add damping or lower mu")
+    return lam, V
+
+
 class _FrictionPhase(_Phase):
     """One set ``A`` of closed contacts with friction: non-symmetric, flown from its first-order eigenvectors."""
 
@@ -240,13 +254,9 @@ class _FrictionPhase(_Phase):
             except np.linalg.LinAlgError:
                 raise ValueError(f"the casing's excitation at {nu / 2 / np.pi:.6g} Hz is at an undamped resonance "
                                  "of a contact phase with friction: add damping or change the speed") from None
-        lam, V = np.linalg.eig(np.block([[np.zeros((n, n)), np.eye(n)], [-K, -C]]))
-        grow = lam.real.max()
         growth = getattr(fl, "allow_growth", False)  # the extended periodic motion concept feeds its phases
-        if not growth and grow > FLUTTER_RTOL * np.abs(lam).max():
-            raise ValueError(f"a contact phase with friction (nodes {[s.nodes[k] for k in idx]} closed, mu = "
-                             f"{fr.mu:g}) is unstable: it grows at {grow:.3g} 1/s ({instability(lam)}); the "
-                             "exact flight needs decaying phases: add damping or lower mu")
+        lam, V = first_order_modes(K, C, lambda: f"a contact phase with friction (nodes {[s.nodes[k] for k in idx]} "
+                                   f"closed, mu = {fr.mu:g})", growth)
         self._lu = sla.lu_factor(V)
         rcond = sla.lapack.zgecon(self._lu[0], np.abs(V).sum(axis=0).max())[0]
         if not rcond * EIGVEC_COND_LIMIT > 1:
