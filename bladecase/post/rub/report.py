@@ -155,7 +155,8 @@ def _wear_lines(w: dict | None, unit: str) -> list[str]:
             out.append(f"- At {r['speed']:.6g} {unit} the tip removes no coating in {r['revolutions']} revolutions.")
             continue
         c = r.get("lobe_check")
-        check = f"; over the last {c['window']} revolutions {lobe_words(c)}" if c else ""
+        check = (f"; over revolutions {c['last'] - c['window'] + 1}–{c['last']}, the last that wore the coating, "
+                 f"{lobe_words(c)}" if c and c.get("last") else f"; {lobe_words(c)}" if c else "")
         out.append(f"- At {r['speed']:.6g} {unit} after {r['revolutions']} revolutions the profile has {r['lobes']} "
                    f"lobes, {r['lobe_depth_um']:.3g} µm deep (deepest {r['max_depth_um']:.3g} µm); "
                    f"{r['removed_mm3']:.4g} mm³ removed (the profile's missing volume to {r['volume_mismatch']:.0e}); "
@@ -163,6 +164,9 @@ def _wear_lines(w: dict | None, unit: str) -> list[str]:
                    + ("; **the tip has worn through to the casing**." if r["worn_through"] else "."))
     if len(w["speeds"]) > 1:
         out.append(f"- The most coating is removed at {w['most_wear']:.6g} {unit}.")
+    out.append("- The wear's depths and volumes are this mesh's: their mesh error is not measured (the tip nodes' "
+               "areas share the coating's pressure, and the crossing speed moves with the mesh's first frequency); "
+               "compare meshes at the same `speed_ratio` before quoting them.")
     return out
 
 
