@@ -28,7 +28,7 @@ def jenkins():
     return s, Friction(MU, T=[[1.0], [0.0]], C_tt=[[1 / K_T]], model="coulomb")
 
 
-@pytest.mark.parametrize("a", [1.0, 10.0])
+@pytest.mark.parametrize("a", [1.0, 10.0, 30.0])
 def test_mode_dissipates_the_jenkins_loop(a):
     s, f = jenkins()
     m = coulomb_mode(s, f, a, load=LOAD)
@@ -40,10 +40,11 @@ def test_mode_dissipates_the_jenkins_loop(a):
     assert abs(m.xi * orbit_kinetic(m.orbit, 0.0, m.period) / wd - 1) < 1e-9
     # the harmonic closed form ζ = W_d / (4π E_max), E_max = ½ω²a²: the orbit is not harmonic, so within 5 %
     assert abs(equivalent_ratio(wd, a, m.frequency) / m.zeta - 1) < 0.05
-    # the free decay (certified simulator, no term) loses the same energy to first order in ζ: it loses
-    # 4μN/k of amplitude a period, so the ratios differ by about πζ (3.2ζ measured at a = 1 … 30)
+    # the free decay (certified simulator, no term) read at the start's amplitude from its first two periods:
+    # 0.080ζ and 0.022ζ apart at a = 10 and 30 (each period's own ratio, half a period lower, was 3.2ζ apart); at
+    # a = 1 the decay sticks within two periods (ζ = 0.16): the first period's own ratio, within 4ζ
     z = coulomb_decay_ratio(s, f, m, load=LOAD)
-    assert abs(z / m.zeta - 1) < 4 * m.zeta
+    assert abs(z / m.zeta - 1) < (4 if a < 10 else 0.15) * m.zeta
 
 
 def test_forced_resonance_matches_the_mode_ratio():
