@@ -165,13 +165,14 @@ def test_demo_tip_turns_round_on_all_26_nodes():
     """The demo blade's tip against a casing at rest: its 26 nodes turn round within nanoseconds of each other, each
     sticking, and a neighbour's stick leaves another's friction force on the cone by the round-off of the phase's
     solves (the run stopped there before). One period of free decay from the mode's start: the energy balance
-    closes to 1e-9 and the decay's ratio is the concept's within 1 % (−0.54 % measured)."""
+    closes to 1e-9 and the decay's ratio (read at the start's amplitude) is the concept's within 0.2 % (−0.06 %
+    measured: friction's share of 3.1e-4 within 1.0 %)."""
     s, f, d = demo_tip()
     period = float(d["period"])
     mode = SimpleNamespace(x0=d["x0"], v0=d["v0"], codes=d["codes"], anchors=d["anchors"], period=period,
                            frequency=2 * np.pi / period)
     damping = Damping(zeta=0.005)
-    assert coulomb_decay_ratio(s, f, mode, damping) == pytest.approx(float(d["zeta"]), rel=0.01)
+    assert coulomb_decay_ratio(s, f, mode, damping) == pytest.approx(float(d["zeta"]), rel=0.002)
     fl = CoulombFlight(s, f, damping, sliding=0.0)
     fl._stick_anchors = lambda codes, q, t: d["anchors"].copy()        # the mode's stuck nodes where they stick
     tr = fl.simulate(d["x0"], d["v0"], period, codes=d["codes"])
