@@ -41,7 +41,9 @@ has contact phases of finite duration instead of impacts. One module per step:
   :mod:`~bladecase.nsm.massless.friction_modes_coulomb` — a mode's damping ratio with stick–slip friction by the
   extended periodic motion concept, its free decay and the Jenkins element's closed form (:func:`coulomb_mode`),
   and :mod:`~bladecase.nsm.massless.friction_modes_forced` — the forced response with stick–slip friction, its
-  resonance peak and half-power frequencies; further friction models sit beside them, in modules named
+  resonance peak and half-power frequencies, and :mod:`~bladecase.nsm.massless.friction_modes_phase` — the mode
+  read off one forced point by its fundamental harmonic's phase (:func:`phase_mode`); further friction models sit
+  beside them, in modules named
   ``friction*``;
 - :mod:`~bladecase.nsm.massless.wear` — an abradable coating round the casing worn by the tip (:class:`Abradable`,
   :class:`WearProfile`, :func:`pass_tip`), elastic–perfectly plastic: the profile each tip passage leaves;
