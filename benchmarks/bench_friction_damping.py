@@ -75,16 +75,19 @@ from bench_rub import at_speed, demo  # noqa: E402
 
 from bladecase.nsm import Damping  # noqa: E402
 from bladecase.nsm.massless.friction import Friction  # noqa: E402
+from bladecase.nsm.massless.friction_coulomb_rub import coulomb_energy  # noqa: E402
 from bladecase.nsm.massless.friction_modes import friction_mode  # noqa: E402
 from bladecase.nsm.massless.friction_modes_coulomb import coulomb_decay_ratio, coulomb_mode, orbit_kinetic  # noqa: E402
 from bladecase.nsm.massless.friction_modes_forced import (  # noqa: E402
     flank_mode,
+    forced_point,
     forced_sweep,
     half_power,
     refine_flanks,
     refine_peak,
     resonance,
 )
+from bladecase.nsm.massless.friction_modes_phase import fundamental, kinetic_factor, phase_mode  # noqa: E402
 from bladecase.nsm.massless.nodes import NodalSystem  # noqa: E402
 from bladecase.reduction.nodal_friction import nodal_friction  # noqa: E402
 from bladecase.study.rub import stage  # noqa: E402
@@ -131,14 +134,55 @@ def main() -> None:
     ap.add_argument("--flank-steps", type=int, default=2, help="secant evaluations on each flank at a")
     ap.add_argument("--rtol", type=float, default=1e-6, help="a forced point's settling: amplitude change a period")
     ap.add_argument("--no-jenkins", action="store_true", help="skip the Jenkins oscillator's checks")
+    ap.add_argument("--method", choices=("phase", "sweep"), default="phase",
+                    help="phase: the two flank points at the mode's fundamental amplitude, each read by its phase "
+                         "(default); sweep: the earlier sweep, peak and flanks by the amplitude's largest value")
     a = ap.parse_args()
     with threadpool_limits(limits=1, user_api="blas"):  # small dense phases: threads only wait for each other
         if not a.no_jenkins:
             jenkins()
-        run(a)
+        (run_phase if a.method == "phase" else run)(a)
 
 
-def run(a) -> None:
+def friction_ratio(tr, t0: float, t1: float, omega: float) -> float:
+    """Friction's own damping ratio on a stretch of orbit: its work over ``2ω∫x'ᵀMx' dt``."""
+    return -coulomb_energy(tr, t0, t1).friction / (2 * omega * orbit_kinetic(tr, t0, t1))
+
+
+def flank_point(s, fr, shape, level: float, guess: float, state, rtol: float, steps: int = 6):
+    """The forced point on one flank whose fundamental amplitude is ``level``: secant steps in the forcing
+    frequency from ``guess`` (the single mode's prediction), each point from the nearest one's end state."""
+    pts, w = [], guess
+    for _ in range(steps):
+        near = min(pts, key=lambda p: abs(p[1] / level - 1))[0] if pts else None
+        p = forced_point(s, fr, shape, w, DAMPING, start=near, state=None if near else state[:4], rtol=rtol,
+                         max_periods=3000)
+        T = 2 * np.pi / w
+        pts.append((p, abs(fundamental(p.trajectory, p.trajectory.t_end - T, T))))
+        if abs(pts[-1][1] / level - 1) < 2e-5:
+            break
+        if len(pts) == 1:
+            w = guess * (1 + 3e-4 * np.sign(level - pts[0][1]) * (1 if guess < state[4] else -1))
+            continue
+        (p1, a1), (p2, a2) = sorted(pts, key=lambda q: abs(q[1] / level - 1))[:2]
+        w = p1.frequency + (level - a1) * (p2.frequency - p1.frequency) / (a2 - a1)
+    return min(pts, key=lambda p: abs(p[1] / level - 1))[0], len(pts)
+
+
+def internal(omega: np.ndarray, frequency: float, within: float = 3.0) -> str:
+    """The higher open-phase modes near a harmonic of ``frequency``: each mode ``k`` whose nearest harmonic ``hΩ``
+    lies within ``within`` of its half-power half-widths ``ζω_k`` (else the nearest one), with that distance."""
+    h = np.maximum(np.round(omega[1:] / frequency), 1)
+    far = np.abs(h * frequency - omega[1:]) / (DAMPING.zeta * omega[1:])
+    near = np.flatnonzero(far <= within) if np.any(far <= within) else [int(np.argmin(far))]
+    return "internal resonance: " + "; ".join(
+        f"harmonic {int(h[k])} of {frequency / 2 / np.pi:.2f} Hz {far[k]:.1f} half-widths from mode {k + 2} "
+        f"({omega[k + 1] / 2 / np.pi:.2f} Hz)" for k in near)
+
+
+def blade(a):
+    """The demo blade's nodal model at ``a.rpm`` (``a.nodes`` of its tip nodes), its stick–slip friction and the
+    first mode's grazing amplitude, said in a line."""
     t0 = time.perf_counter()
     study, model, contact = demo()
     reduced, _, _ = at_speed(study, model, contact, a.rpm, nodes=a.nodes)
@@ -147,11 +191,68 @@ def run(a) -> None:
     s = reduced.system
     omega, phi = s.modes
     grazing = float(np.min(s.gap / np.abs(s.W.T @ phi[:, 0])))
+    print(f"the demo blade at {a.rpm:g} rpm, tip nodes {'all' if a.nodes is None else a.nodes} of "
+          f"{len(contact.nodes)}: n = {s.n}, m = {s.m}, f1 = {omega[0] / 2 / np.pi:.3f} Hz open, grazing amplitude "
+          f"{grazing:.4g}; mu = {MU}, stick–slip, casing at rest, {DAMPING.zeta:.1%} damping "
+          f"({time.perf_counter() - t0:.1f} s to build)")
+    return s, fr, grazing
+
+
+def run_phase(a) -> None:
+    """Each amplitude: the mode (EPMC) at its fundamental amplitude a₁ with its kinetic factor κ, the free decay,
+    friction's own ratio on the orbit; the force ``2√2ζκω²a₁`` (a peak near √2·a₁); the forced
+    point on each flank whose fundamental amplitude is a₁ (secant steps), each read by its phase (ω, ζκ at a₁) and
+    both by the width (``flank_mode``, amplitudes alone)."""
+    t0 = time.perf_counter()
+    s, fr, grazing = blade(a)
+    omega, phi = s.modes
+    guess = None
+    for k in a.amplitudes:
+        t = time.perf_counter()
+        m = coulomb_mode(s, fr, k * grazing, damping=DAMPING, guess=guess)
+        guess = m
+        a1, kap = kinetic_factor(m)
+        zk = m.zeta * kap
+        zd = coulomb_decay_ratio(s, fr, m, DAMPING)
+        zf = friction_ratio(m.orbit, 0.0, m.period, m.frequency)
+        print(f"\n{k:g} x grazing (turning point): EPMC f = {m.frequency / 2 / np.pi:.5f} Hz, zeta {m.zeta:.7f}, "
+              f"fundamental a1 = {a1:.6g}, kappa {kap:.5f}: zeta*kappa {zk:.7f}; free decay {zd:.7f} "
+              f"({zd / m.zeta - 1:+.3%}); friction's own ratio on the orbit {zf:.4e} "
+              f"({time.perf_counter() - t:.0f} s)")
+        print(f"   {internal(omega, m.frequency)} at the mode's frequency")
+        # the force whose peak a mode of constant ω, ζκ would put at √2·a1: its flanks at a1 near the half-power points
+        force = 2 * np.sqrt(2) * zk * m.frequency**2 * a1
+        shape = 1j * force * (s.M @ phi[:, 0])
+        state = (m.x0, m.v0, m.codes, m.anchors, m.frequency)
+        lo, hi = half_power(force, m.frequency, zk, a1)
+        flanks = {}
+        for side, w0 in (("lower", lo), ("upper", hi)):
+            t = time.perf_counter()
+            try:
+                p, steps = flank_point(s, fr, shape, a1, w0, state, a.rtol)
+            except ValueError as e:
+                print(f"   {side} flank: the simulator stopped ({e})")
+                continue
+            w, zp, b1 = phase_mode(p, shape)
+            zfp = friction_ratio(p.trajectory, p.trajectory.t_end - 2 * np.pi / p.frequency, p.trajectory.t_end, w)
+            flanks[side] = p.frequency
+            print(f"   {internal(omega, p.frequency)} at the {side} flank")
+            print(f"   {side} flank at {p.frequency / 2 / np.pi:.5f} Hz (single mode: {w0 / 2 / np.pi:.5f}), a1 "
+                  f"{b1:.6g} ({b1 / a1 - 1:+.1e}), {steps} points, {p.periods} periods: by its phase f = "
+                  f"{w / 2 / np.pi:.5f} Hz ({w / m.frequency - 1:+.1e}), zeta*kappa {zp:.7f}: {rel(zp, zk)}; "
+                  f"friction's own ratio {zfp:.4e} ({zfp / zf - 1:+.1%}) ({time.perf_counter() - t:.0f} s)")
+        if len(flanks) == 2:
+            ww, zw = flank_mode(flanks["lower"], flanks["upper"], force, a1)
+            print(f"   width from the two flanks' amplitudes alone: f = {ww / 2 / np.pi:.5f} Hz, zeta*kappa {zw:.7f}: "
+                  f"{rel(zw, zk)}")
+    print(f"\n{time.perf_counter() - t0:.1f} s in all")
+
+
+def run(a) -> None:
+    t0 = time.perf_counter()
+    s, fr, grazing = blade(a)
+    omega, phi = s.modes
     free = Friction(0.0, T=fr.T, C_nt=fr.C_nt, C_tt=fr.C_tt)
-    nodes = "all" if a.nodes is None else a.nodes
-    print(f"the demo blade at {a.rpm:g} rpm, tip nodes {nodes} of {len(contact.nodes)}: n = {s.n}, m = {s.m}, "
-          f"f1 = {omega[0] / 2 / np.pi:.3f} Hz open, grazing amplitude {grazing:.4g}; mu = {MU}, stick–slip, casing "
-          f"at rest, {DAMPING.zeta:.1%} damping ({time.perf_counter() - t0:.1f} s to build)")
     guess = None
     for k in a.amplitudes:
         amp = k * grazing
