@@ -93,6 +93,7 @@ from bladecase.reduction.nodal_friction import nodal_friction  # noqa: E402
 from bladecase.study.rub import stage  # noqa: E402
 
 MU, DAMPING, GOAL = 0.15, Damping(zeta=0.005), 0.05
+HARMONICS = 12
 
 
 def rel(a: float, b: float) -> str:
@@ -170,10 +171,12 @@ def flank_point(s, fr, shape, level: float, guess: float, state, rtol: float, st
 
 
 def internal(omega: np.ndarray, frequency: float, within: float = 3.0) -> str:
-    """The higher open-phase modes near a harmonic of ``frequency``: each mode ``k`` whose nearest harmonic ``hΩ``
+    """The higher open-phase modes near a harmonic of ``frequency`` (up to the :data:`HARMONICS`-th): each mode ``k``
+    whose nearest harmonic ``hΩ``
     lies within ``within`` of its half-power half-widths ``ζω_k`` (else the nearest one), with that distance."""
     h = np.maximum(np.round(omega[1:] / frequency), 1)
     far = np.abs(h * frequency - omega[1:]) / (DAMPING.zeta * omega[1:])
+    far[h > HARMONICS] = np.inf  # a harmonic that high carries nothing
     near = np.flatnonzero(far <= within) if np.any(far <= within) else [int(np.argmin(far))]
     return "internal resonance: " + "; ".join(
         f"harmonic {int(h[k])} of {frequency / 2 / np.pi:.2f} Hz {far[k]:.1f} half-widths from mode {k + 2} "
