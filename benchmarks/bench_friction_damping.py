@@ -162,25 +162,30 @@ def flank_point(s, fr, shape, level: float, guess: float, state, rtol: float, st
         pts.append((p, abs(fundamental(p.trajectory, p.trajectory.t_end - T, T))))
         if abs(pts[-1][1] / level - 1) < 2e-5:
             break
-        if len(pts) == 1:
-            w = guess * (1 + 3e-4 * np.sign(level - pts[0][1]) * (1 if guess < state[4] else -1))
-            continue
-        (p1, a1), (p2, a2) = sorted(pts, key=lambda q: abs(q[1] / level - 1))[:2]
-        w = p1.frequency + (level - a1) * (p2.frequency - p1.frequency) / (a2 - a1)
+        lower = guess < state[4]
+        below = [q for q in pts if q[1] < level]
+        above = [q for q in pts if q[1] >= level]
+        if below and above:  # bracketed: the secant between the closest on each side (regula falsi)
+            (p1, a1), (p2, a2) = (min(below, key=lambda q: level - q[1]), min(above, key=lambda q: q[1] - level))
+            w = p1.frequency + (level - a1) * (p2.frequency - p1.frequency) / (a2 - a1)
+        else:  # not yet: a step towards the mode's frequency (amplitude too low) or away from it, doubling
+            step = 3e-4 * 2 ** (len(pts) - 1) * (1 if (pts[-1][1] < level) == lower else -1)
+            w = pts[-1][0].frequency * (1 + step)
+            if (w < state[4]) != lower:  # never across the mode's frequency to the other flank
+                w = 0.5 * (pts[-1][0].frequency + state[4])
     return min(pts, key=lambda p: abs(p[1] / level - 1))[0], len(pts)
 
 
-def internal(omega: np.ndarray, frequency: float, within: float = 3.0) -> str:
-    """The higher open-phase modes near a harmonic of ``frequency`` (up to the :data:`HARMONICS`-th): each mode ``k``
-    whose nearest harmonic ``hΩ``
-    lies within ``within`` of its half-power half-widths ``ζω_k`` (else the nearest one), with that distance."""
-    h = np.maximum(np.round(omega[1:] / frequency), 1)
-    far = np.abs(h * frequency - omega[1:]) / (DAMPING.zeta * omega[1:])
-    far[h > HARMONICS] = np.inf  # a harmonic that high carries nothing
-    near = np.flatnonzero(far <= within) if np.any(far <= within) else [int(np.argmin(far))]
-    return "internal resonance: " + "; ".join(
-        f"harmonic {int(h[k])} of {frequency / 2 / np.pi:.2f} Hz {far[k]:.1f} half-widths from mode {k + 2} "
-        f"({omega[k + 1] / 2 / np.pi:.2f} Hz)" for k in near)
+def internal(omega: np.ndarray, frequency: float, least: float = 10.0) -> str:
+    """How strongly the higher open-phase modes answer the harmonics of an orbit at ``frequency``: for each mode
+    ``k`` its nearest harmonic ``h`` (up to the :data:`HARMONICS`-th) and the dynamic amplification
+    ``1/√((1 − r²)² + (2ζr)²)``, ``r = hΩ/ω_k``; those above ``least`` (else the largest)."""
+    h = np.clip(np.round(omega[1:] / frequency), 1, HARMONICS)
+    r = h * frequency / omega[1:]
+    gain = 1 / np.sqrt((1 - r**2) ** 2 + (2 * DAMPING.zeta * r) ** 2)
+    near = np.flatnonzero(gain >= least) if np.any(gain >= least) else [int(np.argmax(gain))]
+    return "; ".join(f"mode {k + 2} ({omega[k + 1] / 2 / np.pi:.2f} Hz) answers harmonic {int(h[k])} of "
+                     f"{frequency / 2 / np.pi:.2f} Hz x{gain[k]:.0f}" for k in near)
 
 
 def blade(a):
@@ -222,7 +227,7 @@ def run_phase(a) -> None:
               f"fundamental a1 = {a1:.6g}, kappa {kap:.5f}: zeta*kappa {zk:.7f}; free decay {zd:.7f} "
               f"({zd / m.zeta - 1:+.3%}); friction's own ratio on the orbit {zf:.4e} "
               f"({time.perf_counter() - t:.0f} s)")
-        print(f"   {internal(omega, m.frequency)} at the mode's frequency")
+        print(f"   at the mode's frequency: {internal(omega, m.frequency)}")
         # the force whose peak a mode of constant ω, ζκ would put at √2·a1: its flanks at a1 near the half-power points
         force = 2 * np.sqrt(2) * zk * m.frequency**2 * a1
         shape = 1j * force * (s.M @ phi[:, 0])
@@ -239,7 +244,7 @@ def run_phase(a) -> None:
             w, zp, b1 = phase_mode(p, shape)
             zfp = friction_ratio(p.trajectory, p.trajectory.t_end - 2 * np.pi / p.frequency, p.trajectory.t_end, w)
             flanks[side] = p.frequency
-            print(f"   {internal(omega, p.frequency)} at the {side} flank")
+            print(f"   at the {side} flank: {internal(omega, p.frequency)}")
             print(f"   {side} flank at {p.frequency / 2 / np.pi:.5f} Hz (single mode: {w0 / 2 / np.pi:.5f}), a1 "
                   f"{b1:.6g} ({b1 / a1 - 1:+.1e}), {steps} points, {p.periods} periods: by its phase f = "
                   f"{w / 2 / np.pi:.5f} Hz ({w / m.frequency - 1:+.1e}), zeta*kappa {zp:.7f}: {rel(zp, zk)}; "
