@@ -143,9 +143,9 @@ class CoatingPhase(_Phase):
             self._modes(K, fl.Cq if fl.Cq is not None else np.zeros((n, n)), n)
         # the switching signals Lq q + Lp q' + Lg (g + w) + Ld g' + c, one or two a node: (node, kind)
         rows, meta = [], []
-        zn, zm = np.zeros(n), np.zeros(m)
+        zn, zm, eye = np.zeros(n), np.zeros(m), np.eye(m)
         for j in range(m):
-            e = np.eye(m)[j]
+            e = eye[j]
             if codes[j] == OPEN:
                 rows.append((-Wq[:, j] + H[j] @ Lq_lam, zn, e + H[j] @ Lg_lam, zm, H[j] @ lam_c))
                 meta.append((j, "gap"))
