@@ -51,7 +51,6 @@ is deeper than the cell's. At a step the nodes are decided again: the forces sol
 
 from __future__ import annotations
 
-import copy
 from dataclasses import dataclass
 
 import numpy as np
@@ -180,7 +179,8 @@ class CoatingPhase(_Phase):
 
     def at_surface(self, w: np.ndarray) -> CoatingPhase:
         """The phase with the nodes' surfaces ``w`` (m): its equilibrium and its signals' constants."""
-        out = copy.copy(self)
+        out = object.__new__(CoatingPhase)  # a shallow copy (copy.copy's, without its dispatch)
+        out.__dict__.update(self.__dict__)
         fl = self._fl
         u = fl.system.gap + w
         out.w = w
@@ -406,11 +406,12 @@ class CoatingFlight:
         t = 0.0
         before = w
         codes, w = self.decide(q, p, t, w)
-        starts, cl, wl, qs, ps, amps, jumps = [], [], [], [], [], [], []
+        starts, cl, wl, qs, ps, amps, jumps, flown = [], [], [], [], [], [], [], []
         still = 0  # switches in a row at the same instant
         while len(starts) <= max_switches:
             ph, a, start = self._ready_start(codes, w, q, p, t)
             starts.append(t), cl.append(codes), wl.append(w), qs.append(q), ps.append(p), amps.append(a)
+            flown.append(ph)
             jumps.append(np.zeros(s.m) if before is None else self._jump(ph, q, t, codes, w, before))
             before = None  # a switch in flight removes nothing at once; a flight cut short neither
             edges = self._edges(profile, t, codes, w) if profile is not None else np.full(s.m, np.inf)
@@ -435,7 +436,8 @@ class CoatingFlight:
             t += tau
             codes, w = self.settle(codes, w, q, p, t, first=k, ph=ph)
         return CoatingTrajectory(self, np.array(starts), np.array(cl), np.array(wl), np.array(qs).T,
-                                 np.array(ps).T, np.array(amps), t, bool(t >= t_end), np.array(jumps))
+                                 np.array(ps).T, np.array(amps), t, bool(t >= t_end), np.array(jumps),
+                                 tuple(flown) if REUSE else None)
 
     def _ready_start(self, codes, w, q, p, t: float):
         """The phase of ``codes`` and ``w``, its amplitudes at ``(q, p, t)`` and their :func:`_start`: those
@@ -501,6 +503,13 @@ class CoatingTrajectory:
     t_end: float
     complete: bool
     jumps: np.ndarray = None  # type: ignore[assignment]
+    flown: tuple | None = None  # the phase flown from each start (its surfaces set), kept to sample the flight
+
+    def _phase(self, i: int) -> CoatingPhase:
+        """The phase flown from the start ``i`` (the one kept, else made again: the same numbers)."""
+        if self.flown is not None:
+            return self.flown[i]
+        return self.flight.phase(self.codes[i], self.surfaces[i])
 
     @property
     def switch_times(self) -> np.ndarray:
@@ -517,7 +526,7 @@ class CoatingTrajectory:
         lam, y = np.zeros((fl.m, t.size)), np.zeros((fl.m, t.size))
         for i in np.unique(k):
             sel = np.flatnonzero(k == i)
-            ph = fl.phase(self.codes[i], self.surfaces[i])
+            ph = self._phase(i)
             Q[:, sel], P[:, sel] = ph.advance(self.amplitudes[i], self.starts[i], t[sel] - self.starts[i])
             y[:, sel], lam[:, sel] = fl.positions(ph, Q[:, sel], t[sel])
         return fl.phi @ Q, fl.phi @ P, lam, y
@@ -529,7 +538,7 @@ class CoatingTrajectory:
         out = self.jumps.sum(axis=0) if self.jumps is not None else np.zeros(fl.m)
         ends = np.r_[self.starts[1:], self.t_end]
         for i in np.flatnonzero((self.codes == PLASTIC).any(axis=1)):
-            ph = fl.phase(self.codes[i], self.surfaces[i])
+            ph = self._phase(i)
             q1 = ph.advance(self.amplitudes[i], self.starts[i], ends[i] - self.starts[i])[0]
             rec = fl.plastic_surface(ph, q1, ends[i]) - fl.plastic_surface(ph, self.q[:, i], self.starts[i])
             out += np.where(self.codes[i] == PLASTIC, rec, 0.0)
