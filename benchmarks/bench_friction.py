@@ -135,7 +135,7 @@ def sweep(count: int, revolutions: int, max_revolutions: int) -> None:
     print("   rpm      model s   rub s   wear s   total s  (cpu s)  rub revs  wear phases  removed mm3  "
           "energy residual")
     t0, c0 = time.perf_counter(), time.process_time()
-    sums, worst = np.zeros(3), 0.0
+    sums, worst, refusals = np.zeros(3), 0.0, 0
     for rpm, w in zip(speeds, w_all):
         t, cpu = time.perf_counter(), time.process_time()
         state = spin(model, w, axis, static=static, previous=earlier.states)
@@ -143,28 +143,37 @@ def sweep(count: int, revolutions: int, max_revolutions: int) -> None:
         hot = stage._running(model, contact, state.displacement, w)
         own = None if state.static == "nonlinear" else interior.of(model, contact, r["size"], casing, axis, static)
         reduced = nodal_model(state.model, hot, r["size"], factor=state.factor, casing=casing, interior=own,
-                                    residual=True)
+                              residual=True)
         t_model = time.perf_counter() - t
         t = time.perf_counter()
-        fr, flight, response = friction_response(reduced, friction, axis, state.factor, w, k["lobes"], k["amplitude"],
-                                                 angles, damping, r["revolutions"], r["window"], cap,
-                                                 respond=rub_response)
-        t_rub = time.perf_counter() - t
-        t = time.perf_counter()
-        worn = wear_rub(reduced.system, coating, w, k["lobes"], k["amplitude"], angles, damping, r["revolutions"],
-                        areas=reduced.areas, friction=fr, flight=flight)
-        t_wear = time.perf_counter() - t
+        times, refused = [], None
+        try:  # as the stage: a speed the simulation refuses is that speed's result, the others go on
+            fr, flight, response = friction_response(reduced, friction, axis, state.factor, w, k["lobes"],
+                                                     k["amplitude"], angles, damping, r["revolutions"], r["window"],
+                                                     cap, respond=rub_response)
+            times.append(time.perf_counter() - t)
+            t = time.perf_counter()
+            worn = wear_rub(reduced.system, coating, w, k["lobes"], k["amplitude"], angles, damping,
+                            r["revolutions"], areas=reduced.areas, friction=fr, flight=flight)
+        except ValueError as exc:
+            refused = str(exc)
+        times.append(time.perf_counter() - t)
+        t_rub, t_wear = times if len(times) == 2 else (times[0], 0.0)  # the rub refused: no wear
         sums += (t_model, t_rub, t_wear)
+        head = (f"   {rpm:7.1f}  {t_model:7.2f}  {t_rub:6.2f}  {t_wear:7.2f}  {t_model + t_rub + t_wear:8.2f}  "
+                f"({time.process_time() - cpu:6.2f})  ")
+        if refused is not None:
+            refusals += 1
+            print(f"{head}refused ({'wear' if len(times) == 2 else 'rub'}): {refused[:90]}", flush=True)
+            continue
         res = response.as_dict().get("friction", {}).get("relative_residual", float("nan"))
         worst = max(worst, abs(res))
-        print(f"   {rpm:7.1f}  {t_model:7.2f}  {t_rub:6.2f}  {t_wear:7.2f}  {t_model + t_rub + t_wear:8.2f}  "
-              f"({time.process_time() - cpu:6.2f})  "
-              f"{response.revolutions_run:8d}  {worn.phases:11d}  {1e9 * worn.profile.removed:11.4g}  {res:.1e}",
-              flush=True)
+        print(f"{head}{response.revolutions_run:8d}  {worn.phases:11d}  {1e9 * worn.profile.removed:11.4g}  "
+              f"{res:.1e}", flush=True)
     total, cpu = time.perf_counter() - t0, time.process_time() - c0
     print(f"   {total:.1f} s in all ({total / count:.2f} s a speed; {cpu:.1f} s of CPU): models {sums[0]:.1f} s, rubs "
           f"with friction and energy {sums[1]:.1f} s, wear rubs in flight {sums[2]:.1f} s; worst energy residual "
-          f"{worst:.2e}")
+          f"{worst:.2e}; {refusals} speeds refused")
 
 
 def main() -> None:
