@@ -19,9 +19,26 @@ the energy balance closes.
 
     python benchmarks/bench_friction.py                 # everything
     python benchmarks/bench_friction.py --speeds 5      # a short sweep
-    python benchmarks/bench_friction.py --skip-modes --sweep-only --speeds 50   # section 3 alone
+    python benchmarks/bench_friction.py --sweep-only --speeds 50   # section 3 alone
 
-Section 3, measured (2 cores shared with other jobs, ``OPENBLAS_NUM_THREADS=1``; MEASURED_PLACEHOLDER)
+Section 3, measured on 2026-11-29 on 2 cores shared with two other people's jobs (load 2.3 to 4 throughout: the wall
+times carry that noise, the CPU seconds less), one process, 4 revolutions a speed, no run-on:
+
+    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_friction.py --sweep-only --speeds 50
+
+- 50 speeds, 1400-1700 rpm: 546.1 s in all (10.9 s a speed; 436.2 s of CPU): models 27.0 s, rubs with friction and
+  their energy 28.6 s, wear rubs in flight 490.5 s (90 %); worst energy residual 1.1e-12. The wear rub takes 4.5 to
+  25.1 s a speed (9.9 s on average), growing with its phases (8.2 k to 19.4 k over the 4 revolutions: the profile
+  steps under each of the 26 nodes are most of them) as the wear deepens towards the crossing of mode 1 with the 8
+  lobes. One speed, 1657.1 rpm, is refused by the wear rub (a grazing switch: a node that stopped yielding does not
+  leave its yield force; the code before these figures refuses it at the same instant); the stage reports such a
+  speed and goes on, and so does this section.
+- Before the coating flight's shortcuts (next profile edges from the runs of equal depth, a flight started from the
+  start its decision computed, phases kept for the sampling; the same numbers bit for bit), the same sweep's first
+  3 speeds back to back: wear rubs 77.0 s -> 53.6 s, 58.4 s -> 44.3 s of CPU for the 3 speeds; one speed at
+  1650 rpm alone (17 566 phases), best of several runs: 15.6 s -> 11.0 s of CPU.
+- The figure this section gave before (549.7 s for 50 speeds) timed an offline wear pass of each speed's last
+  revolution, not the in-flight coupling a study runs; it is not comparable.
 """
 
 from __future__ import annotations
