@@ -51,7 +51,6 @@ is deeper than the cell's. At a step the nodes are decided again: the forces sol
 
 from __future__ import annotations
 
-import copy
 from dataclasses import dataclass
 
 import numpy as np
@@ -81,6 +80,10 @@ EDGE_RTOL = 1e-9
 
 #: Points at which a flat start is checked positive over its first flight.
 LEAVE_POINTS = 16
+
+#: Whether a flight starts from the phase, amplitudes and signals its decision just computed (the same numbers;
+#: ``False`` makes them again, as the identity test does).
+REUSE = True
 
 
 class CoatingPhase(_Phase):
@@ -139,9 +142,9 @@ class CoatingPhase(_Phase):
             self._modes(K, fl.Cq if fl.Cq is not None else np.zeros((n, n)), n)
         # the switching signals Lq q + Lp q' + Lg (g + w) + Ld g' + c, one or two a node: (node, kind)
         rows, meta = [], []
-        zn, zm = np.zeros(n), np.zeros(m)
+        zn, zm, eye = np.zeros(n), np.zeros(m), np.eye(m)
         for j in range(m):
-            e = np.eye(m)[j]
+            e = eye[j]
             if codes[j] == OPEN:
                 rows.append((-Wq[:, j] + H[j] @ Lq_lam, zn, e + H[j] @ Lg_lam, zm, H[j] @ lam_c))
                 meta.append((j, "gap"))
@@ -176,7 +179,8 @@ class CoatingPhase(_Phase):
 
     def at_surface(self, w: np.ndarray) -> CoatingPhase:
         """The phase with the nodes' surfaces ``w`` (m): its equilibrium and its signals' constants."""
-        out = copy.copy(self)
+        out = object.__new__(CoatingPhase)  # a shallow copy (copy.copy's, without its dispatch)
+        out.__dict__.update(self.__dict__)
         fl = self._fl
         u = fl.system.gap + w
         out.w = w
@@ -188,6 +192,22 @@ class CoatingPhase(_Phase):
         """``λ`` ``(m, k)`` at the modal displacements ``Q`` ``(n, k)`` and the times ``t``."""
         g = self._fl.gap(t) + self.w[:, None]
         return self.Lq_lam @ Q + self.Lg_lam @ g + self.lam_c[:, None]
+
+
+def _runs(depth: np.ndarray) -> np.ndarray:
+    """For each cell ``c`` of a profile's ``depth`` (``n`` cells round the casing), how many cells further on
+    (wrapping round) the first of another depth lies: ``1`` to ``n − 1``, or ``n`` when every cell has its depth.
+
+    >>> _runs(np.array([0.0, 0.0, 1.0, 0.0])).tolist()
+    [2, 1, 1, 3]
+    """
+    n = depth.size
+    dd = np.r_[depth, depth]
+    change = np.flatnonzero(dd[1:] != dd[:-1]) + 1  # the cells (unwrapped) of another depth than the one before
+    if not change.size:
+        return np.full(n, n, dtype=np.int64)
+    first = change[np.searchsorted(change, np.arange(n), side="right")]  # the first change after each cell
+    return (first - np.arange(n)).astype(np.int64)
 
 
 def _start(ph, a, t: float):
@@ -232,6 +252,8 @@ class CoatingFlight:
         self.Hc, self.Hy = system.H - mu * C_nt, system.flexibility - mu * C_nt
         self.Cq, self.nu, self.D = flight_terms(self.omega, damping, rub, system.m)
         self._phases: dict[bytes, CoatingPhase] = {}
+        self._ready = None  # the start settle last found admissible (:meth:`_ready_start`)
+        self._runs = (None, None)  # a profile and its runs of equal depths (:func:`_runs`)
 
     def phase(self, codes: np.ndarray, w: np.ndarray) -> CoatingPhase:
         """The phase of the node codes ``codes`` with the surfaces ``w`` (cached per codes)."""
@@ -264,10 +286,11 @@ class CoatingFlight:
 
     # ------------------------------------------------------------------ decisions
 
-    def _bad(self, ph: CoatingPhase, a, t: float) -> list[int]:
+    def _bad(self, ph: CoatingPhase, a, t: float, start=None) -> list[int]:
         """The signals of the phase ``ph`` started with the amplitudes ``a`` at ``t`` that start inadmissible, the
-        most negative first: below 0, or on their surface and falling (flat ones must curve up: checked in flight)."""
-        sig, f0, d0, scale, on, flat = _start(ph, a, t)
+        most negative first: below 0, or on their surface and falling (flat ones must curve up: checked in flight);
+        ``start``: their :func:`_start`, if computed."""
+        sig, f0, d0, scale, on, flat = _start(ph, a, t) if start is None else start
         bad = (~on & (f0 < 0)) | (on & ~flat & (d0 < 0))
         order = np.argsort(np.where(on, 0.0, f0 / scale), kind="stable")
         return [int(k) for k in order if bad[k]]
@@ -295,8 +318,11 @@ class CoatingFlight:
         seen = set()
         for _ in range(4 * self.m + 4):
             new = self.phase(codes, w)
-            bad = self._bad(new, new.amplitudes(q, p, t), t)
-            if not bad:
+            a = new.amplitudes(q, p, t)
+            start = _start(new, a, t)
+            bad = self._bad(new, a, t, start)
+            if not bad:  # the flight that follows starts from these (:meth:`_ready_start`)
+                self._ready = (codes, w, q, p, t, new, a, start)
                 return codes, w
             key = (codes.tobytes(), bad[0])
             if key in seen:
@@ -332,10 +358,10 @@ class CoatingFlight:
 
     # ------------------------------------------------------------------ flight
 
-    def _fly(self, ph: CoatingPhase, a, t: float, horizon: float):
+    def _fly(self, ph: CoatingPhase, a, t: float, horizon: float, start=None):
         """The first switch of a flight (``(τ, signal)``, or ``None``) and the span searched (a flat start that
-        leaves its surface cuts the flight short)."""
-        sig, _, _, _, on, flat = _start(ph, a, t)
+        leaves its surface cuts the flight short); ``start``: the phase's :func:`_start`, if computed."""
+        sig, _, _, _, on, flat = _start(ph, a, t) if start is None else start
         span = horizon
         if flat.any():
             leave = []
@@ -380,17 +406,17 @@ class CoatingFlight:
         t = 0.0
         before = w
         codes, w = self.decide(q, p, t, w)
-        starts, cl, wl, qs, ps, amps, jumps = [], [], [], [], [], [], []
+        starts, cl, wl, qs, ps, amps, jumps, flown = [], [], [], [], [], [], [], []
         still = 0  # switches in a row at the same instant
         while len(starts) <= max_switches:
-            ph = self.phase(codes, w)
-            a = ph.amplitudes(q, p, t)
+            ph, a, start = self._ready_start(codes, w, q, p, t)
             starts.append(t), cl.append(codes), wl.append(w), qs.append(q), ps.append(p), amps.append(a)
+            flown.append(ph)
             jumps.append(np.zeros(s.m) if before is None else self._jump(ph, q, t, codes, w, before))
             before = None  # a switch in flight removes nothing at once; a flight cut short neither
             edges = self._edges(profile, t, codes, w) if profile is not None else np.full(s.m, np.inf)
             stop = min(float(edges.min()), t_end)
-            hit, span = self._fly(ph, a, t, stop - t)
+            hit, span = self._fly(ph, a, t, stop - t, start)
             if hit is None:
                 q, p = ph.advance(a, t, span)
                 if span < stop - t:
@@ -410,7 +436,17 @@ class CoatingFlight:
             t += tau
             codes, w = self.settle(codes, w, q, p, t, first=k, ph=ph)
         return CoatingTrajectory(self, np.array(starts), np.array(cl), np.array(wl), np.array(qs).T,
-                                 np.array(ps).T, np.array(amps), t, bool(t >= t_end), np.array(jumps))
+                                 np.array(ps).T, np.array(amps), t, bool(t >= t_end), np.array(jumps),
+                                 tuple(flown) if REUSE else None)
+
+    def _ready_start(self, codes, w, q, p, t: float):
+        """The phase of ``codes`` and ``w``, its amplitudes at ``(q, p, t)`` and their :func:`_start`: those
+        :meth:`settle` just computed for these very arrays (the same numbers), else made (``start`` ``None``)."""
+        r, self._ready = self._ready, None
+        if REUSE and r is not None and r[0] is codes and r[1] is w and r[2] is q and r[3] is p and r[4] == t:
+            return r[5], r[6], r[7]
+        ph = self.phase(codes, w)
+        return ph, ph.amplitudes(q, p, t), None
 
     @staticmethod
     def _cells(profile: Profile, t: float) -> np.ndarray:
@@ -423,15 +459,17 @@ class CoatingFlight:
         surface (open, elastic), the next cell (plastic: its own surface against the cell's)."""
         n = profile.depth.size
         c0 = self._cells(profile, t)
-        ahead = profile.depth[(c0[:, None] + 1 + np.arange(n)) % n]  # (m, n): the cells ahead of each node
-        differ = (ahead != w[:, None]) | (codes == PLASTIC)[:, None]
-        k = np.where(differ.any(axis=1), np.argmax(differ, axis=1), n)  # n: none in a turn, the turn's edge
+        if self._runs[0] is not profile:
+            self._runs = (profile, _runs(profile.depth))
+        nxt = (c0 + 1) % n  # each node's next cell: another depth than its surface, or its run's length further
+        k = np.where((profile.depth[nxt] != w) | (codes == PLASTIC), 0, self._runs[1][nxt])
         return ((c0 + 1 + k) * profile.step - np.asarray(profile.angles)) / profile.speed
 
     def _jump(self, ph: CoatingPhase, q, t: float, codes, w, before) -> np.ndarray:
         """The depth each node removed at once at ``t`` (a step of the profile, the start): its decided surface (its
         own receding one if plastic) beyond the surface it had (``before``)."""
-        after = np.where(codes == PLASTIC, self.plastic_surface(ph, q, t), w)
+        plastic = codes == PLASTIC
+        after = np.where(plastic, self.plastic_surface(ph, q, t), w) if plastic.any() else w
         return np.maximum(after - before, 0.0)
 
     def _step(self, ph: CoatingPhase, codes, w, q, p, t: float, profile: Profile, crossing: np.ndarray):
@@ -440,7 +478,7 @@ class CoatingFlight:
         pressed beyond its yield removes the excess at once), and the surfaces the nodes had before deciding."""
         depth = profile.depth[self._cells(profile, t) % profile.depth.size]
         plastic = codes == PLASTIC
-        own = self.plastic_surface(ph, q, t)
+        own = self.plastic_surface(ph, q, t) if plastic.any() else w  # read where plastic only
         new = np.where(crossing, np.where(plastic, np.maximum(own, depth), depth), np.where(plastic, own, w))
         if np.any(crossing & plastic & (depth > own)):
             return (*self.decide(q, p, t, new), new)
@@ -465,6 +503,13 @@ class CoatingTrajectory:
     t_end: float
     complete: bool
     jumps: np.ndarray = None  # type: ignore[assignment]
+    flown: tuple | None = None  # the phase flown from each start (its surfaces set), kept to sample the flight
+
+    def _phase(self, i: int) -> CoatingPhase:
+        """The phase flown from the start ``i`` (the one kept, else made again: the same numbers)."""
+        if self.flown is not None:
+            return self.flown[i]
+        return self.flight.phase(self.codes[i], self.surfaces[i])
 
     @property
     def switch_times(self) -> np.ndarray:
@@ -481,7 +526,7 @@ class CoatingTrajectory:
         lam, y = np.zeros((fl.m, t.size)), np.zeros((fl.m, t.size))
         for i in np.unique(k):
             sel = np.flatnonzero(k == i)
-            ph = fl.phase(self.codes[i], self.surfaces[i])
+            ph = self._phase(i)
             Q[:, sel], P[:, sel] = ph.advance(self.amplitudes[i], self.starts[i], t[sel] - self.starts[i])
             y[:, sel], lam[:, sel] = fl.positions(ph, Q[:, sel], t[sel])
         return fl.phi @ Q, fl.phi @ P, lam, y
@@ -493,7 +538,7 @@ class CoatingTrajectory:
         out = self.jumps.sum(axis=0) if self.jumps is not None else np.zeros(fl.m)
         ends = np.r_[self.starts[1:], self.t_end]
         for i in np.flatnonzero((self.codes == PLASTIC).any(axis=1)):
-            ph = fl.phase(self.codes[i], self.surfaces[i])
+            ph = self._phase(i)
             q1 = ph.advance(self.amplitudes[i], self.starts[i], ends[i] - self.starts[i])[0]
             rec = fl.plastic_surface(ph, q1, ends[i]) - fl.plastic_surface(ph, self.q[:, i], self.starts[i])
             out += np.where(self.codes[i] == PLASTIC, rec, 0.0)
