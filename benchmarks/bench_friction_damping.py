@@ -201,7 +201,7 @@ def blade(a):
     grazing = float(np.min(s.gap / np.abs(s.W.T @ phi[:, 0])))
     print(f"the demo blade at {a.rpm:g} rpm, tip nodes {'all' if a.nodes is None else a.nodes} of "
           f"{len(contact.nodes)}: n = {s.n}, m = {s.m}, f1 = {omega[0] / 2 / np.pi:.3f} Hz open, grazing amplitude "
-          f"{grazing:.4g}; mu = {MU}, stick–slip, casing at rest, {DAMPING.zeta:.1%} damping "
+          f"{grazing:.4g}; mu = {MU}, stick–slip, casing at rest, {np.min(DAMPING.zeta):.1%} damping "
           f"({time.perf_counter() - t0:.1f} s to build)")
     return s, fr, grazing
 
@@ -242,6 +242,11 @@ def run_phase(a) -> None:
                 print(f"   {side} flank: the simulator stopped ({e})")
                 continue
             w, zp, b1 = phase_mode(p, shape)
+            if abs(b1 / a1 - 1) > 1e-3:  # the secant did not reach a1: a fold or jump nearby; no reading at a1
+                print(f"   {side} flank: a1 = {a1:.6g} not reached ({b1:.6g} at {p.frequency / 2 / np.pi:.5f} Hz after "
+                      f"{steps} points): the forced curve folds or jumps near it; no reading at a1 "
+                      f"({time.perf_counter() - t:.0f} s)")
+                continue
             zfp = friction_ratio(p.trajectory, p.trajectory.t_end - 2 * np.pi / p.frequency, p.trajectory.t_end, w)
             flanks[side] = p.frequency
             print(f"   at the {side} flank: {internal(omega, p.frequency)}")
