@@ -156,8 +156,14 @@ def flank_point(s, fr, shape, level: float, guess: float, state, rtol: float, st
     pts, w = [], guess
     for _ in range(steps):
         near = min(pts, key=lambda p: abs(p[1] / level - 1))[0] if pts else None
-        p = forced_point(s, fr, shape, w, DAMPING, start=near, state=None if near else state[:4], rtol=rtol,
-                         max_periods=3000)
+        try:
+            p = forced_point(s, fr, shape, w, DAMPING, start=near, state=None if near else state[:4], rtol=rtol,
+                             max_periods=3000)
+        except ValueError as e:  # a degenerate switch is an accident of this frequency: one retry a hair off it
+            print(f"   at {w / 2 / np.pi:.6f} Hz the simulator stopped ({e}); again at 1e-7 above")
+            w *= 1 + 1e-7
+            p = forced_point(s, fr, shape, w, DAMPING, start=near, state=None if near else state[:4], rtol=rtol,
+                             max_periods=3000)
         T = 2 * np.pi / w
         pts.append((p, abs(fundamental(p.trajectory, p.trajectory.t_end - T, T))))
         if abs(pts[-1][1] / level - 1) < 2e-5:
