@@ -1,31 +1,50 @@
 """The damping ratio of the demo blade's first mode with stick–slip friction against amplitude, checked against a
 forced response's resonance width at the same amplitude (goal: within 5 %).
 
-The demo blade at 1650 rpm (its centrifugal state and nodal model as the rub study builds them), all 26 tip nodes
-(``--nodes``: a subset, sharing the casing's stiffness by their areas), μ = 0.15 with the stick–slip model, 0.5 %
-structural damping, the casing at rest (sliding speed 0: classic hysteretic friction damping; with the casing
-sliding at ΩR the rotation model's friction does no net work on a free mode). First the same checks on the Jenkins
-oscillator of the tests; then at each amplitude ``a`` (times the mode's grazing amplitude):
+The demo blade at 1650 rpm (``--rpm``; its centrifugal state and nodal model as the rub study builds them), all 26
+tip nodes (``--nodes``: a subset, sharing the casing's stiffness by their areas), μ = 0.15 with the stick–slip
+model, 0.5 % structural damping, the casing at rest (sliding speed 0: classic hysteretic friction damping; with the
+casing sliding at ΩR the rotation model's friction does no net work on a free mode). First the same checks on the
+Jenkins oscillator of the tests; then at each amplitude ``a`` (times the mode's grazing amplitude, at the orbit's
+turning point), by default (``--method phase``):
 
-1. the extended periodic motion concept (EPMC): frequency ω(a) and ζ(a); the free decay from the orbit's start
-   (certified simulator, without the term) beside it;
-2. the forced response to ``F cos Ωt`` along the mode's shape with ``F = 2ζ(√2a)ω(√2a)²·√2a`` (phase resonance at
-   √2·a by the EPMC, so that the curve passes through ``a`` near its half-power points), started in that mode's
-   orbit, swept over ``--points`` frequencies across ±``--span`` ζ(√2a) around ω(√2a), the top refined by
-   ``--refine`` golden-section evaluations;
-3. **the resonance width at a**: the two flank frequencies Ω₁ < Ω₂ where the response's amplitude is ``a`` (each
-   refined by ``--flank-steps`` secant evaluations) both belong to the single nonlinear mode's ω(a), ζ(a):
-   ``(ω² − Ω_i²)² + (2ζωΩ_i)² = (F/a)²`` (F the modal force) gives them (``flank_mode``), compared with the EPMC's
-   at ``a`` — ζ(a), and friction's share (less the mode's ratio without friction at ``a``, the rotation model's
-   concept at μ = 0);
-4. the earlier figures at the peak: ``ζ_F = F / (2ω_peak²a_peak)`` (phase resonance) against ζ(a_peak) by the
-   EPMC (and friction's part); the half-power width read as a linear mode's, ``(Ω₂ − Ω₁)/(2Ω_peak)``; the
-   half-power frequencies predicted by the EPMC at ``a_peak/√2`` against the sweep's.
+1. the extended periodic motion concept (EPMC): frequency ω(a), ζ(a), the orbit's fundamental amplitude a₁ (the
+   followed mode's coordinate) and kinetic factor κ; the free decay from the orbit's start (certified simulator,
+   without the term, read at the start's amplitude); friction's own ratio on the orbit (its work over a period
+   over 2ω∫x′ᵀMx′ dt); how strongly each higher mode answers the orbit's harmonics (dynamic amplification);
+2. the forced response to ``F cos Ωt`` along the mode's shape, ``F = 2√2ζκω²a₁`` (a peak near √2·a₁): on each
+   flank the point whose fundamental amplitude is a₁ (secant steps, bracketed, kept on its side of ω), read by its
+   phase (``phase_mode``: ω and ζκ at a₁) against the concept's, with friction's own ratio on its orbit; the width
+   from the two flanks' amplitudes alone (``flank_mode``).
 
-    python benchmarks/bench_friction_damping.py                       # 1.5, 2, 2.5, 3 x grazing, all 26 nodes
-    python benchmarks/bench_friction_damping.py --amplitudes 1.5 2 --nodes 0 8 17 25
+``--method sweep`` runs the earlier check instead: a sweep across the resonance, its peak refined by golden-section
+steps, the flanks at ``a`` by the amplitude's largest value, ``ζ_F = F/(2ω²a)`` at the peak.
 
-Figures: (all 26 nodes; ``--points 13 --refine 4`` at 1.5 x grazing, ``--points 15 --refine 6`` at 3; a busy two-core
+    python benchmarks/bench_friction_damping.py --no-jenkins --amplitudes 1.5 2 3 --rtol 1e-8
+    python benchmarks/bench_friction_damping.py --method sweep --amplitudes 1.5 2 --nodes 0 8 17 25
+
+Figures (``--method phase``, all 26 nodes, ``--rtol 1e-8``; a busy two-core machine, one BLAS thread). 1650 rpm:
+
+- 1.5 x grazing: EPMC f = 217.30126 Hz, ζ = 0.0053044, a₁ = 1.27604e-4, κ = 1.00466 (ζκ = 0.0053292); free decay
+  −0.06 %; friction's own ratio 2.42e-4. Lower flank 216.15244 Hz: ω +1.1e-4, ζκ −0.57 %, friction's own +16.0 %;
+  upper flank 218.44568 Hz: ω −4.6e-5, ζκ −0.46 %, friction's own +18.7 %; width from the amplitudes alone
+  +0.97 %. Mode 2 (869.37 Hz, 4.008 f1) answers the 4th harmonic ×100 at the mode's frequency, ×68 and ×70 at the
+  flanks: the forced orbits are not the free mode's in their higher modes, and the dissipation splits otherwise
+  between friction and the higher modes' damping. With the higher modes damped 5 % (a throw-away variant of this
+  script, the first mode's 0.5 % kept): κ = 1.00004, lower flank ζκ +0.03 %, friction's own +0.6 %.
+- 2 x grazing: EPMC f = 217.96489 Hz, ζ = 0.0062680, κ = 1.03339; free decay −0.10 %; friction's own 8.01e-4. Lower
+  flank 216.96791 Hz (0.43 Hz above the single mode's prediction): ω +2.0e-3, ζκ −1.84 %, friction's own −0.3 %;
+  the upper flank not reached at a₁ (6 points, 2910 periods: +3.6 % at 219.576 Hz, the curve folds near it).
+- 3 x grazing: EPMC f = 219.82019 Hz, ζ = 0.0094978, κ = 1.04450; free decay −0.18 %; friction's own 3.90e-3; the
+  lower flank's third secant point (217.802472 Hz) stops the simulator at a degenerate switch (node 35's slip
+  ends with node 22 on its cone 1.3 ns from sliding and neighbours' slip signals coupled: no admissible next state
+  found, again 1e-7 higher), so no reading at 3 x.
+- Each amplitude 1–10 minutes (a forced point 10–60 s, an upper flank near the fold the longest).
+
+Earlier figures, ``--method sweep`` (amplitude as the largest value over a period, before the decay was read at
+the start's amplitude; its "free decay" is a period's own ratio, half a period low in amplitude):
+
+(all 26 nodes; ``--points 13 --refine 4`` at 1.5 x grazing, ``--points 15 --refine 6`` at 3; a busy two-core
 machine, one BLAS thread, two runs side by side). 1.5 x grazing: EPMC f = 217.3013 Hz, ζ(a) = 0.005304 (friction's
 share 3.12e-4 over the 0.004993 without friction; 25 phases a period, 25 s); free decay 0.005276 (−0.54 %). Forced
 at F = 4.449 (21 frequencies, 4550 periods, 616 s; one point not settled to 1e-6): peak 1.794e-4 (2.11 x grazing)
