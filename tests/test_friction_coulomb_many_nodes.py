@@ -209,3 +209,28 @@ def test_demo_tip_nodes_on_the_cone_decided_together():
     assert np.allclose(tau[slide], f.mu * sigma[slide] * lam[slide], rtol=0, atol=1e-9 * scale)
     assert np.all(sigma[slide] * -zd[slide] >= -1e-6 * np.abs(zd).max())
     assert np.all(np.abs(zd[codes == CODES["stick"]]) <= 1e-9 * np.abs(zd).max())
+
+
+def test_nodes_decided_together_start_with_margins_a_few_digits_short():
+    """A forced point of the demo tip at three times the grazing amplitude (stored at the switch): node 35's slip
+    ends while node 22 sticks 1.3 ns from its cone and the neighbours' slip velocities jump with any change. The
+    rate-level problem decides them together (6 and 17 stick, 22 slides); node 17's stuck margin then starts at
+    −1.7e-6 of its terms, rising. Within the decided nodes' tolerance that is admissible: the switch has a next state
+    (before, it toggled nodes 17 and 6 and stopped), and the phase it starts admits every signal but that margin."""
+    from bladecase.nsm import Damping
+    from bladecase.nsm.massless.friction_coulomb import ADMISSIBLE_RTOL, DECIDED_RTOL
+    from bladecase.nsm.massless.friction_modes_forced import _Forced
+
+    d = dict(np.load(Path(__file__).parent / "data" / "demo_tip_degenerate_switch.npz"))
+    s = NodalSystem(d["M"], d["S"], d["W"], d["flexibility"], d["gap"], d["casing"], nodes=tuple(d["nodes"].tolist()))
+    f = Friction(float(d["mu"]), T=d["T"], C_nt=d["C_nt"], C_tt=d["C_tt"], model="coulomb")
+    fl = _Forced(s, f, Damping(zeta=0.005), 0.0, None, d["shape"], float(d["frequency"]), d["anchors"])
+    q, p, t, codes = d["q"], d["p"], float(d["t"]), d["codes"]
+    ph = fl.phase(codes)
+    new, anc = fl._switch(ph, int(d["k"]), codes, d["anchors"], q, p, t)
+    assert [int(c) for c in new[[6, 17, 22]]] == [CODES["stick"], CODES["stick"], CODES["slip+"]]
+    cand, bad = fl._violations(new, anc, q, p, t)
+    f0 = cand.signals(fl, cand.amplitudes(q, p, t, anc), t, anc, 0.0).values(0.0)[0][0]
+    scale = cand.signals(fl, cand.amplitudes(q, p, t, anc), t, anc, 0.0).magnitude
+    short = [(cand.meta[b], float(f0[b] / scale[b])) for b in bad]
+    assert len(short) == 1 and short[0][0] == (17, "cone-") and ADMISSIBLE_RTOL < -short[0][1] < DECIDED_RTOL
