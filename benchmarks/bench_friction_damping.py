@@ -35,10 +35,13 @@ Figures (``--method phase``, all 26 nodes, ``--rtol 1e-8``; a busy two-core mach
 - 2 x grazing: EPMC f = 217.96489 Hz, ζ = 0.0062680, κ = 1.03339; free decay −0.10 %; friction's own 8.01e-4. Lower
   flank 216.96791 Hz (0.43 Hz above the single mode's prediction): ω +2.0e-3, ζκ −1.84 %, friction's own −0.3 %;
   the upper flank not reached at a₁ (6 points, 2910 periods: +3.6 % at 219.576 Hz, the curve folds near it).
-- 3 x grazing: EPMC f = 219.82019 Hz, ζ = 0.0094978, κ = 1.04450; free decay −0.18 %; friction's own 3.90e-3; the
-  lower flank's third secant point (217.802472 Hz) stops the simulator at a degenerate switch (node 35's slip
-  ends with node 22 on its cone 1.3 ns from sliding and neighbours' slip signals coupled: no admissible next state
-  found, again 1e-7 higher), so no reading at 3 x.
+- 3 x grazing: EPMC f = 219.82019 Hz, ζ = 0.0094978, κ = 1.04450; free decay −0.18 %; friction's own 3.90e-3. Lower
+  flank 218.00859 Hz (0.40 Hz above the single mode's prediction; 6 points): ω +2.6e-3, ζκ −9.2 %, friction's own
+  −37 %: no longer one nonlinear mode answering a harmonic force. (Its third point stopped the simulator at a
+  degenerate switch before the nodes decided together were given their tolerance; upper flank not run.)
+- 500 rpm (``--rpm 500``; mode 2 at 4.09 f1), 1.5 x grazing: EPMC f = 213.05825 Hz, ζ = 0.0061519; free decay
+  −0.29 %; lower flank 211.64327 Hz: ω −4.1e-4, ζκ +0.52 %, friction's own +10.1 % (modes 2–4 answer the 4th, 8th
+  and 9th harmonics 34/44/31-fold at the mode's frequency, 24/29/50-fold at the flank).
 - Each amplitude 1–10 minutes (a forced point 10–60 s, an upper flank near the fold the longest).
 
 Earlier figures, ``--method sweep`` (amplitude as the largest value over a period, before the decay was read at
