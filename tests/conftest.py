@@ -269,32 +269,41 @@ HEAVIEST_FIRST = [
     "tests/test_executor.py",  # with test_comparison_study.py and test_mistuning_stats.py (SAME_WORKER)
     "tests/test_search_speed.py",  # with test_kipp.py (SAME_WORKER)
     "tests/test_examples.py",  # with test_fig8.py (SAME_WORKER)
+    "tests/test_friction_study.py",
+    "tests/test_fem.py",
+    "tests/test_scan.py",  # with test_orbits.py and test_simulate.py (SAME_WORKER)
     "tests/test_pipeline.py",
-    "tests/test_rub_study.py",
     "tests/test_nodal_modes.py",
     "tests/test_engineering_outputs.py",  # with the other MASSLESS_MODE_FILES (SAME_WORKER)
-    "tests/test_nodal_study.py",
-    "tests/test_scan.py",  # with test_orbits.py and test_simulate.py (SAME_WORKER)
     "tests/test_compare_decides.py",
-    "tests/test_fem.py",
-    "tests/test_friction_study.py",
     "tests/test_forcing_stage.py",
+    "tests/test_nodal_study.py",
     "tests/test_nodes.py",
-    "tests/test_viz.py",  # with test_export.py (SAME_WORKER)
-    "tests/test_casing_sweep.py",
-    "tests/test_verdict.py",
-    "tests/test_failure_paths.py",
-    "tests/test_tip_excursion.py",
-    "tests/test_massless.py",
-    "tests/test_isoparametric.py",
+    "tests/test_properties.py",
+    "tests/test_friction_coulomb_study.py",
     "tests/test_calculix.py",
-    "tests/test_hex_blade.py",
-    "tests/test_rotation.py",
-    "tests/test_reference.py",
+    "tests/test_rub_study.py",
+    "tests/test_nonlinear_static.py",
+    "tests/test_disk_rub_study.py",
+    "tests/test_stress_limit.py",
+    "tests/test_massless.py",
     "tests/test_forced_massless.py",
-    "tests/test_geometry.py",
-    "tests/test_rotation_study.py",
-    "tests/test_rub_line.py",
+    "tests/test_tip_excursion.py",
+    "tests/test_isoparametric.py",
+    "tests/test_plots.py",
+    "tests/test_rotation.py",
+    "tests/test_hex_blade.py",
+    "tests/test_validity.py",
+    "tests/test_verdict.py",
+    "tests/test_casing_sweep.py",
+    "tests/test_reference.py",
+    "tests/test_massless_casing.py",
+    "tests/test_wear_in_flight.py",
+    "tests/test_viz.py",  # with test_export.py (SAME_WORKER)
+    "tests/test_nonlinear_static_reuse.py",
+    "tests/test_failure_paths.py",
+    "tests/test_mistuning_casing.py",
+    "tests/test_cyclic_calculix.py",
 ]
 
 #: The files that use ``dask_executor`` (one work unit of :data:`SAME_WORKER`) and the session's executor while it
