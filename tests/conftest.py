@@ -385,7 +385,8 @@ def pytest_configure(config):
         _STALE_CLEANUP.append(thread)
 
 
-def pytest_unconfigure(config):
+@pytest.hookimpl(tryfirst=True)  # before pytest's own clean-up of the numbered directories
+def pytest_sessionfinish(session, exitstatus):
     """Wait for :func:`pytest_configure`'s clean-up (long done: it started with the session)."""
     for thread in _STALE_CLEANUP:
         thread.join()
