@@ -80,9 +80,11 @@ HYGIENE = [
     ("lab-notebook prose", r"\b(?:this|last|previous|next|second|third) (?:session|stop)\b", True, ()),
 ]
 
-#: Python that starts processes (a Dask local cluster, a process pool): the page runs in a fresh interpreter.
-STARTS_PROCESSES = re.compile(r"\b(?:DaskExecutor|ProcessExecutor|LocalCluster|make_executor|multiprocessing)\b|"
-                              r"__main__")
+#: Python that starts processes (a Dask local cluster, a process pool, an executor other than the serial one): the
+#: page runs in a fresh interpreter.  Matched in the code without its comments (:func:`starts_processes`): a comment
+#: naming another executor starts nothing.
+STARTS_PROCESSES = re.compile(r"\b(?:DaskExecutor|ProcessExecutor|LocalCluster|multiprocessing)\b|"
+                              r"\bmake_executor\((?!\s*[\"']serial[\"']\s*\))|__main__")
 
 FENCE = re.compile(r"^```([^\n`]*)\n(.*?)^```", re.S | re.M)
 SHELLS = {"sh", "bash", "shell", "console"}
@@ -147,6 +149,11 @@ def documented_commands() -> list[tuple[str, str, bool]]:
                 for cmd in commands(lang, body):
                     out.append((rel(page), cmd, runnable and not argv_of(cmd)[1]))
     return out
+
+
+def starts_processes(source: str) -> bool:
+    """The page's Python may start processes (:data:`STARTS_PROCESSES`, comments left out)."""
+    return bool(STARTS_PROCESSES.search(re.sub(r"#[^\n]*", "", source)))
 
 
 def python_source(page: Path) -> str:
@@ -248,7 +255,7 @@ def page_runs(tmp_path_factory):
     for page in _python_pages():
         source = python_source(ROOT / page)
         tmp = _workdir(tmp_path_factory.mktemp("python"))
-        if STARTS_PROCESSES.search(source) or not forkable:
+        if starts_processes(source) or not forkable:
             fresh.append((page, source, tmp))
         else:
             jobs[("python", page)] = _ForkedPage(page, source, tmp)

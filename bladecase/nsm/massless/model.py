@@ -70,9 +70,19 @@ class Phase:
 
     def advance(self, x, v, tau: float) -> tuple[np.ndarray, np.ndarray]:
         """State after a flight of duration ``tau`` in this phase (closed form)."""
+        return self.flight(x, v)(tau)
+
+    def flight(self, x, v):
+        """``tau -> advance(x, v, tau)``: the flight from one state, its modal coordinates computed once (the same
+        numbers as :meth:`advance` at every ``tau``, for the many instants of one orbit's phase)."""
         q, p = self.modal(x, v)
-        c, s = np.cos(self.omega * tau), np.sin(self.omega * tau)
-        return self.x_eq + self.phi @ (c * q + s * p / self.omega), self.phi @ (-self.omega * s * q + c * p)
+        omega, phi, x_eq = self.omega, self.phi, self.x_eq
+
+        def at(tau: float) -> tuple[np.ndarray, np.ndarray]:
+            c, s = np.cos(omega * tau), np.sin(omega * tau)
+            return x_eq + phi @ (c * q + s * p / omega), phi @ (-omega * s * q + c * p)
+
+        return at
 
     def contact(self, x, v) -> TrigSum:
         """``y(τ) = ŵᵀx(τ)`` during this phase from the state ``(x, v)``."""

@@ -261,7 +261,7 @@ class NodalOrbit:
             sig = ph.signals(a, t0)
             h = min(sig.step / 4, tau / 8) if np.isfinite(sig.step) else tau / 8
             grid = np.linspace(0.0, tau, int(min(np.ceil(tau / h), 20000)) + 1)
-            F = sig.values(grid)[0]
+            F = sig.value(grid)
             F = np.where(A[None, :], F, -F)  # λ_j while closed, −s_j while open
             slack = sig.bound * (grid[1] - grid[0]) ** 2 / 8
             data.append((A, sig, grid, F, slack))
@@ -298,7 +298,7 @@ class NodalOrbit:
             h = min(sig.step / 4, tau / 8) if np.isfinite(sig.step) else tau / 8
             grid = np.linspace(0.0, tau, int(min(np.ceil(tau / h), 20000)) + 1)
             w = A.astype(float)  # the closed nodes' signals are their forces
-            F = sig.values(grid)[0] @ w
+            F = sig.value(grid) @ w
             slack = float(sig.bound @ w) * (grid[1] - grid[0]) ** 2 / 8
             for i in np.flatnonzero(F + slack >= max(F.max(), best)):
                 value, at = _polish(sig, grid, int(i), w)
@@ -409,6 +409,9 @@ def _unit(m: int, j: int) -> np.ndarray:
     return e
 
 
+_NINE = np.arange(9.0)
+
+
 def _polish(sig, grid: np.ndarray, i: int, w: np.ndarray) -> tuple[float, float]:
     """The largest ``Σ_j w_j f_j`` between ``grid[i − 1]`` and ``grid[i + 1]`` and where (``(value, τ)``): nested
     grids of 9 points, each spanning the best point's two neighbours on the previous one (shrinking 4-fold), down
@@ -417,8 +420,9 @@ def _polish(sig, grid: np.ndarray, i: int, w: np.ndarray) -> tuple[float, float]
     lo, hi = float(grid[max(i - 1, 0)]), float(grid[min(i + 1, grid.size - 1)])
     best, where = -np.inf, lo
     for _ in range(40):
-        ts = np.linspace(lo, hi, 9)
-        vals = sig.values(ts)[0] @ w
+        ts = _NINE * ((hi - lo) / 8) + lo  # np.linspace(lo, hi, 9), the same arithmetic without its overhead
+        ts[-1] = hi
+        vals = sig.value(ts) @ w
         k = int(np.argmax(vals))
         if vals[k] > best:
             best, where = float(vals[k]), float(ts[k])

@@ -52,6 +52,14 @@ class _Signals:
             f, df = f + z.real, df - self.nu * z.imag
         return f, df
 
+    def value(self, tau: np.ndarray) -> np.ndarray:
+        """``f`` alone at the points ``tau`` (1-D), ``(len(tau), m)``: :meth:`values`' first array, computed the same
+        way, without the derivatives (the maximum searches of the orbits' peaks read only the values)."""
+        f = (np.exp(np.multiply.outer(tau, self.lam)) @ self.C.T).real + self.const
+        if self.nu > 0:
+            f = f + np.multiply.outer(np.exp(1j * self.nu * tau), self.E).real
+        return f
+
     @cached_property
     def bound(self) -> np.ndarray:
         """``B₂ >= max|f_j''|`` of each signal."""

@@ -177,10 +177,10 @@ class SymmetricOrbit(BoundOrbit):
         t = np.mod(np.atleast_1d(np.asarray(t, float)), self.T)
         x1, v1 = self.closing_state()
         x2, v2 = s.closed.advance(x1, v1, 2 * self.beta)
+        closed, open_ = s.closed.flight(x1, v1), s.open.flight(x2, v2)
         X, V = np.empty((s.n, t.size)), np.empty((s.n, t.size))
         for j, tj in enumerate(t):
-            X[:, j], V[:, j] = s.closed.advance(x1, v1, tj) if tj < 2 * self.beta else \
-                s.open.advance(x2, v2, tj - 2 * self.beta)
+            X[:, j], V[:, j] = closed(tj) if tj < 2 * self.beta else open_(tj - 2 * self.beta)
         return X, V
 
     @cached_property

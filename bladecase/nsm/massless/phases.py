@@ -258,8 +258,11 @@ class PhasedOrbit(BoundOrbit):
         edges = np.concatenate([[0.0], np.cumsum(self.durations)])
         idx = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, self.durations.size - 1)
         X, V = np.empty((s.n, t.size)), np.empty((s.n, t.size))
+        flights = {}  # each phase's flight from its start, its modal coordinates computed once
         for j, (tj, i) in enumerate(zip(t, idx)):
-            X[:, j], V[:, j] = ph[self.kinds[i]].advance(*self._starts[i], tj - edges[i])
+            if i not in flights:
+                flights[i] = ph[self.kinds[i]].flight(*self._starts[i])
+            X[:, j], V[:, j] = flights[i](tj - edges[i])
         return X, V * sign
 
     @cached_property
