@@ -368,8 +368,11 @@ def pytest_configure(config):
     import tempfile
     import time
 
-    from _pytest.pathlib import LOCK_TIMEOUT, cleanup_candidates, try_cleanup
-    from _pytest.tmpdir import get_user
+    try:  # pytest's own clean-up functions (private): without them, pytest's clean-up at the end alone
+        from _pytest.pathlib import LOCK_TIMEOUT, cleanup_candidates, try_cleanup
+        from _pytest.tmpdir import get_user
+    except ImportError:
+        return
 
     root = Path(os.environ.get("PYTEST_DEBUG_TEMPROOT") or tempfile.gettempdir()).resolve()
     root = root / f"pytest-of-{get_user() or 'unknown'}"
