@@ -59,7 +59,7 @@ from scipy.optimize import lsq_linear
 
 from .friction import first_order_modes, lemke
 from .nodal_switches import _Signals, first_switch
-from .nodes import MAX_SWITCHES, NodalSystem, Profile, Rub, casing_gap, flight_terms
+from .nodes import MAX_SWITCHES, NodalSystem, Profile, Rub, Sampled, casing_gap, flight_terms
 from .nodes_phase import _Phase
 
 __all__ = ["CODES", "CoatingFlight", "CoatingTrajectory", "simulate_coating"]
@@ -489,7 +489,7 @@ class CoatingFlight:
 
 
 @dataclass(frozen=True, eq=False)
-class CoatingTrajectory:
+class CoatingTrajectory(Sampled):
     """Result of :func:`simulate_coating`: the start of every phase (time, node codes, surfaces, modal state,
     amplitudes, and the depth each node removed at once there: ``jumps``, ``(phases, m)``)."""
 
@@ -543,14 +543,6 @@ class CoatingTrajectory:
             rec = fl.plastic_surface(ph, q1, ends[i]) - fl.plastic_surface(ph, self.q[:, i], self.starts[i])
             out += np.where(self.codes[i] == PLASTIC, rec, 0.0)
         return out
-
-    @property
-    def x_end(self) -> np.ndarray:
-        return self.sample(self.t_end)[0][:, 0]
-
-    @property
-    def v_end(self) -> np.ndarray:
-        return self.sample(self.t_end)[1][:, 0]
 
 
 def simulate_coating(system: NodalSystem, yield_force, x0, v0, t_end: float, damping=None, rub: Rub | None = None,

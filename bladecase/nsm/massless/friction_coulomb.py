@@ -64,7 +64,7 @@ import numpy as np
 from .friction import Friction, lemke
 from .friction_coulomb_phase import OPEN, SLIP_NEG, SLIP_POS, STICK, CoulombPhase, RampSignals
 from .nodal_switches import first_switch
-from .nodes import MAX_SWITCHES, SURFACE_RTOL, NodalSystem, Rub, casing_gap, flight_terms, lcp
+from .nodes import MAX_SWITCHES, SURFACE_RTOL, NodalSystem, Rub, Sampled, casing_gap, flight_terms, lcp
 
 __all__ = ["CODES", "CoulombFlight", "CoulombTrajectory", "simulate_coulomb"]
 
@@ -400,7 +400,7 @@ def _lifted(sig: RampSignals, shift: np.ndarray) -> RampSignals:
 
 
 @dataclass(frozen=True, eq=False)
-class CoulombTrajectory:
+class CoulombTrajectory(Sampled):
     """Result of :func:`simulate_coulomb`: the start of every phase (time, node codes, sticking anchors, modal state,
     amplitudes); a flight cut where a flat start left its surface starts a new phase with the same codes."""
 
@@ -454,19 +454,6 @@ class CoulombTrajectory:
             z[:, sel] = ph.Zq @ Q[:, sel] + ph.Zr @ rho
             zd[:, sel] = ph.Zq @ P[:, sel] + ph.Zr @ fl.rho_rate(t[sel])
         return fl.phi @ Q, fl.phi @ P, lam, tau, z, zd
-
-    def state(self, t) -> tuple[np.ndarray, np.ndarray]:
-        """Interior ``(x, v)`` at the times ``t`` (``(n, k)``)."""
-        x, v, *_ = self.sample(t)
-        return x, v
-
-    @property
-    def x_end(self) -> np.ndarray:
-        return self.state(self.t_end)[0][:, 0]
-
-    @property
-    def v_end(self) -> np.ndarray:
-        return self.state(self.t_end)[1][:, 0]
 
     def _time(self, mask: np.ndarray, t0: float, t1: float | None) -> np.ndarray:
         t1 = self.t_end if t1 is None else t1

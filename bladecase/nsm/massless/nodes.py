@@ -210,8 +210,26 @@ class NodalFlight:
         return A
 
 
+class Sampled:
+    """What a trajectory with ``sample(t)`` (interior ``x``, ``v`` first) and ``t_end`` gives alike: the interior
+    state at any times and at its end."""
+
+    def state(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """Interior ``(x, v)`` at the times ``t`` (``(n, k)``), in closed form from the phase holding each."""
+        x, v, *_ = self.sample(t)
+        return x, v
+
+    @property
+    def x_end(self) -> np.ndarray:
+        return self.state(self.t_end)[0][:, 0]
+
+    @property
+    def v_end(self) -> np.ndarray:
+        return self.state(self.t_end)[1][:, 0]
+
+
 @dataclass(frozen=True, eq=False)
-class NodalTrajectory:
+class NodalTrajectory(Sampled):
     """Result of :func:`simulate_nodes`: the start of every phase (time, set of closed contacts, modal state)."""
 
     flight: NodalFlight
@@ -231,11 +249,6 @@ class NodalTrajectory:
     def switch_times(self) -> np.ndarray:
         """Times of the switches (the phases' starts after the first)."""
         return self.starts[1:]
-
-    def state(self, t) -> tuple[np.ndarray, np.ndarray]:
-        """Interior ``(x, v)`` at the times ``t`` (``(n, k)``), in closed form from the phase holding each."""
-        x, v, _ = self.sample(t)
-        return x, v
 
     def sample(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Interior ``(x, v)`` and the contact forces ``λ`` (``(m, k)``) at the times ``t``, in closed form from the
@@ -257,14 +270,6 @@ class NodalTrajectory:
                 lam[np.ix_(ph.idx, sel)] = np.maximum(ph.closed_forces(Q[:, sel], t[sel], fl.gap), 0.0)
         x, v = fl.decode(Q, P)
         return x, v, lam
-
-    @property
-    def x_end(self) -> np.ndarray:
-        return self.state(self.t_end)[0][:, 0]
-
-    @property
-    def v_end(self) -> np.ndarray:
-        return self.state(self.t_end)[1][:, 0]
 
     def forces(self, t) -> np.ndarray:
         """Contact forces ``(m, k)`` at the times ``t``."""
