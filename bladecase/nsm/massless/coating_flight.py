@@ -58,7 +58,7 @@ import scipy.linalg as sla
 from scipy.optimize import lsq_linear
 
 from .friction import first_order_modes, lemke
-from .nodal_switches import _Signals, first_switch
+from .nodal_switches import _Signals, first_switch, leave_flat
 from .nodes import MAX_SWITCHES, NodalSystem, Profile, Rub, Sampled, casing_gap, flight_terms
 from .nodes_phase import _Phase
 
@@ -366,26 +366,17 @@ class CoatingFlight:
         if flat.any():
             leave = []
             for k in np.flatnonzero(flat):
-                try:
-                    leave.append(self._leave(sig, k, horizon))
-                except ValueError:  # it stays on its surface: a switch now (e.g. a node that stopped yielding
+                tau = leave_flat(sig.row(k), horizon, sig.step, ADMISSIBLE_RTOL * max(sig.magnitude[k], 1e-300),
+                                 LEAVE_POINTS)
+                if tau is None:  # it stays on its surface: a switch now (e.g. a node that stopped yielding
                     return (0.0, int(k)), 0.0  # yields on: its removal rate only grazed zero)
+                leave.append(tau)
             span = min(span, min(leave))
             keep = ~flat
             sig = _Signals(sig.lam, sig.C * keep[:, None], sig.E * keep, sig.nu, np.where(keep, sig.const, 1.0),
                            sig.lam2)
             on = on & keep
         return (first_switch(sig, span, on) if span > 0 else None), span
-
-    @staticmethod
-    def _leave(sig: _Signals, k: int, horizon: float) -> float:
-        row = sig.row(k)
-        tau = min(horizon, sig.step)
-        for _ in range(200):
-            if np.all(-row(tau * np.arange(1, LEAVE_POINTS + 1) / LEAVE_POINTS)[0] > 0):
-                return float(tau)
-            tau /= 2
-        raise ValueError("grazing switch: a node that stopped yielding does not leave its yield force")
 
     def simulate(self, x0, v0, t_end: float, w0=None, profile: Profile | None = None,
                  max_switches: int = MAX_SWITCHES) -> CoatingTrajectory:

@@ -63,7 +63,7 @@ import numpy as np
 
 from .friction import Friction, lemke
 from .friction_coulomb_phase import OPEN, SLIP_NEG, SLIP_POS, STICK, CoulombPhase, RampSignals
-from .nodal_switches import first_switch
+from .nodal_switches import first_switch, leave_flat
 from .nodes import MAX_SWITCHES, SURFACE_RTOL, NodalSystem, Rub, Sampled, casing_gap, flight_terms, lcp
 
 __all__ = ["CODES", "CoulombFlight", "CoulombTrajectory", "simulate_coulomb"]
@@ -355,7 +355,13 @@ class CoulombFlight:
         flat = on & flat_rate
         span = horizon
         if flat.any():
-            span = min(span, min(self._leave(sig, k, horizon) for k in np.flatnonzero(flat)))
+            band = ADMISSIBLE_RTOL * _start_scale(sig)
+            for k in np.flatnonzero(flat):
+                tau = leave_flat(sig.row(k), horizon, sig.step, band[k], LEAVE_POINTS)
+                if tau is None:
+                    raise ValueError("grazing switch: a sticking node's friction force does not leave the cone's "
+                                     "surface")
+                span = min(span, tau)
             keep = ~flat
             sig = RampSignals(sig.lam, sig.C * keep[:, None], sig.E * keep, sig.nu, np.where(keep, sig.const, 1.0),
                               sig.lam2, sig.slope * keep, np.where(keep, sig.base, 1.0), span)
@@ -370,18 +376,6 @@ class CoulombFlight:
                 span, ramp = float(roots[k]), (float(roots[k]), k)
         hit = first_switch(sig, span, on) if span > 0 else None
         return (hit if hit is not None else ramp), span
-
-    @staticmethod
-    def _leave(sig: RampSignals, k: int, horizon: float) -> float:
-        """A first flight over which the flat-starting signal ``k`` (zero value and slope, curving up) is positive."""
-        row = sig.row(k)
-        tau = min(horizon, sig.step)
-        for _ in range(200):
-            f = -row(tau * np.arange(1, LEAVE_POINTS + 1) / LEAVE_POINTS)[0]
-            if np.all(f > 0):
-                return float(tau)
-            tau /= 2
-        raise ValueError("grazing switch: a sticking node's friction force does not leave the cone's surface")
 
 
 _NAMES = {v: k for k, v in CODES.items()}

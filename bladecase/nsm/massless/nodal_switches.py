@@ -16,7 +16,7 @@ import numpy as np
 
 from ..signals import POINTS_PER_PERIOD, _search, interval_bound
 
-__all__ = ["first_switch"]
+__all__ = ["first_switch", "leave_flat"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -138,6 +138,34 @@ def _leave(f0: float, d0: float, B2: float, horizon: float, row: _Row) -> float:
     while tau > 1e-300 and float(row(tau)[0]) >= 0:
         tau /= 2
     return tau
+
+
+def leave_flat(row: _Row, horizon: float, step: float, band: float, points: int = 16) -> float | None:
+    """A first flight ``τ`` over which the signal of ``row`` (negated), starting on its surface with a zero slope,
+    is positive at ``points`` points: from ``min(horizon, step)``, halved until it is; ``None`` if it never is.
+
+    A flight shorter than ``step`` (cut short by an event: a cell's edge, the end) is taken whole when the signal
+    stays above ``−band`` over it: it could not leave its surface's band (``band``: the tolerance that admitted its
+    start, e.g. a start ``1e-14`` of its size below it curving up by less than that before the event) and the
+    decision at the event takes it from there.
+
+    >>> sig = _Signals(np.array([0.0]), np.array([[0.0]]), np.array([0.0]), 0.0, np.array([0.0]), np.array([0.0]))
+    >>> leave_flat(sig.row(0), 1.0, 0.5, 1e-9) is None          # a zero signal never leaves its surface
+    True
+    >>> leave_flat(sig.row(0), 1e-3, 0.5, 1e-9)                 # unless the flight ends first, within its band
+    0.001
+    """
+    tau = min(horizon, step)
+    grid = np.arange(1, points + 1) / points
+    f = -row(tau * grid)[0]
+    if tau == horizon and np.all(f >= -band):
+        return float(tau)
+    for _ in range(200):
+        if np.all(f > 0):
+            return float(tau)
+        tau /= 2
+        f = -row(tau * grid)[0]
+    return None
 
 
 def first_switch(sig: _Signals, horizon: float, on: np.ndarray, chunk: int = 256) -> tuple[float, int] | None:
