@@ -171,10 +171,43 @@ def _wear_lines(w: dict | None, unit: str) -> list[str]:
 
 
 def _friction_lines(f: dict | None, unit: str) -> list[str]:
-    """The friction's words: its model and assumption, the energy of the hardest speed's last revolution, the
-    balance and the sliding check."""
+    """The friction's words (:func:`_friction_energy_lines`) and those of its mode (:func:`_mode_lines`)."""
     if not f:
         return []
+    return _friction_energy_lines(f, unit) + _mode_lines(f.get("modes"), unit)
+
+
+def _mode_lines(m: dict | None, unit: str) -> list[str]:
+    """The first mode with friction: at the speed where its damping ratio moves most from the structural one, its
+    frequency and ratio from the least to the largest amplitude, the free decay's check, and what is doubtful."""
+    if not m:
+        return []
+    per = [(s, [q for q in s["points"] if "error" not in q]) for s in m["speeds"]]
+    per = [(s, good) for s, good in per if good]
+    out = []
+    if per:
+        s, good = max(per, key=lambda sg: max(abs(q["zeta"] - sg[0]["structural_zeta"]) for q in sg[1]))
+        lo, hi = good[0], good[-1]
+        out.append(f"- The first mode with friction (the extended periodic motion concept: a term balancing what "
+                   f"friction and damping take over a period; `friction_modes.csv`, `friction_modes.png`): at "
+                   f"{s['speed']:.6g} {unit} (where its damping ratio moves most from the structural one), from "
+                   f"{lo['amplitude_ratio']:g} to {hi['amplitude_ratio']:g} × its grazing amplitude "
+                   f"({lo['tip_amplitude_m'] * 1e3:.4g} to {hi['tip_amplitude_m'] * 1e3:.4g} mm at the tip) its "
+                   f"frequency goes {lo['frequency_hz']:.6g} → {hi['frequency_hz']:.6g} Hz (open {s['open_hz']:.6g} "
+                   f"Hz) and its damping ratio {100 * lo['zeta']:.4f} → {100 * hi['zeta']:.4f} % (structural "
+                   f"{100 * s['structural_zeta']:.4f} %).")
+        if m.get("worst_decay_error") is not None:
+            out.append(f"- Checked by the free decay from each orbit's start without the balancing term: its damping "
+                       f"ratio within {100 * abs(m['worst_decay_error']):.2g} % of the mode's at every speed and "
+                       "amplitude. These figures are this mesh's: their mesh error is not measured.")
+    for words in m["doubts"]:
+        out.append(f"- **The mode with friction is doubtful** {words}.")
+    return out
+
+
+def _friction_energy_lines(f: dict, unit: str) -> list[str]:
+    """The friction's model and assumption, the energy of the hardest speed's last revolution, the balance and the
+    sliding check."""
     out = [f"- Friction: {f['assumption']}."]
     rows = [r for r in f["speeds"] if r["casing_input_j"] is not None]
     if rows:

@@ -6,6 +6,8 @@
   tip nodes weighted by tributary length;
 - :mod:`~bladecase.study.rub.keys` — the keys ``[contact] friction`` and ``[casing] abradable``;
 - :mod:`~bladecase.study.rub.friction` — each speed with friction: energy per revolution, the sliding check;
+- :mod:`~bladecase.study.rub.friction_modes` — each speed's first mode with friction against its amplitude, checked
+  by its free decay: ``friction_modes.csv``, ``friction_modes.png``;
 - :mod:`~bladecase.study.rub.wear` — each speed wearing the coating: ``wear.csv``, ``wear.png``, ``wear.vtu``.
 
 The names of :mod:`~bladecase.study.rub.stage` are re-exported here.

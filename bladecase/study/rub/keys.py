@@ -4,6 +4,8 @@
 
 >>> _friction({"mu": 0.15}) is None, _friction({"mu": 0.15, "model": "coulomb"}) is None
 (True, True)
+>>> _friction({"mu": 0.15, "mode_amplitudes": [1.5, 0.8]})[:61]
+'mode_amplitudes must be a list of 1 to 20 numbers in (1, 100]'
 >>> _friction({"mu": 0.15, "model": "stick"})
 "model must be 'rotation' or 'coulomb', got 'stick'"
 """
@@ -19,6 +21,9 @@ __all__ = ["ABRADABLE_KEY", "FRICTION_KEY", "FRICTION_MODELS", "friction_checks"
 #: The friction models a study may ask for.
 FRICTION_MODELS = ("rotation", "coulomb")
 
+#: At most this many amplitudes of the mode with friction (each an orbit and its free decay at every speed).
+MAX_MODE_AMPLITUDES = 20
+
 
 def _number(v) -> bool:
     return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
@@ -26,9 +31,9 @@ def _number(v) -> bool:
 
 def _friction(v: dict) -> str | None:
     """``None`` or what is wrong with ``[contact] friction``."""
-    extra = sorted(set(v) - {"mu", "model"})
+    extra = sorted(set(v) - {"mu", "model", "mode_amplitudes"})
     if extra:
-        return f"unknown key {extra[0]!r} (valid: mu, model)"
+        return f"unknown key {extra[0]!r} (valid: mu, model, mode_amplitudes)"
     if "mu" not in v:
         return "needs mu, the friction coefficient, e.g. {mu = 0.15, model = \"rotation\"}"
     if not _number(v["mu"]) or not 0 <= v["mu"] <= 2:
@@ -36,6 +41,11 @@ def _friction(v: dict) -> str | None:
     model = v.get("model", "rotation")
     if model not in FRICTION_MODELS:
         return f"model must be 'rotation' or 'coulomb', got {model!r}"
+    amps = v.get("mode_amplitudes")
+    if amps is not None and not (isinstance(amps, list) and 1 <= len(amps) <= MAX_MODE_AMPLITUDES
+                                 and all(_number(a) and 1 < a <= 100 for a in amps)):
+        return (f"mode_amplitudes must be a list of 1 to {MAX_MODE_AMPLITUDES} numbers in (1, 100] (the first mode's "
+                f"amplitude over its grazing amplitude; at 1 or below it does not touch the casing), got {amps!r}")
     return None
 
 
@@ -60,7 +70,10 @@ def _abradable(v: dict) -> str | None:
 FRICTION_KEY = Key((dict,), None, "Coulomb friction at each contact node of the [rub] response: {mu = 0.15, model = "
                    "'rotation'} ('rotation': the sliding dominated by the rotation, ΩR ≫ the vibration velocity, "
                    "checked per node and speed; 'coulomb': stick–slip, each touching node sliding either way or "
-                   "sticking to the casing, for a slow speed); default: none.", _friction)
+                   "sticking to the casing, for a slow speed); mode_amplitudes = [1.5, 2, 3]: the first mode with "
+                   "friction at these multiples of its grazing amplitude at each speed, its frequency and damping "
+                   "ratio checked by its free decay (friction_modes.csv, friction_modes.png); default: none.",
+                   _friction)
 
 ABRADABLE_KEY = Key((dict,), None, "An abradable coating on the casing, worn by the [rub] response: {thickness (m), "
                     "yield (Pa: the contact pressure at which it is removed), stiffness (Pa/m), cells (round the "
@@ -85,6 +98,8 @@ def friction_checks(c: dict) -> None:
             raise StudyError("[contact] friction: it acts in the rub response: give [rub] speeds (with an out-of-round "
                              "[casing]), or remove friction")
         ct["friction"] = {"mu": float(fr["mu"]), "model": fr.get("model", "rotation")}
+        if fr.get("mode_amplitudes") is not None:
+            ct["friction"]["mode_amplitudes"] = sorted({float(a) for a in fr["mode_amplitudes"]})
         if ct["friction"]["model"] == "coulomb" and ab is not None:
             raise StudyError('[contact] friction: model = "coulomb" (stick–slip) is not run with a [casing] abradable '
                              'coating; use model = "rotation" with the coating, or remove abradable')

@@ -50,6 +50,7 @@ from .friction import (
     friction_words,
     log_friction,
 )
+from .friction_modes import log_friction_modes, mode_points, modes_section, write_friction_modes
 from .wear import coating_of, log_wear, wear_figures, wear_section, write_wear
 
 __all__ = ["check_rub_contact", "contact_measure", "crossing_speed", "node_angles", "rub_stage"]
@@ -213,6 +214,8 @@ def _rub_point(speed: float, *, model, contact: Contact, interior: np.ndarray | 
         out = {"error": str(exc), "nodes": list(reduced.system.nodes)}
     else:
         out = response.as_dict()
+        if friction is not None and friction.get("mode_amplitudes") and fr is not None:
+            out["friction_modes"] = mode_points(reduced.system, fr, speed, friction["mode_amplitudes"], damping)
         if worn is not None:
             out["wear"] = wear_figures(worn)
         out["load"] = reduced.contact_load(response.force_at_peak)
@@ -362,12 +365,17 @@ def rub_stage(study, model, contact: Contact, *, families=None, executor=None, p
     points = [p for p in points if "error" not in p]  # aligned with the rows
     if coating is not None:
         section["wear"] = wear_section(study, coating, section["rows"], points)
+    if friction is not None and friction.get("mode_amplitudes"):
+        section["friction"]["modes"] = modes_section(section["rows"], points, unit)
+        log_friction_modes(section["friction"]["modes"], unit)
     log_friction(section, unit)
     log_wear(section, unit)
     if folder is not None:
         section["files"] = _write(Path(folder), section, points, figures, title)
         if "vtu" in study["output"]["formats"]:
             section["files"]["vtu"] = _write_vtu(Path(folder) / "rub.vtu", model, contact, section, points)
+        if (section.get("friction") or {}).get("modes"):
+            section["files"].update(write_friction_modes(Path(folder), section["friction"]["modes"], figures, title))
         if coating is not None:
             section["files"].update(write_wear(Path(folder), study, model, contact, section, points, figures,
                                                "vtu" in study["output"]["formats"], title))
