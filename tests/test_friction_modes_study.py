@@ -87,3 +87,16 @@ def test_stick_slip_sliding_at_engine_speed_is_the_rotation_model(blade, rotatio
 def test_mode_amplitudes_errors(given, match):
     with pytest.raises(StudyError, match=match):
         loads(_study(rub=RUB, friction=given), source="<friction modes>")
+
+
+def test_a_users_file_named_as_a_rub_result_is_refused_before_the_run(rotation, tmp_path):
+    """Every file the rub stage writes is a name a run owns: a user's file of that name in the output folder is
+    refused before any work (not found at the end, the results left unpublished)."""
+    from bladecase.study.comparison.stage import FIGURES
+    from bladecase.study.publish import RUN_RESULTS, check_ownership
+
+    written = set(rotation[0]["files"].values()) | {"wear.csv", "wear_profile.csv", "wear.png", "wear.vtu"}
+    assert written <= set(RUN_RESULTS) and {"comparison.csv", *FIGURES.values()} <= set(RUN_RESULTS)
+    (tmp_path / "friction_modes.csv").write_text("mine\n")
+    with pytest.raises(ValueError, match="friction_modes.csv"):
+        check_ownership(tmp_path)

@@ -44,8 +44,10 @@ from .manifest import MANIFEST, TOKEN, entry_hash, read_signed, stamp_folder, st
 #: Top-level result names a run owns in its output directory (older ones it did not write are removed).
 RUN_RESULTS = ("summary.json", "report.md", "run.log", "modes.json", "frequency_energy.png", "mesh.vtu", "animations",
                "vtk", "forced.csv", "forced_response.png", "campbell.png", "rub.csv", "rub_nodes.csv", "rub.png",
-               "rub.vtu", "casing.png", "nodal_modes.csv", "nodal_modes.png", "cyclic.csv", "safe.png",
-               "campbell_nd.png", "mistuning.csv", "mistuning.png")
+               "rub.vtu", "wear.csv", "wear_profile.csv", "wear.png", "wear.vtu", "friction_modes.csv",
+               "friction_modes.png", "casing.png", "nodal_modes.csv", "nodal_modes.png", "cyclic.csv", "safe.png",
+               "campbell_nd.png", "mistuning.csv", "mistuning.png", "comparison.csv", "comparison_frequency_energy.png",
+               "comparison_convergence.png", "comparison_contact_spectrum.png")
 
 LOCK = ".bladecase.lock"
 STAGING_PREFIX = ".bladecase-run-"
