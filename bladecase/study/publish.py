@@ -47,7 +47,8 @@ RUN_RESULTS = ("summary.json", "report.md", "run.log", "modes.json", "frequency_
                "rub.vtu", "wear.csv", "wear_profile.csv", "wear.png", "wear.vtu", "friction_modes.csv",
                "friction_modes.png", "casing.png", "nodal_modes.csv", "nodal_modes.png", "cyclic.csv", "safe.png",
                "campbell_nd.png", "mistuning.csv", "mistuning.png", "comparison.csv", "comparison_frequency_energy.png",
-               "comparison_convergence.png", "comparison_contact_spectrum.png")
+               "comparison_convergence.png", "comparison_contact_spectrum.png", "disk_modes.csv", "disk_rub.csv",
+               "disk_rub.png", "mistuning_contact.csv", "mistuning_rub.csv")
 
 LOCK = ".bladecase.lock"
 STAGING_PREFIX = ".bladecase-run-"
