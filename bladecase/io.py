@@ -19,7 +19,9 @@ ValueError: cannot write '...': it is a folder; give a file path (e.g. '.../resu
 
 from __future__ import annotations
 
+import csv
 import errno
+import io
 import json
 import math
 import os
@@ -36,7 +38,7 @@ from typing import Any
 import numpy as np
 
 __all__ = ["WriteError", "atomic_path", "check_output_dir", "check_output_file", "csv_cell", "npz_array", "npz_scalar",
-           "os_reason", "read_npz", "replace_dir", "save_figure", "strict_json", "write_json", "write_text",
+           "os_reason", "read_npz", "replace_dir", "rows_csv", "save_figure", "strict_json", "write_json", "write_text",
            "written_together"]
 
 
@@ -211,6 +213,22 @@ def csv_cell(value) -> str:
     if isinstance(value, bool):
         return str(value).lower()
     return f"{value:.9g}" if isinstance(value, float) else str(value)
+
+
+def rows_csv(rows: list[dict], columns) -> str:
+    """CSV text of ``rows`` (dicts) under the header ``columns`` (keys beyond them ignored, missing ones empty),
+    floats written with ``repr`` (every digit).
+
+    >>> print(rows_csv([{"T": 0.1 + 0.2, "touching": True, "x": 1}], ("T", "touching")), end="")
+    T,touching
+    0.30000000000000004,True
+    """
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=list(columns), lineterminator="\n", extrasaction="ignore")
+    w.writeheader()
+    for r in rows:
+        w.writerow({k: repr(v) if isinstance(v, float) else v for k, v in r.items()})
+    return buf.getvalue()
 
 
 def write_json(path: str | os.PathLike, data: Any) -> None:

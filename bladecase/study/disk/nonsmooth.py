@@ -16,8 +16,6 @@ the annulus' VTK series and GIF/MP4 (``[output] formats``), and ``summary.json["
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 import time
 from pathlib import Path
@@ -25,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ... import log
-from ...io import write_text
+from ...io import rows_csv, write_text
 from ..schema import Study, StudyError
 from ..stages import build_contact
 from .cyclic_keys import NONSMOOTH_GROWTH, nonsmooth_checks
@@ -36,15 +34,6 @@ __all__ = ["CHECK_PERIODS", "compute_disk_modes"]
 CHECK_PERIODS = 10
 
 _COLUMNS = ("orbit", "T", "frequency_hz", "energy_j", "residual", "return_error_1T", "max_force_n", "touching")
-
-
-def _csv(rows: list[dict]) -> str:
-    buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=_COLUMNS, lineterminator="\n", extrasaction="ignore")
-    w.writeheader()
-    for r in rows:
-        w.writerow({k: repr(v) if isinstance(v, float) else v for k, v in r.items()})
-    return buf.getvalue()
 
 
 def compute_disk_modes(study: Study, staging: Path, files: dict, *, model, sector) -> dict:
@@ -95,7 +84,7 @@ def compute_disk_modes(study: Study, staging: Path, files: dict, *, model, secto
         rows.append({"orbit": i + 1, "T": float(orbit.T), "frequency_hz": float(orbit.frequency),
                      "energy_j": float(orbit.energy), "residual": float(orbit.residual),
                      "return_error_1T": error, "max_force_n": lam, "touching": bool(orbit.touching)})
-    write_text(staging / "disk_modes.csv", _csv(rows))
+    write_text(staging / "disk_modes.csv", rows_csv(rows, _COLUMNS))
     files["disk_modes"] = "disk_modes.csv"
     last = family[-1]
     back = return_error(disk.system, last.x0, last.v0, last.T, periods=CHECK_PERIODS)

@@ -14,8 +14,6 @@ peak force, penetration, contact share, the dominant nodal diameter), ``disk_rub
 
 from __future__ import annotations
 
-import csv
-import io
 import time
 from pathlib import Path
 
@@ -23,7 +21,7 @@ import numpy as np
 
 from ... import log
 from ...fe.rotation import RotationAxis, to_rad_s
-from ...io import save_figure, write_text
+from ...io import rows_csv, save_figure, write_text
 from ..schema import Study, StudyError
 from ..stages import build_contact
 
@@ -32,15 +30,6 @@ __all__ = ["COLUMNS", "compute_disk_rub"]
 #: Columns of ``disk_rub.csv``.
 COLUMNS = ("speed", "speed_rad_s", "blade", "peak_force_n", "penetration_m", "contact_share", "dominant_nd",
            "response")
-
-
-def _csv(rows: list[dict]) -> str:
-    buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=COLUMNS, lineterminator="\n", extrasaction="ignore")
-    w.writeheader()
-    for r in rows:
-        w.writerow({k: repr(v) if isinstance(v, float) else v for k, v in r.items()})
-    return buf.getvalue()
 
 
 def _point(speed: float, *, disk, lobes: int, amplitude: float, damping, offsets, revolutions: int, window: int,
@@ -101,7 +90,7 @@ def compute_disk_rub(study: Study, staging: Path, files: dict, *, model, sector,
         log.info("disk rub at %.6g %s: %s, peak force %.4g–%.4g N, contact share %.3g, nodal diameter %d (%.0f %% "
                  "of the tips' oscillation; the lobes force %d)", given, unit, p.response, p.peak_force.min(),
                  p.peak_force.max(), p.contact_share.max(), p.dominant, 100 * p.nd_share[p.dominant], p.expected)
-    write_text(staging / "disk_rub.csv", _csv(rows))
+    write_text(staging / "disk_rub.csv", rows_csv(rows, COLUMNS))
     files["disk_rub"] = "disk_rub.csv"
     section = {"sectors": disk.sectors, "contacts": disk.system.m, "modes": disk.system.n, "lobes": k["lobes"],
                "amplitude_m": k["amplitude"], "speed_unit": unit, "expected_nd": points[0].expected,
