@@ -173,4 +173,4 @@ __all__ = [
     # study
     "RunResult", "Study", "StudyError", "demo_study", "load_study", "run",
 ]
-__version__ = "0.10.0"
+__version__ = "0.11.0"
