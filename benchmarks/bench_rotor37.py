@@ -48,10 +48,12 @@ GOALS = {"rest": 5e-4, "speed": 3e-3}
 TIP_NODES = [188, 190, 192, 194, 196, 198, 200, 203, 253, 255, 257, 259, 261, 263, 265, 267]
 
 
-def study_text(deck: Path) -> str:
+def deck_text(deck: Path, name: str, mass: str = "consistent") -> str:
+    """The ``[study]``, ``[mesh]`` and ``[fem]`` tables of a study of the deck (N-mm, quadratic wedges, the root's
+    boundary clamped), for this file's studies and ``bench_rotor37_rub.py``'s."""
     return f"""
 [study]
-name = "rotor37"
+name = "{name}"
 
 [mesh]
 path = "{deck.resolve()}"
@@ -59,9 +61,13 @@ unit = "mm"
 
 [fem]
 order = 2
-mass = "consistent"
+mass = "{mass}"
 clamp = "boundary"
+"""
 
+
+def study_text(deck: Path) -> str:
+    return deck_text(deck, "rotor37") + f"""
 [contact]
 nodes = {TIP_NODES}
 normal = [1.0, 0.0, 0.0]
@@ -77,19 +83,7 @@ def rub_text(deck: Path, speed: float, rub: bool = True) -> str:
     1 mm inwards."""
     z0, z1 = 0.00655, 0.06859
     r = lambda z: 0.640006 - 0.27245 * (z - z0) + 2e-3  # noqa: E731
-    text = f"""
-[study]
-name = "rotor37_rub"
-
-[mesh]
-path = "{deck.resolve()}"
-unit = "mm"
-
-[fem]
-order = 2
-mass = "lumped"
-clamp = "boundary"
-
+    text = deck_text(deck, "rotor37_rub", "lumped") + f"""
 [contact]
 nodes = {TIP_NODES}
 model = "massless"

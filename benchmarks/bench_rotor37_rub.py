@@ -67,6 +67,10 @@ from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from bench_rotor37 import deck_text  # noqa: E402
+
 #: The tip's cone (m): r = R0 − SLOPE (z − Z0), from z = Z0 to Z1 (bench_rotor37.rub_text).
 R0, SLOPE, Z0, Z1 = 0.640006, 0.27245, 0.00655, 0.06859
 #: The engine-order-3 crossing of mode 1 (rad/s), f1² linear in Ω² from f1 = 454.6 Hz at 900 rad/s and 624.8 Hz
@@ -90,19 +94,7 @@ def tip_face(model) -> list[int]:
 def study_text(deck: Path, nodes, speeds, args) -> str:
     r = lambda z: R0 - SLOPE * (z - Z0) + args.clearance * 1e-3  # noqa: E731
     cap = "" if args.run_on else f"max_revolutions = {args.revolutions}\n"
-    return f"""
-[study]
-name = "rotor37_rub"
-
-[mesh]
-path = "{deck.resolve()}"
-unit = "mm"
-
-[fem]
-order = 2
-mass = "lumped"
-clamp = "boundary"
-
+    return deck_text(deck, "rotor37_rub", "lumped") + f"""
 [contact]
 nodes = {list(nodes)}
 model = "massless"
@@ -231,16 +223,7 @@ def campbell(deck: Path, args) -> None:
     from bladecase.study.stages import build_mesh, build_model
 
     speeds = [900.0, 1350.0, 1800.0]
-    text = f"""
-[study]
-name = "rotor37_campbell"
-[mesh]
-path = "{deck.resolve()}"
-unit = "mm"
-[fem]
-order = 2
-mass = "consistent"
-clamp = "boundary"
+    text = deck_text(deck, "rotor37_campbell") + f"""
 [contact]
 nodes = [188, 190]
 normal = [1.0, 0.0, 0.0]
