@@ -31,7 +31,12 @@ Figures (``--method phase``, all 26 nodes, ``--rtol 1e-8``; a busy two-core mach
   +0.97 %. Mode 2 (869.37 Hz, 4.008 f1) answers the 4th harmonic ×100 at the mode's frequency, ×68 and ×70 at the
   flanks: the forced orbits are not the free mode's in their higher modes, and the dissipation splits otherwise
   between friction and the higher modes' damping. With the higher modes damped 5 % (a throw-away variant of this
-  script, the first mode's 0.5 % kept): κ = 1.00004, lower flank ζκ +0.03 %, friction's own +0.6 %.
+  script, ``DAMPING`` set to ``Damping(zeta=[0.005] + 7 * [0.05])``): κ = 1.00004, lower flank ζκ +0.03 %,
+  friction's own +0.6 %; at 2 x: EPMC f = 218.33564 Hz, ζ = 0.0063676, κ = 1.00048, lower flank ζκ +0.09 %,
+  friction's own +0.6 %; at 3 x: EPMC f = 220.99250 Hz, ζ = 0.0100638, κ = 1.00392, lower flank ζκ +0.17 %,
+  friction's own +0.1 % (its upper flank not reached at a₁: the curve folds, 663 s). With 0.5 % on every mode the
+  orbit at 2 and 3 x is in a 4:1 internal resonance with mode 2 (κ 1.033, 1.045), which the single-mode reading
+  cannot follow: the −9.2 % at 3 x below.
 - 2 x grazing: EPMC f = 217.96489 Hz, ζ = 0.0062680, κ = 1.03339; free decay −0.10 %; friction's own 8.01e-4. Lower
   flank 216.96791 Hz (0.43 Hz above the single mode's prediction): ω +2.0e-3, ζκ −1.84 %, friction's own −0.3 %;
   the upper flank not reached at a₁ (6 points, 2910 periods: +3.6 % at 219.576 Hz, the curve folds near it).
