@@ -48,7 +48,7 @@ def friction_modes_plot(section: dict, title: str | None = None) -> Figure:
     ax.legend(fontsize=7, loc="best")
     bx.set_xlabel("amplitude (× grazing)")
     bx.set_ylabel("damping ratio (%)")
-    bx.set_title("lines: the mode (balanced); circles: its free decay; dashed: structural", fontsize=8)
+    bx.set_title("line: the mode; circles: its free decay; dashed: structural", fontsize=8)
     for a in (ax, bx):
         a.grid(alpha=0.3)
     if title:
