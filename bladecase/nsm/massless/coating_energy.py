@@ -80,27 +80,54 @@ def _terms(fl):
     return fr.mu, fl.phi.T @ fr.T, fr.C_nt, fr.C_tt, fr.stored(s)
 
 
-def _fields(tr: CoatingTrajectory, k: np.ndarray, t: np.ndarray):
-    """Modal ``q``, ``p``, ``λ``, ``λ'``, the nodes' ``y'``, ``g'`` and the plastic mask ``(m, k)`` at the times
-    ``t``, each from the phase ``k`` (a phase's closed form, read before its start too: the state before a jump)."""
+def _grouped(tr: CoatingTrajectory, k: np.ndarray, t: np.ndarray):
+    """The order that groups the times ``t`` by code set and, in that order, the modal ``q``, ``p``, ``λ``, ``λ'``,
+    the nodes' ``y'``, ``g'`` and the plastic mask ``(m, k)`` at those times, each from the phase ``k`` (a phase's
+    closed form, read before its start too: the state before a jump).
+
+    The phases of one set of node codes share their modes and force maps (only their surfaces, hence their
+    equilibria, differ): the times are taken a code set at a time, each phase's own amplitudes and equilibrium
+    gathered per time; the caller puts them back in order (:func:`_fields`) or sums over them."""
     fl = tr.flight
     n, m = fl.n, fl.m
+    _, first, code = np.unique(tr.codes, axis=0, return_index=True, return_inverse=True)
+    code = code.reshape(-1)
+    order = np.argsort(code[k], kind="stable")  # the times grouped by code set: one contiguous block each
+    ks, ts = k[order], t[order]
+    tau = ts - tr.starts[ks]
     Q, P = np.empty((n, t.size)), np.empty((n, t.size))
-    lam, dlam = np.zeros((m, t.size)), np.zeros((m, t.size))
-    plastic = np.zeros((m, t.size), dtype=bool)
+    lam, dlam = np.empty((m, t.size)), np.empty((m, t.size))
+    g = fl.gap(ts) + tr.surfaces[ks].T
     gdot = np.zeros((m, t.size)) if fl.D is None else np.multiply.outer(1j * fl.nu * fl.D,
-                                                                         np.exp(1j * fl.nu * t)).real
-    order = np.argsort(k, kind="stable")
-    bounds = np.searchsorted(k[order], np.arange(tr.starts.size + 1))
-    for i in np.flatnonzero(np.diff(bounds)):
-        sel = order[bounds[i]:bounds[i + 1]]
-        ph = tr._phase(i)
-        Q[:, sel], P[:, sel] = ph.advance(tr.amplitudes[i], tr.starts[i], t[sel] - tr.starts[i])
-        lam[:, sel] = ph.forces(Q[:, sel], t[sel])
-        dlam[:, sel] = ph.Lq_lam @ P[:, sel] + ph.Lg_lam @ gdot[:, sel]
-        plastic[:, sel] = (tr.codes[i] == PLASTIC)[:, None]
+                                                                         np.exp(1j * fl.nu * ts)).real
+    wave = np.exp(1j * fl.nu * ts) if fl.nu > 0 else None
+    q_eq = np.array([tr._phase(int(i)).q_eq for i in range(tr.starts.size)])
+    bounds = np.searchsorted(code[ks], np.arange(first.size + 1))
+    for u in np.flatnonzero(np.diff(bounds)):
+        a, b = bounds[u], bounds[u + 1]
+        ph = tr._phase(int(first[u]))
+        e = np.exp(ph.lam[:, None] * tau[a:b]) * tr.amplitudes[ks[a:b]].T
+        q, p = q_eq[ks[a:b]].T + (ph.Vx @ e).real, (ph.Vv @ e).real
+        if wave is not None:
+            x = ph.X[:, None] * wave[a:b]
+            q, p = q + x.real, p + (1j * fl.nu * x).real
+        Q[:, a:b], P[:, a:b] = q, p
+        lam[:, a:b], dlam[:, a:b] = ph.lam_c[:, None], 0.0
+        ia = ph.idx  # the elastic nodes: the only rows (and columns of the clearances) the force maps have
+        if ia.size:
+            Lg = ph.Lg_lam[np.ix_(ia, ia)]
+            lam[ia, a:b] += ph.Lq_lam[ia] @ q + Lg @ g[ia, a:b]
+            dlam[ia, a:b] = ph.Lq_lam[ia] @ p + Lg @ gdot[ia, a:b]
     dy = fl.Wq.T @ P - fl.Hy @ dlam
-    return Q, P, lam, dlam, dy, gdot, plastic
+    return order, (Q, P, lam, dlam, dy, gdot, tr.codes[ks].T == PLASTIC)
+
+
+def _fields(tr: CoatingTrajectory, k: np.ndarray, t: np.ndarray):
+    """:func:`_grouped`'s fields in the order of ``t``."""
+    order, fields = _grouped(tr, k, t)
+    back = np.empty_like(order)
+    back[order] = np.arange(order.size)
+    return tuple(A[:, back] for A in fields)
 
 
 def _holding(tr: CoatingTrajectory, t: np.ndarray) -> np.ndarray:
@@ -149,8 +176,9 @@ def _starts(tr: CoatingTrajectory) -> tuple[np.ndarray, np.ndarray]:
         return np.zeros(0, dtype=np.int64), np.zeros(0)
     i = np.arange(1, tr.starts.size)
     t = tr.starts[i]
-    before, e_before = _at_starts(tr, i - 1, t)
-    after, e_after = _at_starts(tr, i, t)
+    surfaces, energies = _at_starts(tr, np.r_[i - 1, i], np.r_[t, t])  # before each start, after it
+    before, after = surfaces[:, :i.size], surfaces[:, i.size:]
+    e_before, e_after = energies[:i.size], energies[i.size:]
     scale = max(float(np.abs(tr.flight.system.gap).max()), float(np.abs(tr.surfaces).max()))
     jump = (np.abs(after - before) > STEP_RTOL * scale).any(axis=0)
     return i[jump], (e_after - e_before)[jump]
@@ -173,22 +201,27 @@ def surface_steps(tr: CoatingTrajectory) -> np.ndarray:
     return _starts(tr)[0]
 
 
-def _powers(tr: CoatingTrajectory, t: np.ndarray) -> np.ndarray:
-    """``(4, k)``: the casing's, friction's, damping's and the plastic flow's powers at ``t``."""
+def _integrals(tr: CoatingTrajectory, t: np.ndarray, weights: tuple) -> tuple:
+    """The casing's, friction's, damping's and the plastic flow's work ``(4,)`` of each set of quadrature
+    ``weights`` at the points ``t`` (the points of every set end to end)."""
     fl = tr.flight
     mu, Tq, C_nt, C_tt, _ = _terms(fl)
-    Q, P, lam, dlam, dy, gdot, plastic = _fields(tr, _holding(tr, t), t)
+    order, (Q, P, lam, dlam, dy, gdot, plastic) = _grouped(tr, _holding(tr, t), t)
     casing = -(lam * gdot).sum(0)
     fric = np.zeros(t.size) if Tq is None else mu * (lam * (Tq.T @ P - C_nt.T @ dlam + mu * (C_tt @ dlam))).sum(0)
     damp = (P * (fl.Cq @ P)).sum(0) if fl.Cq is not None else np.zeros(t.size)
     flow = np.where(plastic, fl.yield_force[:, None] * (dy - gdot), 0.0).sum(0)
-    return np.vstack([casing, fric, damp, flow])
+    powers = np.vstack([casing, fric, damp, flow])
+    cuts = np.cumsum([0] + [w.size for w in weights])
+    return tuple(powers @ np.r_[np.zeros(a), w, np.zeros(t.size - b)][order] for w, a, b in
+                 zip(weights, cuts[:-1], cuts[1:]))
 
 
-def _fastest(tr: CoatingTrajectory) -> float:
-    _, first = np.unique(tr.codes, axis=0, return_index=True)
-    w = max(float(np.abs(tr._phase(int(i)).lam).max()) for i in first)
-    return max(w, tr.flight.nu, 1e-300)
+def _fastest(tr: CoatingTrajectory) -> np.ndarray:
+    """Each phase's fastest rate (rad/s): its modes' or the casing's."""
+    _, first, code = np.unique(tr.codes, axis=0, return_index=True, return_inverse=True)
+    w = np.array([float(np.abs(tr._phase(int(i)).lam).max()) for i in first])
+    return np.maximum(w[code.reshape(-1)], max(tr.flight.nu, 1e-300))
 
 
 def coating_balance(tr: CoatingTrajectory, t0: float, t1: float) -> CoatingEnergy:
@@ -202,9 +235,8 @@ def _balance(tr: CoatingTrajectory, t0: float, t1: float, fast: float, starts) -
     """:func:`coating_balance` with the fastest rate and the jumps at the starts (:func:`_starts`) computed."""
     if not (0 <= t0 < t1 <= tr.t_end * (1 + 1e-12)):
         raise ValueError(f"[t0, t1] = [{t0!r}, {t1!r}] must lie in the trajectory's [0, {tr.t_end!r}] with t0 < t1")
-    (ta, wa), (tb, wb) = (gauss_points(tr.starts, t0, t1, fast, n) for n in ORDERS)  # both orders in one pass
-    pw = _powers(tr, np.r_[ta, tb])
-    low, high = pw[:, :ta.size] @ wa, pw[:, ta.size:] @ wb
+    (ta, wa), (tb, wb) = (gauss_points(tr.starts, t0, t1, fast, n) for n in ORDERS)
+    low, high = _integrals(tr, np.r_[ta, tb], (wa, wb))  # both orders in one pass
     casing, fric, damp, plastic = high
     E = stored_energy(tr, [t0, t1])
     change = float(E[1] - E[0])

@@ -144,9 +144,10 @@ def _fastest(tr: NodalTrajectory) -> float:
     return max(w, fl.nu, 1e-300)
 
 
-def gauss_points(starts: np.ndarray, t0: float, t1: float, fastest: float, order: int):
+def gauss_points(starts: np.ndarray, t0: float, t1: float, fastest, order: int):
     """The Gauss–Legendre points and weights of ``order`` over ``[t0, t1]``, cut at the phase ``starts`` inside it
-    and each phase cut into pieces a :data:`PIECES_PER_PERIOD`-th of the period ``2π/fastest`` long.
+    and each phase cut into pieces a :data:`PIECES_PER_PERIOD`-th of the period ``2π/fastest`` long (``fastest``:
+    one rate (rad/s), or one a phase).
 
     >>> t, w = gauss_points(np.array([0.0, 1.0]), 0.0, 2.0, np.pi, 3)     # two phases of a 2 s period's half each
     >>> t.size, round(float(w.sum()), 12), round(float(w @ t**5), 12)    # ∫₀² t⁵ dt = 64/6, exact
@@ -155,14 +156,17 @@ def gauss_points(starts: np.ndarray, t0: float, t1: float, fastest: float, order
     cuts = np.r_[t0, starts[(starts > t0) & (starts < t1)], t1]
     h = 2 * np.pi / (PIECES_PER_PERIOD * fastest)
     x, w = np.polynomial.legendre.leggauss(order)
-    nodes, weights = [], []
-    for a, b in zip(cuts[:-1], cuts[1:]):
-        k = max(1, int(np.ceil((b - a) / h)))
-        edges = np.linspace(a, b, k + 1)
-        mid, half = 0.5 * (edges[1:] + edges[:-1]), 0.5 * np.diff(edges)
-        nodes.append((mid[:, None] + half[:, None] * x).ravel())
-        weights.append((half[:, None] * w).ravel())
-    return np.concatenate(nodes), np.concatenate(weights)
+    a, b = cuts[:-1], cuts[1:]
+    if np.ndim(h):  # each span's phase: the one starting at its left end
+        h = h[np.clip(np.searchsorted(starts, a, side="right") - 1, 0, None)]
+    k = np.maximum(1, np.ceil((b - a) / h).astype(np.int64))  # pieces of each span, its edges as np.linspace's
+    step = (b - a) / k
+    span = np.repeat(np.arange(a.size), k)
+    j = (np.arange(span.size) - np.repeat(np.cumsum(k) - k, k)).astype(float)
+    left = j * step[span] + a[span]
+    right = np.where(j + 1 == k[span], b[span], (j + 1) * step[span] + a[span])
+    mid, half = 0.5 * (right + left), 0.5 * (right - left)
+    return (mid[:, None] + half[:, None] * x).ravel(), (half[:, None] * w).ravel()
 
 
 def _integrals(tr: NodalTrajectory, t0: float, t1: float, order: int) -> np.ndarray:
