@@ -18,8 +18,9 @@ held, a plastic node's receding with ``λ_j = λ_y,j``), so ``λᵀWᵀx' = λ�
 continuous everywhere; ``λ`` is continuous at every switch but jumps where the surfaces jump — a node entering a
 cell of another depth, or pressed beyond its yield there and removing the excess at once —: there the stored
 energy jumps, ``W_steps = Σ (E(t⁺) − E(t⁻))`` over those instants in ``(t0, t1]`` (:func:`surface_steps`). The
-integrals are taken as :mod:`~bladecase.nsm.massless.friction_energy` takes them (Gauss–Legendre on each phase
-piece at two orders, their difference the stated error); the stored energy is read in closed form.
+integrals are taken as :mod:`~bladecase.nsm.massless.friction_energy` takes them (Gauss–Legendre on each phase, cut
+into pieces a quarter of its own fastest period long, at two orders: their difference is the stated error); the
+stored energy is read in closed form.
 
 >>> from bladecase.nsm.massless.coating_flight import simulate_coating
 >>> from bladecase.nsm.massless.nodes import NodalSystem
@@ -231,8 +232,9 @@ def coating_balance(tr: CoatingTrajectory, t0: float, t1: float) -> CoatingEnerg
     return _balance(tr, t0, t1, _fastest(tr), _starts(tr))
 
 
-def _balance(tr: CoatingTrajectory, t0: float, t1: float, fast: float, starts) -> CoatingEnergy:
-    """:func:`coating_balance` with the fastest rate and the jumps at the starts (:func:`_starts`) computed."""
+def _balance(tr: CoatingTrajectory, t0: float, t1: float, fast: np.ndarray, starts) -> CoatingEnergy:
+    """:func:`coating_balance` with each phase's fastest rate (:func:`_fastest`) and the jumps at the starts
+    (:func:`_starts`) computed."""
     if not (0 <= t0 < t1 <= tr.t_end * (1 + 1e-12)):
         raise ValueError(f"[t0, t1] = [{t0!r}, {t1!r}] must lie in the trajectory's [0, {tr.t_end!r}] with t0 < t1")
     (ta, wa), (tb, wb) = (gauss_points(tr.starts, t0, t1, fast, n) for n in ORDERS)
