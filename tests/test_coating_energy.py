@@ -138,7 +138,8 @@ def _demo():
 
 def test_demo_blade_tip_nodes():
     """The demo blade's 26 tip nodes, friction 0.15 and 8 lobes, from the state stored mid-rub over a worn profile
-    of 120 cells (a tenth of a revolution): the balance closes to 1e-9 with every term at work."""
+    of 120 cells (a tenth of a revolution): the balance closes to 1e-9 with every term at work, the plastic work is
+    λ_y × the depth removed in flight, the forces continuous at every switch."""
     d, fl = _demo()
     speed = float(d["speed"])
     cells = np.arange(120)
@@ -150,6 +151,12 @@ def test_demo_blade_tip_nodes():
     assert abs(e.relative) < 1e-9 and e.quadrature_error < 1e-9 * e.casing
     assert e.plastic > 0 and e.steps != 0 and e.friction != 0 and e.damping > 0
     assert abs(e.residual - e.steps) > 1e-3 * abs(e.residual / e.relative)
+    in_flight = tr.removed() - tr.jumps.sum(axis=0)
+    assert abs(e.plastic - fl.yield_force @ in_flight) < 1e-9 * e.plastic
+    i = np.arange(1, tr.starts.size)
+    lb, la = _fields(tr, i - 1, tr.starts[i])[2], _fields(tr, i, tr.starts[i])[2]
+    switch = ~np.isin(i, surface_steps(tr))
+    assert switch.sum() >= 10 and np.abs(la - lb)[:, switch].max() < 1e-9 * fl.yield_force.max()
 
 
 def _rub_system() -> NodalSystem:
