@@ -51,7 +51,9 @@ has contact phases of finite duration instead of impacts. One module per step:
   profile the previous ones left (:func:`wear_rub`);
 - :mod:`~bladecase.nsm.massless.coating_flight` — the coating yielding during the flight: each node's normal contact
   a Jenkins element (open, elastic, plastic: a constant force while its surface recedes), every combination a
-  linear phase flown exactly (:func:`simulate_coating`);
+  linear phase flown exactly (:func:`simulate_coating`), and :mod:`~bladecase.nsm.massless.coating_energy` — its
+  energy balance: the casing's, friction's and damping's work, the coating's removal and the worn surface's steps,
+  per span or per revolution (:func:`coating_balance`);
 - :mod:`~bladecase.nsm.massless.wear_lobes` — the held-out check of the lobes worn over the last revolutions against
   the tip's vibration frequency over the same ones: agree, differ, or undefined with the reason (:func:`lobe_check`);
 - :mod:`~bladecase.nsm.massless.disk_modes` — travelling-wave nonsmooth modes of a tuned bladed disk: shooting over

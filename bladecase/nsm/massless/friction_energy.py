@@ -34,7 +34,7 @@ import numpy as np
 
 from .nodes import NodalTrajectory
 
-__all__ = ["FrictionEnergy", "energy_balance", "per_revolution", "stored_energy",
+__all__ = ["FrictionEnergy", "energy_balance", "gauss_points", "per_revolution", "revolution_spans", "stored_energy",
            "tangential_rates"]
 
 #: Gauss–Legendre orders of the two quadratures (their difference: the stated error).
@@ -144,18 +144,33 @@ def _fastest(tr: NodalTrajectory) -> float:
     return max(w, fl.nu, 1e-300)
 
 
-def _integrals(tr: NodalTrajectory, t0: float, t1: float, order: int) -> np.ndarray:
-    cuts = np.r_[t0, tr.starts[(tr.starts > t0) & (tr.starts < t1)], t1]
-    h = 2 * np.pi / (PIECES_PER_PERIOD * _fastest(tr))
+def gauss_points(starts: np.ndarray, t0: float, t1: float, fastest, order: int):
+    """The Gauss–Legendre points and weights of ``order`` over ``[t0, t1]``, cut at the phase ``starts`` inside it
+    and each phase cut into pieces a :data:`PIECES_PER_PERIOD`-th of the period ``2π/fastest`` long (``fastest``:
+    one rate (rad/s), or one a phase).
+
+    >>> t, w = gauss_points(np.array([0.0, 1.0]), 0.0, 2.0, np.pi, 3)     # two phases of a 2 s period's half each
+    >>> t.size, round(float(w.sum()), 12), round(float(w @ t**5), 12)    # ∫₀² t⁵ dt = 64/6, exact
+    (12, 2.0, 10.666666666667)
+    """
+    cuts = np.r_[t0, starts[(starts > t0) & (starts < t1)], t1]
+    h = 2 * np.pi / (PIECES_PER_PERIOD * fastest)
     x, w = np.polynomial.legendre.leggauss(order)
-    nodes, weights = [], []
-    for a, b in zip(cuts[:-1], cuts[1:]):
-        k = max(1, int(np.ceil((b - a) / h)))
-        edges = np.linspace(a, b, k + 1)
-        mid, half = 0.5 * (edges[1:] + edges[:-1]), 0.5 * np.diff(edges)
-        nodes.append((mid[:, None] + half[:, None] * x).ravel())
-        weights.append((half[:, None] * w).ravel())
-    t, wt = np.concatenate(nodes), np.concatenate(weights)
+    a, b = cuts[:-1], cuts[1:]
+    if np.ndim(h):  # each span's phase: the one starting at its left end
+        h = h[np.clip(np.searchsorted(starts, a, side="right") - 1, 0, None)]
+    k = np.maximum(1, np.ceil((b - a) / h).astype(np.int64))  # pieces of each span, its edges as np.linspace's
+    step = (b - a) / k
+    span = np.repeat(np.arange(a.size), k)
+    j = (np.arange(span.size) - np.repeat(np.cumsum(k) - k, k)).astype(float)
+    left = j * step[span] + a[span]
+    right = np.where(j + 1 == k[span], b[span], (j + 1) * step[span] + a[span])
+    mid, half = 0.5 * (right + left), 0.5 * (right - left)
+    return (mid[:, None] + half[:, None] * x).ravel(), (half[:, None] * w).ravel()
+
+
+def _integrals(tr: NodalTrajectory, t0: float, t1: float, order: int) -> np.ndarray:
+    t, wt = gauss_points(tr.starts, t0, t1, _fastest(tr), order)
     return _powers(tr, t) @ wt
 
 
@@ -175,6 +190,15 @@ def energy_balance(tr: NodalTrajectory, t0: float, t1: float) -> FrictionEnergy:
 
 def per_revolution(tr: NodalTrajectory, speed: float, first: int = 0) -> list[FrictionEnergy]:
     """:func:`energy_balance` over each whole revolution ``2π/speed`` of ``tr`` from revolution ``first``."""
+    return [energy_balance(tr, a, b) for a, b in revolution_spans(tr.t_end, speed, first)]
+
+
+def revolution_spans(t_end: float, speed: float, first: int = 0) -> list[tuple[float, float]]:
+    """The whole revolutions ``2π/speed`` in ``[0, t_end]`` from revolution ``first``: ``(start, end)`` each.
+
+    >>> revolution_spans(2.0 * np.pi, 2.0)          # two revolutions of π s
+    [(0.0, 3.141592653589793), (3.141592653589793, 6.283185307179586)]
+    """
     turn = 2 * np.pi / speed
-    count = int(np.floor(tr.t_end / turn * (1 + 1e-12)))
-    return [energy_balance(tr, k * turn, min((k + 1) * turn, tr.t_end)) for k in range(first, count)]
+    count = int(np.floor(t_end / turn * (1 + 1e-12)))
+    return [(k * turn, min((k + 1) * turn, t_end)) for k in range(first, count)]

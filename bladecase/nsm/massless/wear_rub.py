@@ -42,6 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .coating_energy import CoatingEnergy, coating_balance
 from .coating_flight import CoatingFlight
 from .friction import friction_flight
 from .nodes import NodalFlight, NodalSystem, Profile, Rub, simulate_nodes
@@ -70,8 +71,9 @@ class WearRub:
     tip normal displacement over the rotation frequency (:func:`vibration_ratio`); the phases flown (switches and
     profile steps); that mean tip displacement over each revolution (``tip``: ``(revolutions,
     samples_per_turn)``, m), the held-out check of the lobes worn over the last revolutions against the
-    vibration's frequency over the same ones (``check``: :func:`~bladecase.nsm.massless.wear_lobes.lobe_check`) and
-    the coupling flown (:data:`COUPLINGS`)."""
+    vibration's frequency over the same ones (``check``: :func:`~bladecase.nsm.massless.wear_lobes.lobe_check`),
+    the coupling flown (:data:`COUPLINGS`) and, asked for (in flight), each revolution's energy balance (``energy``:
+    :func:`~bladecase.nsm.massless.coating_energy.coating_balance`, else ``None``)."""
 
     profile: WearProfile
     removed: np.ndarray
@@ -84,6 +86,7 @@ class WearRub:
     samples_per_turn: int = 0
     check: LobeCheck | None = None
     coupling: str = "staggered"
+    energy: tuple[CoatingEnergy, ...] | None = None
 
     @property
     def depths(self) -> np.ndarray:
@@ -107,13 +110,14 @@ def vibration_ratio(signal, samples_per_turn: int) -> float:
 def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, amplitude: float, angles,
              damping=None, revolutions: int = 10, areas=None, friction=None,
              max_switches: int = 2_000_000, flight: NodalFlight | None = None,
-             coupling: str | None = None) -> WearRub:
+             coupling: str | None = None, energy: bool = False) -> WearRub:
     """The coupled rub and wear of ``system`` at ``speed`` (rad/s) in a casing with ``lobes`` lobes of
     ``amplitude`` (m) lined with ``coating``, from rest over ``revolutions`` turns (module docstring). ``areas``:
     each node's tributary area (m²), for the pressure (``system.casing`` should be ``coating.stiffness × areas``);
     ``friction``: a :class:`~bladecase.nsm.massless.friction.Friction`, or ``None``; ``flight``: the flight to fly
     (its phases reused, e.g. the rub response's: of this system, damping, casing and friction; the staggered
-    coupling's only); ``coupling``: one of :data:`COUPLINGS` (default ``"in_flight"``)."""
+    coupling's only); ``coupling``: one of :data:`COUPLINGS` (default ``"in_flight"``); ``energy``: keep each
+    revolution's energy balance (:mod:`~bladecase.nsm.massless.coating_energy`; the in-flight coupling's only)."""
     if not isinstance(coating, Abradable):
         raise ValueError(f"coating must be an Abradable, got {type(coating).__name__}")
     if isinstance(revolutions, bool) or int(revolutions) != revolutions or revolutions < 1:
@@ -125,6 +129,10 @@ def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, 
         coupling = "in_flight"
     if coupling not in COUPLINGS:
         raise ValueError(f"coupling must be one of {COUPLINGS}, got {coupling!r}")
+    if not isinstance(energy, (bool, np.bool_)):
+        raise ValueError(f"energy must be True or False, got {energy!r}")
+    if energy and coupling != "in_flight":
+        raise ValueError(f"the energy balance of the wear rub needs the coupling 'in_flight', got {coupling!r}")
     areas = np.ones(system.m) if areas is None else np.asarray(areas, dtype=float)
     rub = Rub(lobes, amplitude, speed, angles)
     if coupling == "in_flight":
@@ -145,7 +153,7 @@ def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, 
     grid = np.arange(per_turn) * (turn / per_turn)
     profile = WearProfile.new(coating)
     x, v = np.zeros(system.n), np.zeros(system.n)
-    removed, peak_u, peak_p, count, tip, phases = [], [], [], [], [], 0
+    removed, peak_u, peak_p, count, tip, phases, balances = [], [], [], [], [], 0, []
     for _ in range(int(revolutions)):
         here = Profile(profile.depth, speed, phi)
         if coupling == "in_flight":
@@ -156,6 +164,8 @@ def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, 
             raise ValueError(f"the wear rub at {speed:.6g} rad/s needed more than {max_switches} switches in a "
                              "revolution")
         phases += int(tr.starts.size)
+        if energy:
+            balances.append(coating_balance(tr, 0.0, tr.t_end))
         t = np.unique(np.r_[grid, tr.starts, turn])
         if coupling == "in_flight":
             xs, _, lam, y = tr.sample(t)
@@ -178,4 +188,4 @@ def wear_rub(system: NodalSystem, coating: Abradable, speed: float, lobes: int, 
     ratio = vibration_ratio(tip[-TAIL:].ravel(), per_turn)
     check = lobe_check(np.array(profile.history), tip, per_turn, window=TAIL)
     return WearRub(profile, np.array(removed), np.array(peak_u), np.array(peak_p), np.array(count), ratio, phases,
-                   tip, per_turn, check, coupling)
+                   tip, per_turn, check, coupling, tuple(balances) if energy else None)
