@@ -146,7 +146,7 @@ def test_abradable_key_errors(coating, rub, contact, match):
 def test_friction_and_wear_end_to_end_through_the_cli(tmp_path):
     """``bladecase run`` on the demo blade at 1650 rpm with μ = 0.15 and a 12-cell abradable coating, two
     revolutions: rub.csv with the friction's columns, wear.csv per revolution whose removed volume is the
-    profile's missing volume to 1e-6, wear_profile.csv, wear.png, the worn casing's ring in wear.vtu, the summary
+    profile's missing volume to 1e-6 and whose energy balance closes to 1e-9, wear_profile.csv, wear.png, the worn casing's ring in wear.vtu, the summary
     and the report's words."""
     import csv
     import json
@@ -168,6 +168,12 @@ def test_friction_and_wear_end_to_end_through_the_cli(tmp_path):
     for r in rows:
         assert float(r["removed_volume_mm3"]) == pytest.approx(float(r["missing_volume_mm3"]), rel=1e-6)
     assert float(rows[-1]["removed_volume_mm3"]) > 0
+    # each revolution's energy balance with the coating yielding in flight closes (measured ~1e-13), the coating's
+    # removal takes energy, friction dissipates
+    for r in rows:
+        assert abs(float(r["balance_residual"])) < 1e-9
+    assert float(rows[-1]["removal_work_j"]) > 0 and float(rows[-1]["friction_work_j"]) < 0
+    assert summary["wear"]["worst_balance_residual"] < 1e-9
     wear = summary["wear"]["speeds"][0]
     assert wear["volume_mismatch"] < 1e-6 and wear["lobes"] == int(rows[-1]["lobes"])
     ring = meshio.read(out / "wear.vtu")
@@ -181,10 +187,10 @@ def test_friction_and_wear_end_to_end_through_the_cli(tmp_path):
     assert (out / "wear.png").is_file() and (out / "rub.png").is_file()
     report = (out / "report.md").read_text()
     assert "Abradable coating: 1 mm thick" in report and "the sliding dominated by the rotation" in report
-    assert "round(f_vib / f_rot)" in report
+    assert "round(f_vib / f_rot)" in report and "removing the coating" in report
     log = (out / "run.log").read_text()
     assert "the sliding dominated by the rotation" in log and "the sliding is dominated by the rotation at every" in log
-    assert "the coating is worn to" in log
+    assert "the coating is worn to" in log and "the last wearing revolution's energy" in log
 
 
 def test_a_coating_on_a_line_of_nodes_is_refused_before_any_factorisation():

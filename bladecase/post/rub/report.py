@@ -164,6 +164,16 @@ def _wear_lines(w: dict | None, unit: str) -> list[str]:
                    + ("; **the tip has worn through to the casing**." if r["worn_through"] else "."))
     if len(w["speeds"]) > 1:
         out.append(f"- The most coating is removed at {w['most_wear']:.6g} {unit}.")
+    top = next((r for r in w["speeds"] if r["speed"] == w["most_wear"]), None)
+    e = top and top.get("energy")
+    if e:
+        out.append(f"- Energy of the last revolution at {top['speed']:.6g} {unit}: the casing puts in "
+                   f"{e['casing_input_j']:.4g} J, friction does {e['friction_work_j']:.4g} J on the vibration, damping "
+                   f"takes {e['damping_j']:.4g} J, removing the coating {e['removal_work_j']:.4g} J, the worn "
+                   f"profile's steps under the touching nodes do {e['surface_steps_j']:.4g} J and the stored energy "
+                   f"changes by {e['stored_change_j']:.4g} J; the balance closes to "
+                   f"{w['worst_balance_residual']:.1e} (relative, worst revolution of every speed; `wear.csv` gives "
+                   "each).")
     out.append("- The wear's depths and volumes are this mesh's: their mesh error is not measured (the tip nodes' "
                "areas share the coating's pressure, and the crossing speed moves with the mesh's first frequency); "
                "compare meshes at the same `speed_ratio` before quoting them.")

@@ -208,7 +208,7 @@ def _rub_point(speed: float, *, model, contact: Contact, interior: np.ndarray | 
                                                  respond=rub_response)
         worn = None if coating is None else wear_rub(reduced.system, coating, speed, lobes, amplitude, angles,
                                                      damping, revolutions, areas=reduced.areas, friction=fr,
-                                                     flight=flight)
+                                                     flight=flight, energy=True)
     except ValueError as exc:  # the simulation refused this speed (a grazing switch, friction-induced flutter on the
         # worn casing, …): it is that speed's result, the others go on
         out = {"error": str(exc), "nodes": list(reduced.system.nodes)}

@@ -32,7 +32,19 @@ WEAR_COLUMNS = {
     "lobes": "the number of lobes of the profile (its strongest circumferential harmonic; 0: unworn)",
     "tip_normal_displacement_mm": "the peak outward normal displacement over the contact nodes in the revolution (mm)",
     "max_pressure_mpa": "the peak contact pressure on the coating in the revolution (MPa)",
+    "casing_input_j": "the work of the out-of-round casing on the blade over the revolution (J)",
+    "friction_work_j": "the work of friction on the vibration over the revolution (J; negative: it dissipates)",
+    "damping_j": "the energy the structural damping dissipates over the revolution (J)",
+    "removal_work_j": "the work of removing coating (yield force × depth removed in flight) over the revolution (J)",
+    "surface_steps_j": "the stored energy's jumps where the worn profile steps under a touching node (J)",
+    "stored_change_j": "the change of the stored energy over the revolution (J)",
+    "balance_residual": "the relative residual of stored change = casing + friction − damping − removal + steps",
 }
+
+#: ``wear.csv``'s energy columns → the balance's terms (:class:`~bladecase.nsm.massless.coating_energy.CoatingEnergy`).
+ENERGY_TERMS = {"casing_input_j": "casing", "friction_work_j": "friction", "damping_j": "damping",
+                "removal_work_j": "plastic", "surface_steps_j": "steps", "stored_change_j": "stored_change",
+                "balance_residual": "relative"}
 
 
 def _frame(study, model, nodes) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -87,7 +99,9 @@ def wear_figures(w) -> dict:
             "peak_displacement_m": w.peak_displacement.tolist(), "peak_pressure_pa": w.peak_pressure.tolist(),
             "vibration_ratio": w.vibration_ratio, "depth_m": w.profile.depth.tolist(),
             "history_m": depths.tolist(), "worn_through": bool(w.profile.worn_through), "phases": w.phases,
-            "lobe_check": None if w.check is None else w.check.as_dict(), "coupling": w.coupling}
+            "lobe_check": None if w.check is None else w.check.as_dict(), "coupling": w.coupling,
+            "energy": None if w.energy is None else [{c: float(getattr(e, t)) for c, t in ENERGY_TERMS.items()}
+                                                     for e in w.energy]}
 
 
 def wear_section(study, coating: Abradable, rows: list[dict], points: list[dict]) -> dict:
@@ -106,9 +120,14 @@ def wear_section(study, coating: Abradable, rows: list[dict], points: list[dict]
                     "vibration_ratio": w["vibration_ratio"], "expected_lobes": int(round(w["vibration_ratio"])),
                     "worn_through": w["worn_through"], "revolutions": len(w["lobes"]),
                     "peak_pressure_mpa": 1e-6 * max(w["peak_pressure_pa"]),
-                    "lobe_check": w.get("lobe_check")})
+                    "lobe_check": w.get("lobe_check"),
+                    "energy": (w.get("energy") or [None])[-1],
+                    "worst_balance_residual": max((abs(e["balance_residual"]) for e in w.get("energy") or []),
+                                                  default=None)})
     top = max(range(len(per)), key=lambda i: per[i]["removed_mm3"]) if per else None
-    return {"coating": {"thickness_m": coating.thickness, "yield_pa": coating.yield_pressure,
+    residuals = [r["worst_balance_residual"] for r in per if r["worst_balance_residual"] is not None]
+    return {"worst_balance_residual": max(residuals) if residuals else None,
+            "coating": {"thickness_m": coating.thickness, "yield_pa": coating.yield_pressure,
                         "stiffness_pa_per_m": coating.stiffness, "cells": coating.cells, "radius_m": coating.radius,
                         "width_m": coating.width, "yield_depth_m": coating.yield_depth},
             "speeds": per, "most_wear": None if top is None else per[top]["speed"],
@@ -122,6 +141,13 @@ def log_wear(section: dict, unit: str) -> None:
         log.info("rub: at %.6g %s the coating is worn to %.4g µm in %d lobes after %d revolutions (%.4g mm³ removed; "
                  "the tip vibrates at %.3g × the rotation frequency)", w["speed"], unit, w["max_depth_um"], w["lobes"],
                  w["revolutions"], w["removed_mm3"], w["vibration_ratio"])
+        e = w.get("energy")
+        if e is not None:
+            log.info("rub: at %.6g %s the last wearing revolution's energy: casing %.4g J, friction %.4g J, damping "
+                     "%.4g J, coating removed %.4g J, profile steps %.4g J, stored change %.4g J (balance to %.1e; "
+                     "worst revolution %.1e)", w["speed"], unit, e["casing_input_j"], e["friction_work_j"],
+                     e["damping_j"], e["removal_work_j"], e["surface_steps_j"], e["stored_change_j"],
+                     e["balance_residual"], w["worst_balance_residual"])
         c = w.get("lobe_check")
         if c and c.get("last"):
             log.info("rub: at %.6g %s, over revolutions %d to %d (the last that wore the coating): %s", w["speed"],
@@ -144,7 +170,8 @@ def write_wear(folder: Path, study, model, contact, section: dict, points: list[
                      "missing_volume_mm3": 1e9 * w["missing_m3"][k], "max_depth_um": 1e6 * w["max_depth_m"][k],
                      "lobe_depth_um": 1e6 * w["lobe_depth_m"][k], "lobes": w["lobes"][k],
                      "tip_normal_displacement_mm": 1e3 * w["peak_displacement_m"][k],
-                     "max_pressure_mpa": 1e-6 * w["peak_pressure_pa"][k]}
+                     "max_pressure_mpa": 1e-6 * w["peak_pressure_pa"][k],
+                     **(w["energy"][k] if w.get("energy") else dict.fromkeys(ENERGY_TERMS))}
             lines.append(",".join(csv_cell(cells[c]) for c in WEAR_COLUMNS))
         step = 360.0 / len(w["depth_m"])
         for i, d in enumerate(w["depth_m"]):
