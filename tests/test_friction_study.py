@@ -146,8 +146,8 @@ def test_abradable_key_errors(coating, rub, contact, match):
 def test_friction_and_wear_end_to_end_through_the_cli(tmp_path):
     """``bladecase run`` on the demo blade at 1650 rpm with μ = 0.15 and a 12-cell abradable coating, two
     revolutions: rub.csv with the friction's columns, wear.csv per revolution whose removed volume is the
-    profile's missing volume to 1e-6 and whose energy balance closes to 1e-9, wear_profile.csv, wear.png, the worn casing's ring in wear.vtu, the summary
-    and the report's words."""
+    profile's missing volume to 1e-6 and whose energy balance closes to 1e-9, wear_profile.csv, wear.png, the worn
+    casing's ring in wear.vtu, the summary and the report's words."""
     import csv
     import json
 
