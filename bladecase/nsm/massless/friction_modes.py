@@ -42,7 +42,8 @@ from .friction import Friction, FrictionFlight
 from .friction_energy import stored_energy
 from .nodes import NodalSystem, simulate_nodes
 
-__all__ = ["GRID_POINTS", "FrictionMode", "decay_ratio", "friction_mode", "start_ratio"]
+__all__ = ["GRID_POINTS", "FrictionMode", "decay_ratio", "friction_mode", "harmonic_amplification",
+           "start_ratio"]
 
 #: Grid points per fastest period of a phase in the switch search of the EPMC flow.
 GRID_POINTS = 64
@@ -163,6 +164,27 @@ def friction_mode(system: NodalSystem, friction: Friction, amplitude: float, mod
     T, xi = float(y[-2]), float(y[-1])
     w = 2 * np.pi / T
     return FrictionMode(phi @ q, phi @ p, T, w, xi, xi / (2 * w), res, bool(res < 1e3 * tol and T > 0))
+
+
+def harmonic_amplification(omega, zeta, frequency: float, mode: int = 0,
+                           harmonics: int = 12) -> list[tuple[int, int, float]]:
+    """How strongly each other open-phase mode answers the harmonics of an orbit of ``mode`` at ``frequency``
+    (rad/s): for each mode ``k`` above ``mode`` (angular frequencies ``omega``, damping ratios ``zeta``), its nearest
+    harmonic ``h`` (1 to ``harmonics``) and the dynamic amplification ``1/√((1 − r²)² + (2ζ_k r)²)``,
+    ``r = hΩ/ω_k``: ``[(k, h, gain), ...]``. A gain of tens says an internal resonance: the orbit's ``h``-th
+    harmonic drives mode ``k`` near its resonance, and the orbit is not one nonlinear mode's alone.
+
+    >>> out = harmonic_amplification([1.0, 4.01, 9.7], [0.005, 0.005, 0.005], 1.0)
+    >>> [(k, h, round(g, 1)) for k, h, g in out]      # mode 1 answers the 4th harmonic, mode 2 the 10th
+    [(1, 4, 89.7), (2, 10, 15.7)]
+    """
+    omega, zeta = np.asarray(omega, dtype=float), np.broadcast_to(np.asarray(zeta, dtype=float), np.shape(omega))
+    out = []
+    for k in range(mode + 1, omega.size):
+        h = int(np.clip(np.round(omega[k] / frequency), 1, harmonics))
+        r = h * frequency / omega[k]
+        out.append((k, h, float(1 / np.sqrt((1 - r**2) ** 2 + (2 * zeta[k] * r) ** 2))))
+    return out
 
 
 def start_ratio(losses, kinetic, frequency: float) -> float:

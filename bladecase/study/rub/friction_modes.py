@@ -33,17 +33,23 @@ import numpy as np
 from ... import log
 from ...io import csv_cell, save_figure, write_text
 from ...nsm.massless.friction import Friction
-from ...nsm.massless.friction_modes import decay_ratio, friction_mode
+from ...nsm.massless.friction_modes import decay_ratio, friction_mode, harmonic_amplification
 from ...nsm.massless.friction_modes_coulomb import coulomb_decay_ratio, coulomb_mode
 from ...nsm.massless.nodes import NodalSystem
 
-__all__ = ["DECAY_RTOL", "MODE_COLUMNS", "log_friction_modes", "mode_points", "modes_section",
-           "write_friction_modes"]
+__all__ = ["DECAY_RTOL", "INTERNAL_GAIN", "INTERNAL_SHARE", "MODE_COLUMNS", "log_friction_modes", "mode_points",
+           "modes_section", "write_friction_modes"]
 
 #: The concept's ratio and the free decay's agree to this (relative) or the report says the mode is doubtful there
 #: (friction works on a decaying orbit and not on the balanced one: a few per cent apart on small examples; on the
 #: demo blade's tip within 0.2 %).
 DECAY_RTOL = 0.05
+
+#: A higher mode answering one of the orbit's harmonics this many times over (dynamic amplification) and holding at
+#: least :data:`INTERNAL_SHARE` of the orbit's modal energy makes the mode an internal resonance: the report says the
+#: figures are not a single nonlinear mode's.
+INTERNAL_GAIN = 10.0
+INTERNAL_SHARE = 1e-3
 
 #: The columns of ``friction_modes.csv``: name → what it holds.
 MODE_COLUMNS = {
@@ -59,6 +65,10 @@ MODE_COLUMNS = {
     "decay_error": "decay_zeta / zeta − 1",
     "residual": "the orbit's closing residual relative to its amplitude",
     "converged": "whether the orbit closed",
+    "internal_mode": "the higher mode (1 = the first) that answers one of the orbit's harmonics most, if at least "
+                     "INTERNAL_GAIN-fold (an internal resonance), else empty",
+    "internal_harmonic": "that harmonic of the orbit",
+    "internal_gain": "its dynamic amplification",
     "seconds": "CPU seconds of the mode and its check",
 }
 
@@ -95,12 +105,26 @@ def mode_points(system: NodalSystem, friction: Friction, speed: float, ratios, d
             guess = None
             continue
         guess = m if m.converged else None
-        out["points"].append({
+        share = _shares(system, m)
+        near = [(k, h, g) for k, h, g in harmonic_amplification(omega, damping.ratios(omega), m.frequency)
+                if g >= INTERNAL_GAIN and share[k] >= INTERNAL_SHARE]
+        k, h, gain = max(near, key=lambda r: r[2], default=(None, None, 0.0))
+        internal = None if k is None else {"mode": k + 1, "frequency_hz": float(omega[k] / (2 * np.pi)),
+                                           "harmonic": h, "gain": gain, "share": float(share[k])}
+        out["points"].append({"internal": internal, "mode_share": float(share[0]),
             "amplitude_ratio": ratio, "tip_amplitude_m": float(a * reach.max()),
             "frequency_hz": float(m.frequency / (2 * np.pi)), "zeta": float(m.zeta), "decay_zeta": float(zd),
             "decay_error": float(zd / m.zeta - 1) if m.zeta != 0 else None, "residual": float(m.residual),
             "converged": bool(m.converged), "seconds": time.process_time() - clock})
     return out
+
+
+def _shares(system: NodalSystem, m) -> np.ndarray:
+    """Each open-phase mode's share of the modal energy ``Σ ½(ω_j²q_j² + p_j²)`` at the orbit's start."""
+    omega, phi = system.modes
+    q, p = phi.T @ (system.M @ m.x0), phi.T @ (system.M @ m.v0)
+    e = (omega * q) ** 2 + p**2
+    return e / e.sum()
 
 
 def modes_section(rows: list[dict], points: list[dict], unit: str) -> dict | None:
@@ -111,7 +135,7 @@ def modes_section(rows: list[dict], points: list[dict], unit: str) -> dict | Non
            for row, p in zip(rows, points) if p.get("friction_modes") is not None]
     if not per:
         return None
-    doubts, worst = [], None
+    doubts, worst, internal = [], None, []
     for s in per:
         for q in s["points"]:
             where = f"{q['amplitude_ratio']:g} × grazing at {s['speed']:.6g} {unit}"
@@ -121,13 +145,22 @@ def modes_section(rows: list[dict], points: list[dict], unit: str) -> dict | Non
                 doubts.append(f"at {where} the orbit did not close (residual {q['residual']:.1e}): its figures are "
                               "not a mode's")
             elif q["decay_error"] is not None:
+                if q.get("internal") and not any(d.startswith(f"at {s['speed']:.6g} {unit}") for d in internal):
+                    i = q["internal"]
+                    ratio = i["frequency_hz"] / q["frequency_hz"]
+                    internal.append(f"at {s['speed']:.6g} {unit} from {q['amplitude_ratio']:g} × grazing: mode "
+                                    f"{i['mode']} ({i['frequency_hz']:.6g} Hz, {ratio:.4g} × the mode's frequency) "
+                                    f"answers the orbit's harmonic {i['harmonic']} {i['gain']:.0f}-fold and holds "
+                                    f"{i['share']:.2%} of its modal energy: an internal resonance, so the orbit is not "
+                                    "one nonlinear mode's alone and a forced response's resonance width need not give "
+                                    "its damping ratio, least of all friction's part of it")
                 worst = q if worst is None or abs(q["decay_error"]) > abs(worst["decay_error"]) else worst
                 if abs(q["decay_error"]) > DECAY_RTOL:
                     doubts.append(f"at {where} the free decay's damping ratio is {q['decay_error']:+.1%} off the "
                                   f"concept's ({q['decay_zeta']:.4%} against {q['zeta']:.4%}): the ratio is doubtful "
                                   "there")
     return {"speed_unit": unit, "speeds": per, "worst_decay_error": None if worst is None else worst["decay_error"],
-            "doubts": doubts}
+            "doubts": doubts + internal}
 
 
 def _rows(section: dict):
@@ -165,6 +198,8 @@ def write_friction_modes(folder: Path, section: dict, figures: bool, title: str 
                  "frequency_shift": q["frequency_hz"] / s["open_hz"] - 1, "zeta": q["zeta"],
                  "structural_zeta": s["structural_zeta"], "decay_zeta": q["decay_zeta"],
                  "decay_error": q["decay_error"], "residual": q["residual"], "converged": q["converged"],
+                 "mode_share": q["mode_share"],
+                 **{f"internal_{k}": (q.get("internal") or {}).get(k) for k in ("mode", "harmonic", "gain", "share")},
                  "seconds": q["seconds"]}
         lines.append(",".join(csv_cell(cells[c]) for c in MODE_COLUMNS))
     write_text(folder / "friction_modes.csv", "\n".join(lines) + "\n")
