@@ -1,0 +1,160 @@
+"""The mesh error of the friction-damping figures: the demo blade's first mode with stick–slip friction (μ = 0.15,
+all tip nodes, 1650 rpm, casing at rest, 0.5 % damping) at 1.5 × each mesh's own grazing amplitude, on meshes whose
+element sizes are the demo study's ``[geometry] size`` and ``tip_size`` times each factor (as
+``bladecase.study.convergence.stage.scaled_study`` scales them).
+
+Each mesh is built as the rub study builds it (``bench_rub.at_speed``: the centrifugal state at the speed, the nodal
+model with one contact per tip node, the casing's stiffness shared by the nodes' areas; a finer mesh has more tip
+nodes), its friction as ``bench_friction_damping.blade`` builds it. Per mesh: dofs, tip (contact) nodes ``m``, the
+open-phase f1 and f2/f1 (mode 2 lies near 4·f1: the orbit's 4th harmonic drives it), the grazing amplitude; the
+extended periodic motion concept (EPMC, ``coulomb_mode``) at ``--amplitude`` × grazing: f(a), ζ, ζκ (kinetic factor)
+and friction's own damping ratio on the orbit (its work over a period over ``2ω∫x'ᵀMx' dt``). Then, for each
+figure, the observed order, the Richardson extrapolation and the error of the study's mesh (factor 1) by
+``richardson`` (the grid convergence index of the convergence stage: 1.25 × the distance from the extrapolation when
+the order is established, else 3 × the range over the meshes).
+
+    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_friction_mesh.py --factors 1 0.8 0.64 --json mesh.json
+
+``--json`` keeps each mesh's row as soon as it is done and reuses the rows already there (one mesh a process:
+``--factors 0.64 --json mesh.json`` then the table over all three).
+
+Figures (``--factors 1 0.8 0.64``, amplitude 1.5 × grazing; a busy two-core machine, one BLAS thread):
+
+(filled in below after the run)
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from dataclasses import replace
+from pathlib import Path
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+from threadpoolctl import threadpool_limits  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+
+from bench_friction_damping import DAMPING, MU, friction_ratio  # noqa: E402
+from bench_rub import at_speed, demo  # noqa: E402
+from test_rub_study import CASING, _study  # noqa: E402
+
+from bladecase.nsm.massless.friction_modes_coulomb import coulomb_mode  # noqa: E402
+from bladecase.nsm.massless.friction_modes_phase import kinetic_factor  # noqa: E402
+from bladecase.reduction.nodal_friction import nodal_friction  # noqa: E402
+from bladecase.study.convergence.stage import estimate_words, richardson, scaled_study  # noqa: E402
+from bladecase.study.rub import stage  # noqa: E402
+from bladecase.study.schema import loads  # noqa: E402
+
+#: The figures compared: key → (words, format).
+FIGURES = {
+    "f1_hz": ("f1 open (Hz)", ".5f"),
+    "f2_over_f1": ("f2/f1 open", ".5f"),
+    "grazing": ("grazing amplitude", ".6g"),
+    "f_hz": ("EPMC f(a) (Hz)", ".5f"),
+    "zeta": ("zeta(a)", ".7f"),
+    "zeta_kappa": ("zeta*kappa", ".7f"),
+    "friction": ("friction's own ratio", ".4e"),
+    "zeta_minus": ("zeta(a) - 0.005", ".4e"),
+    "f2_over_f": ("f2/f(a)", ".5f"),
+}
+
+
+def mesh(factor: float, rpm: float, amplitude: float) -> dict:
+    """One mesh's row: its nodal model at ``rpm`` (all tip nodes) and the EPMC at ``amplitude`` × grazing."""
+    t0 = time.perf_counter()
+    study, model, contact = demo(mesh=factor)
+    g, scaled = study["geometry"], scaled_study(loads(_study(CASING, ""), source="<bench>"), factor)["geometry"]
+    # the same sizes as the convergence stage's own scaling
+    assert np.isclose(g["size"], scaled["size"], rtol=1e-5) and np.isclose(g["tip_size"], scaled["tip_size"],
+                                                                           rtol=1e-5), (g, scaled)
+    reduced, _, _ = at_speed(study, model, contact, rpm)
+    axis = stage._axis(study)
+    fr = replace(nodal_friction(reduced, MU, axis.origin, axis.direction), model="coulomb")
+    s = reduced.system
+    omega, phi = s.modes
+    grazing = float(np.min(s.gap / np.abs(s.W.T @ phi[:, 0])))
+    build = time.perf_counter() - t0
+    row = {"factor": factor, "dofs": int(model.n_dofs), "n": int(s.n), "m": int(s.m),
+           "f1_hz": float(omega[0] / 2 / np.pi), "f2_over_f1": float(omega[1] / omega[0]), "grazing": grazing,
+           "build_s": build}
+    print(f"mesh x{factor:g} (size {g['size']:.6g}, tip_size {g['tip_size']:.6g}): {row['dofs']} dofs, nodal model "
+          f"n = {s.n}, {s.m} tip (contact) nodes, f1 open {row['f1_hz']:.5f} Hz, f2 {omega[1] / 2 / np.pi:.4f} Hz "
+          f"= {row['f2_over_f1']:.5f} f1, grazing amplitude {grazing:.6g} ({build:.1f} s to build)", flush=True)
+    t = time.perf_counter()
+    m = coulomb_mode(s, fr, amplitude * grazing, damping=DAMPING, guess=None)
+    a1, kap = kinetic_factor(m)
+    zf = friction_ratio(m.orbit, 0.0, m.period, m.frequency)
+    row.update(f_hz=float(m.frequency / 2 / np.pi), zeta=float(m.zeta), kappa=float(kap), a1=float(a1),
+               zeta_kappa=float(m.zeta * kap), friction=float(zf), zeta_minus=float(m.zeta - DAMPING.zeta),
+               f2_over_f=float(omega[1] / m.frequency), epmc_s=time.perf_counter() - t,
+               phases=int(m.orbit.starts.size))
+    print(f"   EPMC at {amplitude:g} x grazing: f = {row['f_hz']:.5f} Hz, zeta {m.zeta:.7f}, kappa {kap:.5f}: "
+          f"zeta*kappa {row['zeta_kappa']:.7f}; friction's own ratio {zf:.4e}; f2/f(a) {row['f2_over_f']:.5f}; "
+          f"{row['phases']} phases ({row['epmc_s']:.0f} s)", flush=True)
+    return row
+
+
+def table(rows: list[dict]) -> None:
+    """Per mesh, then each figure's order, extrapolation and the study mesh's error (``richardson``)."""
+    rows = sorted(rows, key=lambda r: -r["factor"])
+    print("\nper mesh:")
+    print(f"{'factor':>7} {'dofs':>7} {'m':>3} {'build s':>8} {'EPMC s':>7} " +
+          " ".join(f"{k:>12}" for k in FIGURES), flush=True)
+    for r in rows:
+        print(f"{r['factor']:7g} {r['dofs']:7d} {r['m']:3d} {r['build_s']:8.1f} {r.get('epmc_s', np.nan):7.0f} " +
+              " ".join(f"{r.get(k, np.nan):12{f}}" for k, (_, f) in FIGURES.items()))
+    if len(rows) < 3:
+        print("(fewer than three meshes: no order)")
+        return
+    h = [r["factor"] for r in rows]
+    print(f"\nRichardson over the meshes {h} (the study's mesh: factor 1):")
+    print(f"{'figure':24} {'factor 1':>13} {'order':>6} {'extrapolated':>13} {'error':>8}  regime")
+    for k, (words, f) in FIGURES.items():
+        values = [r.get(k) for r in rows]
+        r = richardson(h, values, study_h=1.0)
+        if r["error"] is None:
+            continue
+        order = "-" if r["order"] is None else f"{r['order']:.2f}"
+        ext = "-" if r["extrapolated"] is None else format(r["extrapolated"], f)
+        how = estimate_words(r)
+        changes = np.diff(values)
+        print(f"{words:24} {values[0]:13{f}} {order:>6} {ext:>13} {r['error']:8.2%}  {r['regime']}"
+              f"{' (' + how + ')' if how else ''}; changes {', '.join(f'{c:+.3g}' for c in changes)}")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--factors", type=float, nargs="+", default=[1.0, 0.8, 0.64])
+    ap.add_argument("--amplitude", type=float, default=1.5, help="the EPMC's amplitude, times each mesh's grazing")
+    ap.add_argument("--rpm", type=float, default=1650.0)
+    ap.add_argument("--json", type=Path, default=None, help="keep each mesh's row here; reuse the rows already there")
+    a = ap.parse_args()
+    t0 = time.perf_counter()
+    done: dict[float, dict] = {}
+    if a.json is not None and a.json.exists():
+        for r in json.loads(a.json.read_text()):
+            if r.get("rpm") == a.rpm and r.get("amplitude") == a.amplitude:
+                done[float(r["factor"])] = r
+    with threadpool_limits(limits=1, user_api="blas"):
+        for factor in a.factors:
+            if factor in done:
+                print(f"mesh x{factor:g}: from {a.json}", flush=True)
+                continue
+            done[factor] = {**mesh(factor, a.rpm, a.amplitude), "rpm": a.rpm, "amplitude": a.amplitude}
+            if a.json is not None:
+                a.json.write_text(json.dumps(list(done.values()), indent=1))
+    print(f"\nthe demo blade at {a.rpm:g} rpm, all tip nodes, mu = {MU}, stick–slip, casing at rest, "
+          f"{DAMPING.zeta:.1%} damping; EPMC at {a.amplitude:g} x each mesh's grazing amplitude")
+    table([done[f] for f in a.factors])
+    print(f"\n{time.perf_counter() - t0:.1f} s in all", flush=True)
+
+
+if __name__ == "__main__":
+    main()
