@@ -45,6 +45,7 @@ from bench_friction_damping import DAMPING, MU, friction_ratio  # noqa: E402
 from bench_rub import at_speed, demo  # noqa: E402
 from test_rub_study import CASING, _study  # noqa: E402
 
+from bladecase.nsm import Damping  # noqa: E402
 from bladecase.nsm.massless.friction_modes_coulomb import coulomb_mode  # noqa: E402
 from bladecase.nsm.massless.friction_modes_phase import kinetic_factor  # noqa: E402
 from bladecase.reduction.nodal_friction import nodal_friction  # noqa: E402
@@ -63,11 +64,13 @@ FIGURES = {
     "friction": ("friction's own ratio", ".4e"),
     "zeta_minus": ("zeta(a) - 0.005", ".4e"),
     "f2_over_f": ("f2/f(a)", ".5f"),
+    "past_area": ("area past its gap (lin.)", ".4%"),
 }
 
 
-def mesh(factor: float, rpm: float, amplitude: float) -> dict:
-    """One mesh's row: its nodal model at ``rpm`` (all tip nodes) and the EPMC at ``amplitude`` × grazing."""
+def mesh(factor: float, rpm: float, amplitude: float, higher: float | None = None) -> dict:
+    """One mesh's row: its nodal model at ``rpm`` (all tip nodes) and the EPMC at ``amplitude`` × grazing (the modes
+    above the first damped ``higher`` when given, else as the first)."""
     t0 = time.perf_counter()
     study, model, contact = demo(mesh=factor)
     g, scaled = study["geometry"], scaled_study(loads(_study(CASING, ""), source="<bench>"), factor)["geometry"]
@@ -79,16 +82,23 @@ def mesh(factor: float, rpm: float, amplitude: float) -> dict:
     fr = replace(nodal_friction(reduced, MU, axis.origin, axis.direction), model="coulomb")
     s = reduced.system
     omega, phi = s.modes
-    grazing = float(np.min(s.gap / np.abs(s.W.T @ phi[:, 0])))
+    reach = np.abs(s.W.T @ phi[:, 0])  # each node's normal displacement in the first open mode, per unit amplitude
+    grazing = float(np.min(s.gap / reach))
     build = time.perf_counter() - t0
+    # the nodes the first open mode at the amplitude would push past their gaps, and their share of the tip's area
+    past = amplitude * grazing * reach > s.gap
+    k = np.asarray(s.casing, dtype=float)
     row = {"factor": factor, "dofs": int(model.n_dofs), "n": int(s.n), "m": int(s.m),
            "f1_hz": float(omega[0] / 2 / np.pi), "f2_over_f1": float(omega[1] / omega[0]), "grazing": grazing,
-           "build_s": build}
+           "build_s": build, "past": int(past.sum()), "past_area": float(k[past].sum() / k.sum())}
     print(f"mesh x{factor:g} (size {g['size']:.6g}, tip_size {g['tip_size']:.6g}): {row['dofs']} dofs, nodal model "
           f"n = {s.n}, {s.m} tip (contact) nodes, f1 open {row['f1_hz']:.5f} Hz, f2 {omega[1] / 2 / np.pi:.4f} Hz "
-          f"= {row['f2_over_f1']:.5f} f1, grazing amplitude {grazing:.6g} ({build:.1f} s to build)", flush=True)
+          f"= {row['f2_over_f1']:.5f} f1, grazing amplitude {grazing:.6g} ({build:.1f} s to build); the first open "
+          f"mode at {amplitude:g} x grazing pushes {row['past']} nodes past their gaps ({row['past_area']:.2%} of "
+          "the tip's area)", flush=True)
     t = time.perf_counter()
-    m = coulomb_mode(s, fr, amplitude * grazing, damping=DAMPING, guess=None)
+    damping = DAMPING if higher is None else Damping(zeta=(DAMPING.zeta,) + (higher,) * (s.n - 1))
+    m = coulomb_mode(s, fr, amplitude * grazing, damping=damping, guess=None)
     a1, kap = kinetic_factor(m)
     zf = friction_ratio(m.orbit, 0.0, m.period, m.frequency)
     row.update(f_hz=float(m.frequency / 2 / np.pi), zeta=float(m.zeta), kappa=float(kap), a1=float(a1),
@@ -101,21 +111,13 @@ def mesh(factor: float, rpm: float, amplitude: float) -> dict:
     return row
 
 
-def table(rows: list[dict]) -> None:
-    """Per mesh, then each figure's order, extrapolation and the study mesh's error (``richardson``)."""
-    rows = sorted(rows, key=lambda r: -r["factor"])
-    print("\nper mesh:")
-    print(f"{'factor':>7} {'dofs':>7} {'m':>3} {'build s':>8} {'EPMC s':>7} " +
-          " ".join(f"{k:>12}" for k in FIGURES), flush=True)
-    for r in rows:
-        print(f"{r['factor']:7g} {r['dofs']:7d} {r['m']:3d} {r['build_s']:8.1f} {r.get('epmc_s', np.nan):7.0f} " +
-              " ".join(f"{r.get(k, np.nan):12{f}}" for k, (_, f) in FIGURES.items()))
-    if len(rows) < 3:
-        print("(fewer than three meshes: no order)")
-        return
-    h = [r["factor"] for r in rows]
-    print(f"\nRichardson over the meshes {h} (the study's mesh: factor 1):")
-    print(f"{'figure':24} {'factor 1':>13} {'order':>6} {'extrapolated':>13} {'error':>8}  regime")
+def richardson_table(h: list[float], rows: list[dict], label: str) -> None:
+    """Each figure's order, extrapolation and the error of the study's mesh (``h = 1``) by ``richardson`` (the three
+    finest meshes), and the changes from mesh to mesh."""
+    print(f"\nRichardson, h = {label}: {', '.join(f'{x:.4g}' for x in h)} (the study's mesh: h = 1; the three finest "
+          "give the order):")
+    print(f"{'figure':24} {'h = 1':>13} {'order':>6} {'extrapolated':>13} {'error':>8}  order established?; "
+          "changes mesh to mesh")
     for k, (words, f) in FIGURES.items():
         values = [r.get(k) for r in rows]
         r = richardson(h, values, study_h=1.0)
@@ -123,10 +125,30 @@ def table(rows: list[dict]) -> None:
             continue
         order = "-" if r["order"] is None else f"{r['order']:.2f}"
         ext = "-" if r["extrapolated"] is None else format(r["extrapolated"], f)
-        how = estimate_words(r)
-        changes = np.diff(values)
-        print(f"{words:24} {values[0]:13{f}} {order:>6} {ext:>13} {r['error']:8.2%}  {r['regime']}"
-              f"{' (' + how + ')' if how else ''}; changes {', '.join(f'{c:+.3g}' for c in changes)}")
+        how = estimate_words(r) or "yes: 1.25 × the distance from the extrapolation"
+        changes = ", ".join(f"{c:+.3g}" for c in np.diff(values))
+        print(f"{words:24} {values[0]:13{f}} {order:>6} {ext:>13} {r['error']:8.2%}  {how}; {changes}", flush=True)
+
+
+def table(rows: list[dict]) -> None:
+    """Per mesh, then the Richardson table over the factors (as the convergence stage reads them) and, as a check of
+    how far the unstructured meshes are from the factors' refinement, over ``h = (dofs₁/dofs)^(1/3)``."""
+    rows = sorted(rows, key=lambda r: -r["factor"])
+    print("\nper mesh:")
+    print(f"{'factor':>7} {'h dofs':>7} {'dofs':>7} {'m':>3} {'build s':>8} {'EPMC s':>7} " +
+          " ".join(f"{k:>12}" for k in FIGURES), flush=True)
+    for r in rows:
+        h = (rows[0]["dofs"] / r["dofs"]) ** (1 / 3)
+        print(f"{r['factor']:7g} {h:7.4f} {r['dofs']:7d} {r['m']:3d} {r['build_s']:8.1f} "
+              f"{r.get('epmc_s', np.nan):7.0f} " + " ".join(f"{r.get(k, np.nan):12{f}}" for k, (_, f) in
+                                                            FIGURES.items()))
+    if len(rows) < 3:
+        print("(fewer than three meshes: no order)")
+        return
+    if rows[0]["factor"] != 1.0:
+        print("(no mesh of factor 1: the error is the coarsest mesh's)")
+    richardson_table([r["factor"] / rows[0]["factor"] for r in rows], rows, "the factors")
+    richardson_table([(rows[0]["dofs"] / r["dofs"]) ** (1 / 3) for r in rows], rows, "(dofs1/dofs)^(1/3)")
 
 
 def main() -> None:
@@ -134,24 +156,31 @@ def main() -> None:
     ap.add_argument("--factors", type=float, nargs="+", default=[1.0, 0.8, 0.64])
     ap.add_argument("--amplitude", type=float, default=1.5, help="the EPMC's amplitude, times each mesh's grazing")
     ap.add_argument("--rpm", type=float, default=1650.0)
+    ap.add_argument("--higher", type=float, default=None,
+                    help="the damping ratio of the modes above the first (default: 0.5 %%, as the first)")
     ap.add_argument("--json", type=Path, default=None, help="keep each mesh's row here; reuse the rows already there")
     a = ap.parse_args()
     t0 = time.perf_counter()
     done: dict[float, dict] = {}
     if a.json is not None and a.json.exists():
         for r in json.loads(a.json.read_text()):
-            if r.get("rpm") == a.rpm and r.get("amplitude") == a.amplitude:
+            if (r.get("rpm"), r.get("amplitude"), r.get("higher")) == (a.rpm, a.amplitude, a.higher):
                 done[float(r["factor"])] = r
     with threadpool_limits(limits=1, user_api="blas"):
         for factor in a.factors:
             if factor in done:
                 print(f"mesh x{factor:g}: from {a.json}", flush=True)
                 continue
-            done[factor] = {**mesh(factor, a.rpm, a.amplitude), "rpm": a.rpm, "amplitude": a.amplitude}
-            if a.json is not None:
-                a.json.write_text(json.dumps(list(done.values()), indent=1))
+            done[factor] = {**mesh(factor, a.rpm, a.amplitude, a.higher), "rpm": a.rpm, "amplitude": a.amplitude,
+                            "higher": a.higher}
+            if a.json is not None:  # the other settings' rows kept
+                old = json.loads(a.json.read_text()) if a.json.exists() else []
+                keep = [r for r in old if (r.get("rpm"), r.get("amplitude"), r.get("higher"), r.get("factor"))
+                        != (a.rpm, a.amplitude, a.higher, factor)]
+                a.json.write_text(json.dumps(keep + [done[factor]], indent=1))
+    higher = "" if a.higher is None else f" (modes 2 and above: {a.higher:.1%})"
     print(f"\nthe demo blade at {a.rpm:g} rpm, all tip nodes, mu = {MU}, stick–slip, casing at rest, "
-          f"{DAMPING.zeta:.1%} damping; EPMC at {a.amplitude:g} x each mesh's grazing amplitude")
+          f"{DAMPING.zeta:.1%} damping{higher}; EPMC at {a.amplitude:g} x each mesh's grazing amplitude")
     table([done[f] for f in a.factors])
     print(f"\n{time.perf_counter() - t0:.1f} s in all", flush=True)
 
