@@ -48,6 +48,7 @@ from test_rub_study import CASING, _study  # noqa: E402
 from bladecase.nsm import Damping  # noqa: E402
 from bladecase.nsm.massless.friction_modes_coulomb import coulomb_mode  # noqa: E402
 from bladecase.nsm.massless.friction_modes_phase import kinetic_factor  # noqa: E402
+from bladecase.nsm.massless.nodal_system import lcp  # noqa: E402
 from bladecase.reduction.nodal_friction import nodal_friction  # noqa: E402
 from bladecase.study.convergence.stage import estimate_words, richardson, scaled_study  # noqa: E402
 from bladecase.study.rub import stage  # noqa: E402
@@ -57,14 +58,18 @@ from bladecase.study.schema import loads  # noqa: E402
 FIGURES = {
     "f1_hz": ("f1 open (Hz)", ".5f"),
     "f2_over_f1": ("f2/f1 open", ".5f"),
+    "gap_um": ("hot gap, grazing node (um)", ".4f"),
+    "reach": ("its normal disp. in mode 1", ".5f"),
     "grazing": ("grazing amplitude", ".6g"),
     "f_hz": ("EPMC f(a) (Hz)", ".5f"),
+    "stiffening": ("f(a)/f1 - 1", ".4e"),
     "zeta": ("zeta(a)", ".7f"),
     "zeta_kappa": ("zeta*kappa", ".7f"),
     "friction": ("friction's own ratio", ".4e"),
     "zeta_minus": ("zeta(a) - 0.005", ".4e"),
     "f2_over_f": ("f2/f(a)", ".5f"),
     "past_area": ("area past its gap (lin.)", ".4%"),
+    "force_n": ("normal force, mode 1 (N)", ".5f"),
 }
 
 
@@ -85,23 +90,30 @@ def mesh(factor: float, rpm: float, amplitude: float, higher: float | None = Non
     reach = np.abs(s.W.T @ phi[:, 0])  # each node's normal displacement in the first open mode, per unit amplitude
     grazing = float(np.min(s.gap / reach))
     build = time.perf_counter() - t0
-    # the nodes the first open mode at the amplitude would push past their gaps, and their share of the tip's area
+    # the nodes the first open mode at the amplitude would push past their gaps, and their share of the tip's area;
+    # the normal forces there with the other modes held (the contact problem at that turning point)
     past = amplitude * grazing * reach > s.gap
     k = np.asarray(s.casing, dtype=float)
+    toward = np.sign((s.W.T @ phi[:, 0])[np.argmin(s.gap / reach)]) * (s.W.T @ phi[:, 0])
+    lam = lcp(s.gap - amplitude * grazing * toward, s.H)
     row = {"factor": factor, "dofs": int(model.n_dofs), "n": int(s.n), "m": int(s.m),
            "f1_hz": float(omega[0] / 2 / np.pi), "f2_over_f1": float(omega[1] / omega[0]), "grazing": grazing,
-           "build_s": build, "past": int(past.sum()), "past_area": float(k[past].sum() / k.sum())}
+           "build_s": build, "past": int(past.sum()), "past_area": float(k[past].sum() / k.sum()),
+           "gap_um": float(1e6 * s.gap[np.argmin(s.gap / reach)]), "reach": float(reach[np.argmin(s.gap / reach)]),
+           "force_n": float(lam.sum()), "pressed": int(np.count_nonzero(lam > 0))}
     print(f"mesh x{factor:g} (size {g['size']:.6g}, tip_size {g['tip_size']:.6g}): {row['dofs']} dofs, nodal model "
           f"n = {s.n}, {s.m} tip (contact) nodes, f1 open {row['f1_hz']:.5f} Hz, f2 {omega[1] / 2 / np.pi:.4f} Hz "
-          f"= {row['f2_over_f1']:.5f} f1, grazing amplitude {grazing:.6g} ({build:.1f} s to build); the first open "
+          f"= {row['f2_over_f1']:.5f} f1, grazing amplitude {grazing:.6g} (the hot gap at the grazing node "
+          f"{row['gap_um']:.3f} um) ({build:.1f} s to build); the first open "
           f"mode at {amplitude:g} x grazing pushes {row['past']} nodes past their gaps ({row['past_area']:.2%} of "
-          "the tip's area)", flush=True)
+          f"the tip's area), held there: {row['force_n']:.4f} N on {row['pressed']} nodes", flush=True)
     t = time.perf_counter()
     damping = DAMPING if higher is None else Damping(zeta=(DAMPING.zeta,) + (higher,) * (s.n - 1))
     m = coulomb_mode(s, fr, amplitude * grazing, damping=damping, guess=None)
     a1, kap = kinetic_factor(m)
     zf = friction_ratio(m.orbit, 0.0, m.period, m.frequency)
-    row.update(f_hz=float(m.frequency / 2 / np.pi), zeta=float(m.zeta), kappa=float(kap), a1=float(a1),
+    row.update(f_hz=float(m.frequency / 2 / np.pi), stiffening=float(m.frequency / omega[0] - 1),
+               zeta=float(m.zeta), kappa=float(kap), a1=float(a1),
                zeta_kappa=float(m.zeta * kap), friction=float(zf), zeta_minus=float(m.zeta - DAMPING.zeta),
                f2_over_f=float(omega[1] / m.frequency), epmc_s=time.perf_counter() - t,
                phases=int(m.orbit.starts.size))
