@@ -37,8 +37,9 @@ factor  dofs   m    f1 open    f2/f1    grazing    f(a) Hz    ζ(a)       ζκ  
 ======  =====  ===  =========  =======  =========  =========  =========  =========  =========  =======  =======
 
 (0.32768: 59976 dofs, 112 tip nodes, f1 219.83103 Hz, f2/f1 4.03494, grazing 9.6216e-5 in 26 s; its EPMC not
-reached: the first flight of ``coulomb_mode``'s start guess stops at t = 0.49854 T1 on one node's slip signal,
-switched again and again at the same instant with nothing changed — 2341 switches in 300 s, the same at 1.5001 ×.)
+reached in 18 min: the first flight of ``coulomb_mode``'s start guess stalls at t = 0.49854 T1, one node's slip
+signal switched again and again at the same instant with nothing changed — the switch finds it grazing and goes on,
+and the flight's next search finds it again at τ = 0 — 2341 times in 300 s, the same at 1.5001 × grazing.)
 
 The error of the study's mesh (``richardson``, h = the factors; "—": the order not established, 3 × the range):
 
@@ -59,25 +60,27 @@ f2/f(a)                 6.77, 4.0192, 0.57 %                       2.03, 4.0334,
 
 What they say. The frequencies converge from below at an established order (3.5–4): f1 and f(a) of the study's mesh
 are 1.4 % low (219.94 / 220.27 Hz extrapolated), error estimate 1.5–1.7 %. The grazing amplitude is 10–13 % low
-(error estimate 13–16 %):
-the hot gap at the grazing node (the leading tip corner, the same node on every mesh) is the cold 0.5 mm less the
-centrifugal growth, 134.4 → 141.2 → 144.3 → 146.6 → 147.9 μm (the growth, ~0.36 mm, converging slowly, order ~2,
-and the gap its small remainder), with the mode's normal displacement there 1.578 → 1.546. The damping figures
-jump at the first refinement and then drift: ζ(a) − 0.005 is 3.04e-4 on the study's mesh, 2.40, 2.36, 2.31, 2.28e-4
-after (−21 %, then −1.4…−2 % a step; extrapolated 2.19e-4: the study's mesh ~+39 %); ζ(a) itself is 1.6 % high.
-Friction's own ratio is 2.42e-4 on the study's mesh and 2.214–2.231e-4 (±0.4 %, oscillating) on the four finer: +9 %.
-The 4:1 internal resonance moves with the mesh: f2/f(a) = 4.0008 on the study's mesh (mode 2 within 0.02 % of the
-orbit's 4th harmonic), 4.015, 4.018, 4.024, 4.027 on the finer ones, 4.033 extrapolated; the part of ζ − 0.005 that
-is not friction's (mode 2's damping, pumped) falls 6.2e-5 → 1.9, 1.4, 0.8, 0.5e-5, κ 1.0047 → 1.0008.
-With ``--higher 0.05`` (mode 2 not resonating, κ ≤ 1.0001) friction's own ratio is 3.030e-4, 2.474, 2.431, 2.383,
-2.347e-4: monotone, order 1.35, extrapolated 2.246e-4, the study's mesh +35 % (error estimate 44 %); ζ(a) 0.0053018 →
-0.0052328 (order 1.31, 1.9 %). So the jump at the first refinement is not the internal resonance: with 0.5 % on
-mode 2 the two effects (friction's part falling with the mesh, mode 2 detuning from 4:1) partly cancel in friction's
-own ratio, and its +9 % is that coincidence, not a small mesh error. Nor is it the normal load: the first mode held
-at 1.5 × grazing presses 5, 7, 8, 11, 14 nodes (6.5–9.0 % of the tip's area) with 2.185, 2.114, 2.218, 2.224,
-2.253 N in all (within 3 %). With h from the dofs the orders rise (f1: 6.1 over 1, 0.8, 0.64; 5.4 over the three
-finest) and the errors stay within 0.5 points (f(a)/f1 − 1: 27 %, ζ − 0.005: 47 %), except that over 1, 0.8, 0.64
-f2/f1 and f2/f(a) lose their order (order 10: 1.3 % instead of 0.55 %).
+(error estimate 13–16 %): the hot gap at the grazing node (a corner of the tip, the same point on every mesh) is the
+cold 0.5 mm less the centrifugal growth, 134.4 → 141.2 → 144.3 → 146.6 → 147.9 μm (the growth, ~0.36 mm, converging
+slowly, order ~2, and the gap its small remainder), with the mode's normal displacement there 1.578 → 1.546. The
+damping figures jump at the first refinement and then drift: ζ(a) − 0.005 is 3.04e-4 on the study's mesh, 2.40,
+2.36, 2.31, 2.28e-4 after (−21 %, then −1.4…−2 % a step; extrapolated 2.19e-4: the study's mesh ~+39 %); ζ(a) itself
+is 1.6 % high. Friction's own ratio is 2.42e-4 on the study's mesh and 2.214–2.231e-4 (±0.4 %, oscillating) on the
+four finer: +9 %. The 4:1 internal resonance moves with the mesh: f2/f(a) = 4.0008 on the study's mesh (mode 2
+within 0.02 % of the orbit's 4th harmonic), 4.015, 4.018, 4.024, 4.027 on the finer ones, 4.033 extrapolated; the
+part of ζ − 0.005 that is not friction's (mode 2's damping, pumped) falls 6.2e-5 → 1.9, 1.4, 0.8, 0.5e-5, κ 1.0047 →
+1.0008. With ``--higher 0.05`` (mode 2 not resonating, κ ≤ 1.0001) friction's own ratio is 3.030e-4, 2.474, 2.431,
+2.383, 2.347e-4: monotone, order 1.35, extrapolated 2.246e-4, the study's mesh +35 % (error estimate 44 %); ζ(a)
+0.0053018 → 0.0052328 (order 1.31, 1.9 %). So the jump at the first refinement is not the internal resonance: with
+0.5 % on mode 2 the two effects (friction's part falling with the mesh, mode 2 detuning from 4:1) partly cancel in
+friction's own ratio, and its +9 % is that coincidence, not a small mesh error. Nor is it the total normal load: the
+first mode held at 1.5 × grazing presses 5, 7, 8, 11, 14 nodes (6.5–9.0 % of the tip's area) with 2.185, 2.114,
+2.218, 2.224, 2.253 N in all (within 3 %); but on the study's mesh half of it (1.10 N) sits on one node of 3.3 % of
+the tip's area, tangentially stiff, where on the meshes 0.8 and 0.64 the most loaded node carries 0.57 and 0.51 N:
+how the load is shared among the tip's nodes is what the coarse mesh gets wrong. With h from the dofs the orders
+rise (f1: 6.1 over 1, 0.8, 0.64; 5.4 over the three finest) and the errors move by at most 0.5 points, except
+f(a)/f1 − 1 (27 % instead of 32 %) and ζ − 0.005 (47 % instead of 49 %); over 1, 0.8, 0.64 alone, f2/f1 and f2/f(a)
+lose their order (order 10: 1.3 % instead of 0.55 %).
 """
 
 from __future__ import annotations
