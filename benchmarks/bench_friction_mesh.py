@@ -89,7 +89,7 @@ At 3 × grazing (``--amplitude 3``; 25, 39, 48, 104 s an EPMC): f(a) 219.82019, 
 again the outlier (friction's own ratio +43 % over the mesh 0.8's, ζ(a) +8 %), and the finer meshes are not in the
 asymptotic range (the changes from 0.64 to 0.512 larger than from 0.8 to 0.64: no order; error estimates 3 × the
 range: ζ 32 %, friction's own 158 %); f(a) order 1.34, 223.94 Hz extrapolated, 2.3 %. The mesh 0.4096 at 3 ×: its
-EPMC not reached (stopped after 13 min inside the solve's flights, the 0.512's took 104 s).
+EPMC not reached (stopped after 11 min inside the solve's flights, the 0.512's took 104 s).
 """
 
 from __future__ import annotations
