@@ -154,8 +154,9 @@ class CoulombFlight:
     def _violations(self, codes, anchors, q, p, t, decided=None) -> tuple[CoulombPhase, list[int]]:
         """The phase ``codes`` started at ``(q, p, t)`` and its signals that start inadmissible, the most negative
         first: below 0, or on their surface and not leaving it (falling, or flat and not curving up). ``decided``:
-        nodes whose state the rate-level problem chose (:meth:`_on_cone`): their signals above 0 may fall (a slide
-        at a small rate ends in the flight)."""
+        nodes whose state the rate-level problem chose (:meth:`_on_cone`): their signals above 0 — beyond
+        :data:`~bladecase.nsm.massless.nodes.SURFACE_RTOL` of their size, not by round-off — may fall (a slide at a
+        small rate ends in the flight)."""
         ph = self.phase(codes)
         amp = ph.amplitudes(q, p, t, anchors)
         sig = ph.signals(self, amp, t, anchors, 0.0)
@@ -166,7 +167,7 @@ class CoulombFlight:
         flat = on & (np.abs(d0) <= FLAT_RTOL * np.maximum(rate, np.finfo(float).tiny))
         if decided is not None:
             rows = decided[[node for node, _ in ph.meta]]
-            on = (on | (rows & (np.abs(f0) <= DECIDED_RTOL * scale))) & ~(rows & (f0 > 0))
+            on = (on | (rows & (np.abs(f0) <= DECIDED_RTOL * scale))) & ~(rows & (f0 > SURFACE_RTOL * scale))
         bad = (~on & (f0 < 0)) | (on & ~flat & (d0 < 0)) | (flat & (sig.second() <= 0))
         order = np.argsort(np.where(on, 0.0, f0 / scale), kind="stable")
         return ph, [int(k) for k in order if bad[k]]

@@ -114,7 +114,7 @@ def _start(fl: CoulombFlight, q, p, ratio: np.ndarray) -> tuple[np.ndarray, np.n
 def _flow(fl: CoulombFlight, q, p, codes, anchors, period: float, max_switches: int = 20_000) -> CoulombTrajectory:
     """The flight of ``period`` from ``(q, p)`` with the node state ``(codes, anchors)``: its phases as a
     :class:`CoulombTrajectory` (switches on a grid, then bracketed: the phases may grow)."""
-    t = 0.0
+    t, still = 0.0, 0
     starts, cl, al, qs, ps, amps = [], [], [], [], [], []
     for _ in range(max_switches):
         ph = fl.phase(codes)
@@ -129,7 +129,14 @@ def _flow(fl: CoulombFlight, q, p, codes, anchors, period: float, max_switches: 
         tau, k = hit
         q, p = ph.advance(amp, t, tau, anchors)
         t += tau
-        codes, anchors = fl._switch(ph, k, codes, anchors, q, p, t)
+        new, anchors = fl._switch(ph, k, codes, anchors, q, p, t)
+        # a switch that changes no node and finds its signal again at once would repeat forever
+        still = still + 1 if np.array_equal(new, codes) and tau <= 1e-12 * period else 0
+        if still > 2 * fl.m + 2:
+            node, kind = ph.meta[k]
+            raise ValueError(f"the mode's flow is stuck at t = {t:.12g} s: contact node {fl.system.nodes[node]}'s "
+                             f"{kind} signal reaches 0 again at once and no node changes (a degenerate switch)")
+        codes = new
     else:
         raise ValueError(f"the mode's flow needed more than {max_switches} switches in one period")
     return CoulombTrajectory(fl, np.array(starts), np.array(cl), np.array(al), np.array(qs).T, np.array(ps).T,
