@@ -36,11 +36,13 @@ factor  dofs   m    f1 open    f2/f1    grazing    f(a) Hz    ζ(a)       ζκ  
 0.4096  34635  76   219.76867  4.03361  9.5685e-5  220.11335  0.0052277  0.0052316  2.2251e-4  4.02729  12 + 20
 ======  =====  ===  =========  =======  =========  =========  =========  =========  =========  =======  =======
 
-(0.32768: 59976 dofs, 112 tip nodes, f1 219.83103 Hz, f2/f1 4.03494, grazing 9.6216e-5 in 26 s; its EPMC not
-reached in 18 min: the first flight of ``coulomb_mode``'s start guess stalls at t = 0.49854 T1 — one sliding node's
-slip signal reaches 0 falling (slope −756, not a graze), the nodes decided together at the rate level keep every
-code as it was, the signal is left a hair above 0 (4e-18 of its size), and the flight's next search finds its root
-again at τ ≈ 0, t unchanged: 2341 such switches in 300 s, the same at 1.5001 × grazing.)
+0.32768: 59976 dofs, 112 tip nodes, f1 219.83103 Hz, f2/f1 4.03494, grazing 9.62158e-5 (28.5 s to build); EPMC
+f = 220.17310 Hz, ζ = 0.0052256, ζκ = 0.0052292, friction's own 2.2133e-4, f2/f(a) 4.02867, 70 phases (32 s).
+Over the three finest of the six: f1 order 5.1, extrapolated 219.861 Hz, the demo mesh's error 1.7 %; ζ order 2.0,
+0.0052219, 2.0 %; ζ − 0.005 order 1.7, 2.206e-4, 47 %; friction's own not established (not shrinking), 28 %.
+(Before the fix of a stick–slip switch this mesh's EPMC did not finish: its first flight switched 2341 times in
+300 s at t = 0.49854 T1 without advancing — a sliding node's slip signal reaching 0 falling, the nodes decided
+together keeping every code, the signal left 4e-18 of its size above 0.)
 
 The error of the study's mesh (``richardson``, h = the factors; "—": the order not established, 3 × the range):
 
