@@ -154,9 +154,9 @@ def sweep(count: int, revolutions: int, max_revolutions: int) -> None:
     print(f"3. a {count}-speed friction/wear sweep as the study runs it ({speeds[0]:g}-{speeds[-1]:g} rpm, "
           f"mu = {MU}, coating {COATING}, {revolutions} revolutions (at most {cap}), wear in flight)")
     print("   rpm      model s   rub s   wear s   total s  (cpu s)  rub revs  wear phases  removed mm3  "
-          "energy residual")
+          "energy residual (rub, wear)")
     t0, c0 = time.perf_counter(), time.process_time()
-    sums, worst, refusals = np.zeros(3), 0.0, 0
+    sums, worst, worn_worst, refusals = np.zeros(3), 0.0, 0.0, 0
     for rpm, w in zip(speeds, w_all):
         t, cpu = time.perf_counter(), time.process_time()
         state = spin(model, w, axis, static=static, previous=earlier.states)
@@ -175,7 +175,7 @@ def sweep(count: int, revolutions: int, max_revolutions: int) -> None:
             times.append(time.perf_counter() - t)
             t = time.perf_counter()
             worn = wear_rub(reduced.system, coating, w, k["lobes"], k["amplitude"], angles, damping,
-                            r["revolutions"], areas=reduced.areas, friction=fr, flight=flight)
+                            r["revolutions"], areas=reduced.areas, friction=fr, flight=flight, energy=True)
         except ValueError as exc:
             refused = str(exc)
         times.append(time.perf_counter() - t)
@@ -189,12 +189,14 @@ def sweep(count: int, revolutions: int, max_revolutions: int) -> None:
             continue
         res = response.as_dict().get("friction", {}).get("relative_residual", float("nan"))
         worst = max(worst, abs(res))
+        balance = max(abs(e.relative) for e in worn.energy)
+        worn_worst = max(worn_worst, balance)
         print(f"{head}{response.revolutions_run:8d}  {worn.phases:11d}  {1e9 * worn.profile.removed:11.4g}  "
-              f"{res:.1e}", flush=True)
+              f"{res:.1e}, {balance:.1e}", flush=True)
     total, cpu = time.perf_counter() - t0, time.process_time() - c0
     print(f"   {total:.1f} s in all ({total / count:.2f} s a speed; {cpu:.1f} s of CPU): models {sums[0]:.1f} s, rubs "
-          f"with friction and energy {sums[1]:.1f} s, wear rubs in flight {sums[2]:.1f} s; worst energy residual "
-          f"{worst:.2e}; {refusals} speeds refused")
+          f"with friction and energy {sums[1]:.1f} s, wear rubs in flight with their energy {sums[2]:.1f} s; worst "
+          f"energy residual {worst:.2e} (rub), {worn_worst:.2e} (wear); {refusals} speeds refused")
 
 
 def main() -> None:

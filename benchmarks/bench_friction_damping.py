@@ -156,6 +156,7 @@ def main() -> None:
     ap.add_argument("--amplitudes", type=float, nargs="+", default=[1.5, 2.0, 2.5, 3.0])
     ap.add_argument("--nodes", type=int, nargs="+", default=None, help="a subset of the tip nodes (default: all)")
     ap.add_argument("--rpm", type=float, default=1650.0)
+    ap.add_argument("--mesh", type=float, default=1.0, help="the demo's element sizes times this (a finer mesh: < 1)")
     ap.add_argument("--points", type=int, default=21)
     ap.add_argument("--span", type=float, default=3.0, help="the sweep's half-width in zeta(sqrt2 a) (relative)")
     ap.add_argument("--refine", type=int, default=10, help="golden-section evaluations at the peak (0: none)")
@@ -225,14 +226,15 @@ def blade(a):
     """The demo blade's nodal model at ``a.rpm`` (``a.nodes`` of its tip nodes), its stick–slip friction and the
     first mode's grazing amplitude, said in a line."""
     t0 = time.perf_counter()
-    study, model, contact = demo()
+    study, model, contact = demo(mesh=getattr(a, "mesh", 1.0))
     reduced, _, _ = at_speed(study, model, contact, a.rpm, nodes=a.nodes)
     axis = stage._axis(study)
     fr = replace(nodal_friction(reduced, MU, axis.origin, axis.direction), model="coulomb")
     s = reduced.system
     omega, phi = s.modes
     grazing = float(np.min(s.gap / np.abs(s.W.T @ phi[:, 0])))
-    print(f"the demo blade at {a.rpm:g} rpm, tip nodes {'all' if a.nodes is None else a.nodes} of "
+    print(f"the demo blade (mesh x{getattr(a, 'mesh', 1.0):g}, {model.n_dofs} dofs) at {a.rpm:g} rpm, tip nodes "
+          f"{'all' if a.nodes is None else a.nodes} of "
           f"{len(contact.nodes)}: n = {s.n}, m = {s.m}, f1 = {omega[0] / 2 / np.pi:.3f} Hz open, grazing amplitude "
           f"{grazing:.4g}; mu = {MU}, stick–slip, casing at rest, {np.min(DAMPING.zeta):.1%} damping "
           f"({time.perf_counter() - t0:.1f} s to build)")
