@@ -47,6 +47,10 @@ Figures (``--method phase``, all 26 nodes, ``--rtol 1e-8``; a busy two-core mach
 - 500 rpm (``--rpm 500``; mode 2 at 4.09 f1), 1.5 x grazing: EPMC f = 213.05825 Hz, ζ = 0.0061519; free decay
   −0.29 %; lower flank 211.64327 Hz: ω −4.1e-4, ζκ +0.52 %, friction's own +10.1 % (modes 2–4 answer the 4th, 8th
   and 9th harmonics 34/44/31-fold at the mode's frequency, 24/29/50-fold at the flank).
+- Mesh x0.8 (``--mesh 0.8``: 8958 dofs, 36 tip nodes, f1 = 218.509 Hz open), 1.5 x grazing: EPMC f = 218.86715 Hz,
+  ζ = 0.0052402, κ = 1.00169; free decay −0.067 %; lower flank 217.70349 Hz: ζκ −0.11 %, friction's own +8.8 %;
+  upper flank 219.97989 Hz: ζκ −0.05 %, friction's own −0.9 %; width from the amplitudes alone +0.95 % (mode 2 at
+  878.78 Hz answers the 4th harmonic x80 at the mode's frequency, x49 / x97 at the flanks; 248 s).
 - Each amplitude 1–10 minutes (a forced point 10–60 s, an upper flank near the fold the longest).
 
 Earlier figures, ``--method sweep`` (amplitude as the largest value over a period, before the decay was read at
