@@ -37,6 +37,9 @@ times carry that noise, the CPU seconds less), one process, 4 revolutions a spee
   edge), the same command, load about 2.3 (a helper's benchmark and a diagnostic beside it): every speed runs,
   658.0 s in all (13.2 s a speed; 451.0 s of CPU): models 29.7 s, rubs 32.9 s, wear rubs 595.4 s; worst energy
   residual 1.13e-12; 1657.1 rpm: 18 008 phases, 1.394e4 mm3 removed, as when it runs alone.
+- The wear rub with its energy balance per revolution, as the study now flies it (``wear_rub(..., energy=True)``),
+  load about 1.5 (a benchmark beside it): every speed runs, 497.0 s in all (9.9 s a speed; 495.3 s of CPU): models
+  18.8 s, rubs 21.3 s, wear rubs with their energy 456.9 s; worst energy residual 1.13e-12 (rub), 4.52e-11 (wear).
 - Before the coating flight's shortcuts (next profile edges from the runs of equal depth, a flight started from the
   start its decision computed, phases kept for the sampling; the same numbers bit for bit), the same sweep's first
   3 speeds back to back: wear rubs 77.0 s -> 53.6 s, 58.4 s -> 44.3 s of CPU for the 3 speeds; one speed at
