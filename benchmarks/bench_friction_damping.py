@@ -50,7 +50,10 @@ Figures (``--method phase``, all 26 nodes, ``--rtol 1e-8``; a busy two-core mach
 - Mesh x0.8 (``--mesh 0.8``: 8958 dofs, 36 tip nodes, f1 = 218.509 Hz open), 1.5 x grazing: EPMC f = 218.86715 Hz,
   ζ = 0.0052402, κ = 1.00169; free decay −0.067 %; lower flank 217.70349 Hz: ζκ −0.11 %, friction's own +8.8 %;
   upper flank 219.97989 Hz: ζκ −0.05 %, friction's own −0.9 %; width from the amplitudes alone +0.95 % (mode 2 at
-  878.78 Hz answers the 4th harmonic x80 at the mode's frequency, x49 / x97 at the flanks; 248 s).
+  878.78 Hz answers the 4th harmonic x80 at the mode's frequency, x49 / x97 at the flanks; 248 s). At 3 x: EPMC
+  f = 221.15017 Hz, ζ = 0.0087857, κ = 1.07874 (deeper in the 4:1 resonance than the demo mesh's 1.045), free decay
+  −0.109 %; the lower flank folds before a₁ (6 points). At 2 x the EPMC stops at a degenerate switch (node 42's
+  cone signal: no admissible next state).
 - Each amplitude 1–10 minutes (a forced point 10–60 s, an upper flank near the fold the longest).
 
 Earlier figures, ``--method sweep`` (amplitude as the largest value over a period, before the decay was read at
