@@ -135,7 +135,7 @@ def modes_section(rows: list[dict], points: list[dict], unit: str) -> dict | Non
            for row, p in zip(rows, points) if p.get("friction_modes") is not None]
     if not per:
         return None
-    doubts, worst, internal = [], None, []
+    doubts, worst, internal, flagged = [], None, [], set()
     for s in per:
         for q in s["points"]:
             where = f"{q['amplitude_ratio']:g} × grazing at {s['speed']:.6g} {unit}"
@@ -145,7 +145,8 @@ def modes_section(rows: list[dict], points: list[dict], unit: str) -> dict | Non
                 doubts.append(f"at {where} the orbit did not close (residual {q['residual']:.1e}): its figures are "
                               "not a mode's")
             elif q["decay_error"] is not None:
-                if q.get("internal") and not any(d.startswith(f"at {s['speed']:.6g} {unit}") for d in internal):
+                if q.get("internal") and s["speed"] not in flagged:  # once a speed, from its least amplitude
+                    flagged.add(s["speed"])
                     i = q["internal"]
                     ratio = i["frequency_hz"] / q["frequency_hz"]
                     internal.append(f"at {s['speed']:.6g} {unit} from {q['amplitude_ratio']:g} × grazing: mode "
